@@ -1,0 +1,39 @@
+// A subcommand of the `terrapolis` command line; every command is registered in commands.cpp.
+// SPDX-License-Identifier: MIT
+#pragma once
+#include <array>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/progress.hpp"
+
+namespace CLI { class App; }
+
+namespace terrapolis::cli {
+
+/// What every command receives from the global options.
+struct Context {
+  Log log;
+  Progress& progress;
+  int threads = 0;  ///< 0: all cores
+};
+
+class Command {
+ public:
+  virtual ~Command() = default;
+  virtual std::string name() const = 0;
+  virtual std::string summary() const = 0;
+  /// Declares the command's options on its CLI11 subcommand.
+  virtual void setup(CLI::App& app) = 0;
+  /// Runs with the parsed options. Throws terrapolis::Error.
+  virtual void run(Context& context) = 0;
+};
+
+/// Every command, in the order `terrapolis --help` lists them (the one registration point).
+std::vector<std::unique_ptr<Command>> all_commands();
+
+/// Parses "X,Y" (either may be negative) into two numbers. Throws bad_input naming `option`.
+std::array<double, 2> parse_pair(const std::string& option, const std::string& text);
+
+}  // namespace terrapolis::cli

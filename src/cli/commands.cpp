@@ -1,0 +1,14 @@
+// The one list of `terrapolis` subcommands.
+// SPDX-License-Identifier: MIT
+#include "cli/command.hpp"
+#include "cli/commands_list.hpp"
+
+namespace terrapolis::cli {
+
+std::vector<std::unique_ptr<Command>> all_commands() {
+  std::vector<std::unique_ptr<Command>> commands;
+  commands.push_back(make_info_command());
+  return commands;
+}
+
+}  // namespace terrapolis::cli

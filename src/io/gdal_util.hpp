@@ -1,0 +1,29 @@
+// Private helpers shared by the io sources (the only files that see GDAL headers).
+// SPDX-License-Identifier: MIT
+#pragma once
+#include <ogr_spatialref.h>
+
+#include <string>
+
+#include "core/raster.hpp"
+
+namespace terrapolis::detail {
+
+/// Describes an OGR spatial reference as a Crs.
+Crs describe(const OGRSpatialReference& srs);
+
+/// The OGR spatial reference of a Crs, with longitude-first axis order.
+OGRSpatialReference to_ogr(const Crs& crs);
+
+/// Last GDAL error message, or `fallback`.
+std::string last_gdal_error(const std::string& fallback);
+
+/// Writes to "<path>.tmp-<pid>" then renames over `path`, removing the temporary on failure.
+std::string temporary_name(const std::string& path);
+void commit_file(const std::string& temporary, const std::string& path);
+void discard_file(const std::string& temporary);
+
+/// Refuses an existing output unless `overwrite`, and an output whose folder does not exist or is not writable.
+void check_output(const std::string& path, bool overwrite);
+
+}  // namespace terrapolis::detail

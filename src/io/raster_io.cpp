@@ -1,0 +1,319 @@
+// GDAL raster reading and GeoTIFF writing.
+// SPDX-License-Identifier: MIT
+#include "io/raster_io.hpp"
+
+#include <cpl_conv.h>
+#include <cpl_error.h>
+#include <gdal_priv.h>
+#include <gdalwarper.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <limits>
+#include <memory>
+#include <mutex>
+#include <unistd.h>
+
+#include "core/error.hpp"
+#include "io/gdal_util.hpp"
+
+namespace terrapolis {
+namespace {
+
+struct DatasetCloser {
+  void operator()(GDALDataset* d) const { if (d) GDALClose(GDALDataset::ToHandle(d)); }
+};
+using DatasetPtr = std::unique_ptr<GDALDataset, DatasetCloser>;
+
+/// Silences GDAL's stderr output for a scope; errors are read with CPLGetLastErrorMsg.
+struct QuietGdal {
+  QuietGdal() { CPLPushErrorHandler(CPLQuietErrorHandler); CPLErrorReset(); }
+  ~QuietGdal() { CPLPopErrorHandler(); }
+};
+
+DatasetPtr open_raster(const std::string& path) {
+  init_gdal();
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec) && path.rfind("/vsi", 0) != 0)
+    throw bad_input(path + ": no such file");
+  QuietGdal quiet;
+  auto* ds = GDALDataset::Open(path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY);
+  if (!ds) throw bad_input(path + ": not a raster GDAL can read (" + detail::last_gdal_error("unknown format") + ")");
+  if (ds->GetRasterCount() == 0) {
+    GDALClose(ds);
+    throw bad_input(path + ": holds no raster band");
+  }
+  return DatasetPtr(ds);
+}
+
+/// Metres per vertical unit from the band's unit string or a compound CRS's vertical part.
+double vertical_factor(const std::string& path, GDALRasterBand* band, const OGRSpatialReference* srs, std::string& unit) {
+  unit = band->GetUnitType() ? band->GetUnitType() : "";
+  std::string u = unit;
+  std::transform(u.begin(), u.end(), u.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (u.empty() && srs && srs->IsCompound()) {
+    const char* name = nullptr;
+    const double f = srs->GetTargetLinearUnits("VERT_CS", &name);
+    if (name) unit = name;
+    if (f > 0) return f;
+  }
+  if (u.empty() || u == "m" || u == "metre" || u == "meter" || u == "metres" || u == "meters") return 1.0;
+  if (u == "ft" || u == "foot" || u == "feet" || u == "international foot") return 0.3048;
+  if (u == "us-ft" || u == "us survey foot" || u == "ftus" || u == "foot_us") return 1200.0 / 3937.0;
+  if (u == "cm") return 0.01;
+  if (u == "km") return 1000.0;
+  throw bad_input(path + ": unknown vertical unit '" + unit + "'");
+}
+
+RasterHeader header_of(const std::string& path, GDALDataset& ds, const ReadOptions& options, GDALRasterBand*& band_out,
+                       double& vfactor) {
+  RasterHeader h;
+  h.cols = ds.GetRasterXSize();
+  h.rows = ds.GetRasterYSize();
+  h.bands = ds.GetRasterCount();
+  h.driver = ds.GetDriver() ? ds.GetDriver()->GetDescription() : "";
+  int band = 1;
+  if (options.band) {
+    band = *options.band;
+    if (band < 1 || band > h.bands)
+      throw bad_input(path + ": band " + std::to_string(band) + " does not exist (the file has " + std::to_string(h.bands) + ")");
+  } else if (h.bands > 1) {
+    throw bad_input(path + ": has " + std::to_string(h.bands) +
+                    " bands (a colour image?), not a DEM; choose one with --band N");
+  }
+  GDALRasterBand* b = ds.GetRasterBand(band);
+  if (!options.band && (b->GetColorTable() || b->GetColorInterpretation() == GCI_PaletteIndex))
+    throw bad_input(path + ": is a palette colour image, not a DEM; use --band 1 to read its indices as heights");
+  h.data_type = GDALGetDataTypeName(b->GetRasterDataType());
+  if (h.cols < 2 || h.rows < 2)
+    throw bad_input(path + ": is " + std::to_string(h.cols) + "x" + std::to_string(h.rows) + " cells; a DEM needs at least 2x2");
+  // Refuse before allocating anything: float values plus the working copies a stage makes.
+  const double bytes = double(h.cols) * double(h.rows) * sizeof(float);
+  const double memory = double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE));
+  if (double(h.cols) * double(h.rows) > double(std::numeric_limits<std::int32_t>::max()) || bytes * 4 > memory)
+    throw bad_input(path + ": size " + std::to_string(h.cols) + "x" + std::to_string(h.rows) + " (" +
+                    std::to_string(std::int64_t(bytes / 1e6)) + " MB as float) is too large for this machine's memory");
+  std::array<double, 6> gt;
+  if (ds.GetGeoTransform(gt.data()) != CE_None)
+    throw bad_input(path + ": has no geotransform (not georeferenced)");
+  h.georef.transform = gt;
+  const OGRSpatialReference* srs = ds.GetSpatialRef();
+  if (srs && !srs->IsEmpty()) {
+    h.georef.crs = detail::describe(*srs);
+  } else if (options.assume_crs) {
+    OGRSpatialReference user;
+    if (user.SetFromUserInput(options.assume_crs->c_str()) != OGRERR_NONE)
+      throw bad_input(path + ": unknown CRS '" + *options.assume_crs + "' given to --assume-crs");
+    h.georef.crs = detail::describe(user);
+  } else {
+    throw bad_input(path + ": has no CRS; give one with --assume-crs EPSG:n");
+  }
+  if (h.georef.crs.geographic && (gt[2] != 0 || gt[4] != 0))
+    throw bad_input(path + ": rotated geographic grids are not supported");
+  int has_nodata = 0;
+  const double nd = b->GetNoDataValue(&has_nodata);
+  if (has_nodata) h.nodata = nd;
+  int has = 0;
+  h.scale = b->GetScale(&has);
+  if (!has) h.scale = 1.0;
+  h.offset = b->GetOffset(&has);
+  if (!has) h.offset = 0.0;
+  vfactor = vertical_factor(path, b, srs, h.vertical_unit);
+  band_out = b;
+  return h;
+}
+
+GDALDataType gdal_type(float) { return GDT_Float32; }
+GDALDataType gdal_type(double) { return GDT_Float64; }
+GDALDataType gdal_type(std::uint8_t) { return GDT_Byte; }
+GDALDataType gdal_type(std::int16_t) { return GDT_Int16; }
+GDALDataType gdal_type(std::uint16_t) { return GDT_UInt16; }
+GDALDataType gdal_type(std::int32_t) { return GDT_Int32; }
+GDALDataType gdal_type(std::uint32_t) { return GDT_UInt32; }
+
+}  // namespace
+
+void init_gdal() {
+  static std::once_flag once;  // GDAL's driver registry is process-wide by design
+  std::call_once(once, [] {
+    GDALAllRegister();
+    CPLSetConfigOption("GDAL_PAM_ENABLED", "NO");  // never write .aux.xml beside inputs or outputs
+  });
+}
+
+RasterHeader read_header(const std::string& path, const ReadOptions& options) {
+  auto ds = open_raster(path);
+  GDALRasterBand* band = nullptr;
+  double vfactor = 1.0;
+  return header_of(path, *ds, options, band, vfactor);
+}
+
+Dem read_dem(const std::string& path, const ReadOptions& options) {
+  auto ds = open_raster(path);
+  GDALRasterBand* band = nullptr;
+  double vfactor = 1.0;
+  const RasterHeader h = header_of(path, *ds, options, band, vfactor);
+
+  Dem dem(h.cols, h.rows, h.georef);
+  {
+    QuietGdal quiet;
+    if (band->RasterIO(GF_Read, 0, 0, h.cols, h.rows, dem.data(), h.cols, h.rows, GDT_Float32, 0, 0) != CE_None)
+      throw bad_input(path + ": corrupt or truncated (" + detail::last_gdal_error("read failed") + ")");
+  }
+  // A mask band that is not just "nodata value" or "all valid" (alpha, internal mask) also hides cells.
+  std::vector<std::uint8_t> mask;
+  const int flags = band->GetMaskFlags();
+  if (!(flags & GMF_ALL_VALID) && !(flags & GMF_NODATA)) {
+    mask.resize(dem.size());
+    QuietGdal quiet;
+    if (band->GetMaskBand()->RasterIO(GF_Read, 0, 0, h.cols, h.rows, mask.data(), h.cols, h.rows, GDT_Byte, 0, 0) != CE_None)
+      throw bad_input(path + ": corrupt mask band (" + detail::last_gdal_error("read failed") + ")");
+  }
+  // Compare in float: the nodata value went through the same conversion as the data.
+  const bool has_nd = h.nodata.has_value() && !std::isnan(*h.nodata);
+  const float nd = has_nd ? float(*h.nodata) : 0.0f;
+  const double factor = h.scale * vfactor, offset = h.offset * vfactor;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  std::size_t valid = 0;
+  for (std::size_t i = 0; i < dem.size(); ++i) {
+    float& v = dem[i];
+    if ((has_nd && v == nd) || (!mask.empty() && mask[i] == 0) || !std::isfinite(v)) {
+      v = nan;
+      continue;
+    }
+    if (factor != 1.0 || offset != 0.0) v = float(v * factor + offset);
+    ++valid;
+  }
+  if (valid == 0) throw bad_input(path + ": holds no data (every cell is nodata)");
+  return dem;
+}
+
+Raster<float> read_resampled(const std::string& path, const Georef& like, int cols, int rows, Resampling resampling, int band) {
+  auto src = open_raster(path);
+  if (band < 1 || band > src->GetRasterCount()) throw bad_input(path + ": band " + std::to_string(band) + " does not exist");
+  const OGRSpatialReference* srs = src->GetSpatialRef();
+  if (!srs || srs->IsEmpty()) throw bad_input(path + ": has no CRS; cannot place it on the DEM's grid");
+  Raster<float> out(cols, rows, like, std::numeric_limits<float>::quiet_NaN());
+  GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");
+  DatasetPtr dst(mem->Create("", cols, rows, 0, GDT_Float32, nullptr));
+  char pointer[64];
+  CPLPrintPointer(pointer, out.data(), sizeof(pointer));
+  const std::string opt = std::string("DATAPOINTER=") + pointer;
+  char* band_options[] = {const_cast<char*>(opt.c_str()), nullptr};
+  dst->AddBand(GDT_Float32, band_options);
+  dst->SetGeoTransform(const_cast<double*>(like.transform.data()));
+  const OGRSpatialReference dst_srs = detail::to_ogr(like.crs);
+  dst->SetSpatialRef(&dst_srs);
+  dst->GetRasterBand(1)->SetNoDataValue(std::numeric_limits<double>::quiet_NaN());
+
+  GDALWarpOptions* wo = GDALCreateWarpOptions();
+  wo->hSrcDS = GDALDataset::ToHandle(src.get());
+  wo->hDstDS = GDALDataset::ToHandle(dst.get());
+  wo->nBandCount = 1;
+  wo->panSrcBands = static_cast<int*>(CPLMalloc(sizeof(int)));
+  wo->panSrcBands[0] = band;
+  wo->panDstBands = static_cast<int*>(CPLMalloc(sizeof(int)));
+  wo->panDstBands[0] = 1;
+  int has_nd = 0;
+  const double nd = src->GetRasterBand(band)->GetNoDataValue(&has_nd);
+  if (has_nd) {
+    wo->padfSrcNoDataReal = static_cast<double*>(CPLMalloc(sizeof(double)));
+    wo->padfSrcNoDataReal[0] = nd;
+  }
+  wo->padfDstNoDataReal = static_cast<double*>(CPLMalloc(sizeof(double)));
+  wo->padfDstNoDataReal[0] = std::numeric_limits<double>::quiet_NaN();
+  wo->papszWarpOptions = CSLSetNameValue(wo->papszWarpOptions, "INIT_DEST", "NO_DATA");
+  switch (resampling) {
+    case Resampling::nearest: wo->eResampleAlg = GRA_NearestNeighbour; break;
+    case Resampling::bilinear: wo->eResampleAlg = GRA_Bilinear; break;
+    case Resampling::cubic: wo->eResampleAlg = GRA_Cubic; break;
+    case Resampling::average: wo->eResampleAlg = GRA_Average; break;
+    case Resampling::mode: wo->eResampleAlg = GRA_Mode; break;
+  }
+  char* src_wkt = nullptr;
+  srs->exportToWkt(&src_wkt);
+  wo->pTransformerArg = GDALCreateGenImgProjTransformer(wo->hSrcDS, src_wkt, wo->hDstDS, like.crs.wkt.c_str(), FALSE, 0.0, 1);
+  CPLFree(src_wkt);
+  wo->pfnTransformer = GDALGenImgProjTransform;
+  CPLErr err = CE_Failure;
+  {
+    QuietGdal quiet;
+    if (wo->pTransformerArg) {
+      GDALWarpOperation op;
+      if (op.Initialize(wo) == CE_None) err = op.ChunkAndWarpImage(0, 0, cols, rows);
+    }
+    const std::string msg = detail::last_gdal_error("warp failed");
+    if (wo->pTransformerArg) GDALDestroyGenImgProjTransformer(wo->pTransformerArg);
+    GDALDestroyWarpOptions(wo);
+    if (err != CE_None) throw bad_input(path + ": cannot resample onto the DEM grid (" + msg + ")");
+  }
+  return out;
+}
+
+void check_output_path(const std::string& path, bool overwrite) { detail::check_output(path, overwrite); }
+
+template <class T>
+void write_raster(const std::string& path, const Raster<T>& raster, const WriteOptions& options) {
+  init_gdal();
+  detail::check_output(path, options.overwrite);
+  GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");
+  DatasetPtr src(mem->Create("", raster.cols(), raster.rows(), 0, gdal_type(T{}), nullptr));
+  char pointer[64];
+  CPLPrintPointer(pointer, const_cast<T*>(raster.data()), sizeof(pointer));
+  const std::string opt = std::string("DATAPOINTER=") + pointer;
+  char* band_options[] = {const_cast<char*>(opt.c_str()), nullptr};
+  src->AddBand(gdal_type(T{}), band_options);
+  src->SetGeoTransform(const_cast<double*>(raster.georef().transform.data()));
+  if (!raster.georef().crs.empty()) {
+    const OGRSpatialReference srs = detail::to_ogr(raster.georef().crs);
+    src->SetSpatialRef(&srs);
+  }
+  GDALRasterBand* band = src->GetRasterBand(1);
+  if constexpr (std::is_floating_point_v<T>) band->SetNoDataValue(std::numeric_limits<double>::quiet_NaN());
+  else if (raster.nodata) band->SetNoDataValue(*raster.nodata);
+  if (!options.description.empty()) {
+    band->SetDescription(options.description.c_str());
+    src->SetMetadataItem("DESCRIPTION", options.description.c_str());
+  }
+  for (const auto& [key, value] : options.metadata) src->SetMetadataItem(key.c_str(), value.c_str());
+
+  const bool is_float = std::is_floating_point_v<T>;
+  CPLStringList co;
+  co.SetNameValue("COMPRESS", "DEFLATE");
+  co.SetNameValue("BIGTIFF", "IF_SAFER");
+  GDALDriver* driver = nullptr;
+  if (options.cog) {
+    driver = GetGDALDriverManager()->GetDriverByName("COG");
+    co.SetNameValue("PREDICTOR", "YES");
+    co.SetNameValue("OVERVIEW_RESAMPLING", is_float ? "AVERAGE" : "NEAREST");
+  } else {
+    driver = GetGDALDriverManager()->GetDriverByName("GTiff");
+    co.SetNameValue("TILED", "YES");
+    co.SetNameValue("PREDICTOR", is_float ? "3" : "2");
+  }
+  const std::string tmp = detail::temporary_name(path);
+  {
+    QuietGdal quiet;
+    GDALDataset* out = driver->CreateCopy(tmp.c_str(), src.get(), FALSE, co.List(), nullptr, nullptr);
+    const bool ok = out && CPLGetLastErrorType() < CE_Failure;
+    if (out) GDALClose(GDALDataset::ToHandle(out));
+    if (!ok) {
+      const std::string msg = detail::last_gdal_error("write failed");
+      detail::discard_file(tmp);
+      throw bad_input(path + ": cannot write output (" + msg + ")");
+    }
+  }
+  detail::commit_file(tmp, path);
+}
+
+template void write_raster(const std::string&, const Raster<float>&, const WriteOptions&);
+template void write_raster(const std::string&, const Raster<double>&, const WriteOptions&);
+template void write_raster(const std::string&, const Raster<std::uint8_t>&, const WriteOptions&);
+template void write_raster(const std::string&, const Raster<std::int16_t>&, const WriteOptions&);
+template void write_raster(const std::string&, const Raster<std::uint16_t>&, const WriteOptions&);
+template void write_raster(const std::string&, const Raster<std::int32_t>&, const WriteOptions&);
+template void write_raster(const std::string&, const Raster<std::uint32_t>&, const WriteOptions&);
+
+}  // namespace terrapolis

@@ -1,0 +1,63 @@
+// Reading DEMs and rasters from any GDAL format, and writing GeoTIFF / Cloud Optimized GeoTIFF.
+// SPDX-License-Identifier: MIT
+#pragma once
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/raster.hpp"
+
+namespace terrapolis {
+
+/// Registers GDAL's drivers and quiets its side files (.aux.xml); safe to call many times.
+void init_gdal();
+
+struct ReadOptions {
+  std::optional<int> band;                ///< 1-based band; required for multi-band files
+  std::optional<std::string> assume_crs;  ///< CRS for files that carry none ("EPSG:n", WKT, PROJ)
+};
+
+/// What a raster file holds, read from its header only (no pixel is read).
+struct RasterHeader {
+  int cols = 0, rows = 0, bands = 0;
+  std::string driver, data_type, vertical_unit;
+  Georef georef;
+  std::optional<double> nodata;
+  double scale = 1.0, offset = 0.0;
+};
+
+/// Reads the header of `path`, applying the same checks as read_dem except for reading pixels.
+RasterHeader read_header(const std::string& path, const ReadOptions& options = {});
+
+/// Reads an elevation model as metres in float32, NaN where there is no data.
+/// Honours the nodata value (including NaN, and 65535 in UInt16), the mask band, scale/offset, and
+/// vertical units in feet. Throws bad_input, naming the file, when the file is missing, unreadable,
+/// corrupt, has no CRS (unless assume_crs), is a multi-band colour image (unless band), is smaller
+/// than 2x2, would not fit in memory, or holds no data at all.
+Dem read_dem(const std::string& path, const ReadOptions& options = {});
+
+/// GDAL resampling methods offered for layers read onto a DEM's grid.
+enum class Resampling { nearest, bilinear, cubic, average, mode };
+
+/// Reads band `band` of any GDAL raster warped onto the grid of `like` (NaN where nodata/outside).
+Raster<float> read_resampled(const std::string& path, const Georef& like, int cols, int rows,
+                             Resampling resampling = Resampling::bilinear, int band = 1);
+
+struct WriteOptions {
+  bool cog = false;        ///< Cloud Optimized GeoTIFF layout (GDAL's COG driver)
+  bool overwrite = false;  ///< replace an existing file
+  std::string description;  ///< what the raster is, stored as the band description
+  std::vector<std::pair<std::string, std::string>> metadata;  ///< dataset metadata items (provenance)
+};
+
+/// Writes a GeoTIFF (tiled, DEFLATE with predictor, BigTIFF when needed) under a temporary name
+/// then renames it. CRS, geotransform and nodata are kept. Instantiated for float, double,
+/// uint8, int16, uint16, int32, uint32.
+template <class T>
+void write_raster(const std::string& path, const Raster<T>& raster, const WriteOptions& options = {});
+
+/// Refuses an output path that exists (unless overwrite) or whose folder is missing or read-only.
+void check_output_path(const std::string& path, bool overwrite);
+
+}  // namespace terrapolis

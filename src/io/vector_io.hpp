@@ -1,0 +1,51 @@
+// Vector layers: GeoJSON (RFC 7946) or GeoPackage through GDAL/OGR, chosen by the file's extension.
+// SPDX-License-Identifier: MIT
+#pragma once
+#include <array>
+#include <cstdint>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "core/raster.hpp"
+
+namespace terrapolis {
+
+enum class GeometryType { point, line_string, polygon };
+enum class FieldType { integer, real, string };
+
+struct FieldDef {
+  std::string name;
+  FieldType type;
+};
+
+/// A field value; monostate writes a null.
+using FieldValue = std::variant<std::monostate, std::int64_t, double, std::string>;
+
+/// One feature. Geometry in the layer's CRS: a point is parts[0][0], a line string parts[0],
+/// a polygon's rings are parts (outer ring first, any orientation: writers fix it).
+struct Feature {
+  std::vector<std::vector<std::array<double, 2>>> parts;
+  std::vector<FieldValue> values;  ///< one per field of the layer, in order
+};
+
+struct VectorLayer {
+  std::string name;
+  GeometryType geometry = GeometryType::point;
+  Crs crs;  ///< CRS of the coordinates in `features`
+  std::vector<FieldDef> fields;
+  std::vector<Feature> features;
+
+  /// Index of a field by name, or -1.
+  int field_index(const std::string& field) const;
+};
+
+/// Writes `layer` to `path`: ".geojson"/".json" as RFC 7946 GeoJSON (reprojected to WGS 84 lon/lat,
+/// right-hand rule, no crs member), ".gpkg" as GeoPackage in the layer's CRS. Temporary name, then rename.
+void write_vector(const std::string& path, const VectorLayer& layer, bool overwrite = false);
+
+/// Reads the first layer of any OGR vector file with its coordinates transformed to `target`.
+/// Multi-geometries are split into single features (attributes repeated).
+VectorLayer read_vector(const std::string& path, const Crs& target);
+
+}  // namespace terrapolis
