@@ -10,6 +10,7 @@ std::vector<std::unique_ptr<Command>> all_commands() {
   commands.push_back(make_info_command());
   commands.push_back(make_convert_command());
   commands.push_back(make_run_command());
+  commands.push_back(make_compare_command());
   return commands;
 }
 

@@ -32,3 +32,11 @@ else
   fail "python3-qgis is not installed (scripts/setup installs it)"
 fi
 echo "run: ok"
+
+# compare: two runs differing in one parameter.
+"$TP" --quiet run -o run3 --set outputs.preview_width=500
+"$TP" compare run1 run3 > cmp.txt
+grep -Eq "outputs.preview_width +400 +500" cmp.txt || fail "compare does not show the changed parameter: $(cat cmp.txt)"
+"$TP" compare --json run1 run1 | /usr/bin/python3 -c "import json,sys; c=json.load(sys.stdin); assert c['parameters']==[], c" || fail "compare of a run with itself"
+expect_fail 2 "nowhere: not a run folder" "$TP" compare run1 nowhere
+echo "compare: ok"
