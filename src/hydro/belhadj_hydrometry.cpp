@@ -81,61 +81,127 @@ BelhadjModel::BelhadjModel(const Dem& dem, const CellMetrics& metrics, VerticalS
   row_sum_.assign(std::size_t(rows_), 0.0);
 }
 
+namespace {
+
+// The two passes over one row, written column-innermost on restrict pointers so that the
+// compiler vectorises them (sqrt included: the file is built with -fno-math-errno). Only
+// element-wise IEEE operations and per-cell sums in a fixed order are used, so every ISA
+// variant (target_clones) gives the same bits.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define TP_KERNEL __attribute__((target_clones("avx2", "default")))
+#else
+#define TP_KERNEL
+#endif
+
+struct RowView {
+  const double* __restrict z;
+  const double* __restrict valid;
+  const double* __restrict fx;
+  const double* __restrict fy;
+  const double* __restrict fz;
+  const double* __restrict q;
+  const double* __restrict w;
+};
+
+/// Pass 1 on a row of `n` cells starting at padded index i0: Σn, w = Q / Σn, Acc += Q.
+TP_KERNEL double sender_row(const RowView& v, std::size_t i0, int n, const std::ptrdiff_t* off, const double* hx,
+                            const double* hy, bool all, double* __restrict sn, double* __restrict w,
+                            double* __restrict acc) {
+  const double* __restrict z = v.z + i0;
+  const double* __restrict fx = v.fx + i0;
+  const double* __restrict fy = v.fy + i0;
+  const double* __restrict fz = v.fz + i0;
+  const double* __restrict q = v.q + i0;
+  for (int c = 0; c < n; ++c) sn[c] = 0.0;
+  for (int k = 0; k < 8; ++k) {
+    const double* __restrict zn = z + off[k];
+    const double vx = hx[k], vy = hy[k];
+    for (int c = 0; c < n; ++c) {
+      const double dz = zn[c] - z[c];
+      const double rx = fx[c] + vx, ry = fy[c] + vy, rz = fz[c] + dz;
+      const double s = rx * vx + ry * vy + rz * dz;
+      const double norm = std::sqrt(rx * rx + ry * ry + rz * rz);
+      sn[c] += (all || s > 0) ? norm : 0.0;
+    }
+  }
+  double sum = 0;
+  for (int c = 0; c < n; ++c) {
+    w[i0 + std::size_t(c)] = sn[c] > 0 ? q[c] / sn[c] : 0.0;
+    acc[i0 + std::size_t(c)] += q[c];
+  }
+  for (int c = 0; c < n; ++c) sum += q[c];
+  return sum;
+}
+
+/// Pass 2 on a row: each receiver gathers R and |R| w from the senders whose R . V > 0.
+TP_KERNEL void receiver_row(const RowView& v, std::size_t i0, int n, const std::ptrdiff_t* off, const int* order,
+                            const double* const* hx_row, const double* const* hy_row, double* __restrict ax,
+                            double* __restrict ay, double* __restrict az, double* __restrict aq) {
+  const double* __restrict z = v.z + i0;
+  for (int c = 0; c < n; ++c) ax[c] = ay[c] = az[c] = aq[c] = 0.0;
+  for (int g = 0; g < 8; ++g) {
+    const int k = order[g];
+    const int j = opposite(k);  // the sender's direction towards the receiver
+    const double vx = hx_row[g][j], vy = hy_row[g][j];
+    const std::ptrdiff_t o = off[k];
+    const double* __restrict zn = z + o;
+    const double* __restrict valid = v.valid + i0 + o;
+    const double* __restrict fx = v.fx + i0 + o;
+    const double* __restrict fy = v.fy + i0 + o;
+    const double* __restrict fz = v.fz + i0 + o;
+    const double* __restrict w = v.w + i0 + o;
+    for (int c = 0; c < n; ++c) {
+      const double vz = z[c] - zn[c];
+      const double rx = fx[c] + vx, ry = fy[c] + vy, rz = fz[c] + vz;
+      const double s = rx * vx + ry * vy + rz * vz;
+      const double m = s > 0 ? valid[c] : 0.0;
+      ax[c] += m * rx;
+      ay[c] += m * ry;
+      az[c] += m * rz;
+      aq[c] += m * (std::sqrt(rx * rx + ry * ry + rz * rz) * w[c]);
+    }
+  }
+}
+
+}  // namespace
+
 double BelhadjModel::step() {
   std::ptrdiff_t off[8];
   for (int k = 0; k < 8; ++k) off[k] = std::ptrdiff_t(drow[k]) * stride_ + dcol[k];
-  const double* z = z_.data();
-  const double* valid = valid_.data();
   const bool all = share_ == BelhadjShare::all_neighbours;
+  const RowView cur{z_.data(), valid_.data(), fx_.data(), fy_.data(), fz_.data(), q_.data(), w_.data()};
   // Pass 1: each sender's Σn over its 8 neighbours, its share factor w = Q / Σn, Acc += Q.
   tbb::parallel_for(tbb::blocked_range<int>(0, rows_), [&](const tbb::blocked_range<int>& range) {
+    std::vector<double> sn(static_cast<std::size_t>(cols_));
     for (int r = range.begin(); r < range.end(); ++r) {
-      const std::size_t pr = std::size_t(r + 1), base = pr * std::size_t(stride_) + 1;
-      const double* hx = &hx_[pr * 8];
-      const double* hy = &hy_[pr * 8];
-      double sum = 0;
-      for (int c = 0; c < cols_; ++c) {
-        const std::size_t i = base + std::size_t(c);
-        double sn = 0;
-        for (int k = 0; k < 8; ++k) {
-          const double dz = z[std::ptrdiff_t(i) + off[k]] - z[i];
-          const double rx = fx_[i] + hx[k], ry = fy_[i] + hy[k], rz = fz_[i] + dz;
-          const double s = rx * hx[k] + ry * hy[k] + rz * dz;
-          sn += (all || s > 0) ? std::sqrt(rx * rx + ry * ry + rz * rz) : 0.0;
-        }
-        w_[i] = sn > 0 ? q_[i] / sn : 0.0;
-        acc_[i] += q_[i];
-        sum += q_[i];
-      }
-      row_sum_[std::size_t(r)] = sum;
+      const std::size_t pr = std::size_t(r + 1), i0 = pr * std::size_t(stride_) + 1;
+      row_sum_[std::size_t(r)] =
+          sender_row(cur, i0, cols_, off, &hx_[pr * 8], &hy_[pr * 8], all, sn.data(), w_.data(), acc_.data());
     }
   });
-  // Pass 2: each receiver gathers R and |R| w from the senders whose R . V > 0.
+  // Pass 2: each receiver gathers from its senders in the thesis's serial order.
   tbb::parallel_for(tbb::blocked_range<int>(0, rows_), [&](const tbb::blocked_range<int>& range) {
+    std::vector<double> buf(4 * std::size_t(cols_));
+    double* ax = buf.data();
+    double* ay = ax + cols_;
+    double* az = ay + cols_;
+    double* aq = az + cols_;
     for (int r = range.begin(); r < range.end(); ++r) {
-      const std::size_t pr = std::size_t(r + 1), base = pr * std::size_t(stride_) + 1;
+      const std::size_t pr = std::size_t(r + 1), i0 = pr * std::size_t(stride_) + 1;
+      const double* hx_row[8];
+      const double* hy_row[8];
+      for (int g = 0; g < 8; ++g) {
+        const std::size_t sender_row_index = std::size_t(std::ptrdiff_t(pr) + drow[kGatherOrder[g]]);
+        hx_row[g] = &hx_[sender_row_index * 8];
+        hy_row[g] = &hy_[sender_row_index * 8];
+      }
+      receiver_row(cur, i0, cols_, off, kGatherOrder, hx_row, hy_row, ax, ay, az, aq);
+      const double* valid = valid_.data() + i0;
       for (int c = 0; c < cols_; ++c) {
-        const std::size_t i = base + std::size_t(c);
-        double ax = 0, ay = 0, az = 0, aq = 0;
-        for (int g = 0; g < 8; ++g) {
-          const int k = kGatherOrder[g];
-          const std::size_t n = std::size_t(std::ptrdiff_t(i) + off[k]);
-          const int j = opposite(k);  // the sender's direction towards this cell
-          const std::size_t pn = std::size_t(std::ptrdiff_t(pr) + drow[k]) * 8 + std::size_t(j);
-          const double vx = hx_[pn], vy = hy_[pn], vz = z[i] - z[n];
-          const double rx = fx_[n] + vx, ry = fy_[n] + vy, rz = fz_[n] + vz;
-          const double s = rx * vx + ry * vy + rz * vz;
-          const double m = s > 0 ? valid[n] : 0.0;
-          ax += m * rx;
-          ay += m * ry;
-          az += m * rz;
-          aq += m * (std::sqrt(rx * rx + ry * ry + rz * rz) * w_[n]);
-        }
-        const double self = valid[i];
-        fx2_[i] = self * ax;
-        fy2_[i] = self * ay;
-        fz2_[i] = self * az;
-        q2_[i] = self * aq;
+        fx2_[i0 + std::size_t(c)] = valid[c] * ax[c];
+        fy2_[i0 + std::size_t(c)] = valid[c] * ay[c];
+        fz2_[i0 + std::size_t(c)] = valid[c] * az[c];
+        q2_[i0 + std::size_t(c)] = valid[c] * aq[c];
       }
     }
   });
