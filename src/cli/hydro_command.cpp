@@ -65,6 +65,8 @@ class HydroCommand final : public Command {
         ->check(CLI::IsMember({"m2", "km2", "cells"}))->capture_default_str();
     app.add_option("--weights", weights_, "Raster of per-cell weights (resampled bilinearly onto the DEM)");
     app.add_option("--assume-crs", assume_crs_, "CRS for a DEM file that carries none, e.g. EPSG:32611");
+    app.add_option("--outputs", outputs_, "Outputs to write, comma-separated: filled,flowdir,accumulation,hydrometry,streams")
+        ->capture_default_str();
     app.add_flag("--cog", cog_, "Write Cloud Optimized GeoTIFFs");
     app.add_flag("--overwrite", overwrite_, "Replace existing outputs");
   }
@@ -90,6 +92,20 @@ class HydroCommand final : public Command {
     o.unit = units_ == "cells" ? AccumulationUnit::cells : AccumulationUnit::area_m2;
     o.streams.threshold_km2 = streams_km2_;
 
+    const std::string names[5] = {"filled.tif", "flowdir.tif", "accumulation.tif", "hydrometry.tif", "streams.geojson"};
+    bool wanted[5] = {false, false, false, false, false};
+    for (std::size_t start = 0; start <= outputs_.size();) {
+      const std::size_t comma = std::min(outputs_.find(',', start), outputs_.size());
+      const std::string item = outputs_.substr(start, comma - start);
+      bool known = false;
+      for (int i = 0; i < 5; ++i)
+        if (item + (i == 4 ? ".geojson" : ".tif") == names[i]) wanted[i] = known = true;
+      if (!known) throw bad_input("--outputs: unknown output '" + item + "'");
+      start = comma + 1;
+    }
+    o.with_hydrometry = wanted[3];
+    o.with_streams = wanted[4];
+
     ReadOptions read;
     if (!assume_crs_.empty()) read.assume_crs = assume_crs_;
     const Dem dem = read_dem(dem_path_, read);
@@ -98,11 +114,18 @@ class HydroCommand final : public Command {
     // Refuse existing outputs before any work.
     const bool created = !fs::exists(out_dir_);
     if (!created && !fs::is_directory(out_dir_)) throw bad_input(out_dir_ + ": exists and is not a folder");
-    const std::string names[5] = {"filled.tif", "flowdir.tif", "accumulation.tif", "hydrometry.tif", "streams.geojson"};
     if (!created)
-      for (const auto& n : names) check_output_path((fs::path(out_dir_) / n).string(), overwrite_);
+      for (int i = 0; i < 5; ++i)
+        if (wanted[i]) check_output_path((fs::path(out_dir_) / names[i]).string(), overwrite_);
 
     HydroResult result = run_hydro(dem, o, context.progress);
+    if (result.hydrometry_iterations > 0) {
+      char line[160];
+      std::snprintf(line, sizeof line, "belhadj: %d iterations in %.2f ms, %.1f M cell-iterations/s", result.hydrometry_iterations,
+                    result.hydrometry_seconds * 1e3,
+                    double(dem.size()) * result.hydrometry_iterations / result.hydrometry_seconds / 1e6);
+      context.log.detail(line);
+    }
 
     std::vector<std::pair<std::string, std::string>> provenance = {
         {"TERRAPOLIS_VERSION", version}, {"TERRAPOLIS_COMMAND", "hydro"}, {"SOURCE_DEM", fs::path(dem_path_).filename().string()},
@@ -118,9 +141,13 @@ class HydroCommand final : public Command {
       w.metadata.insert(w.metadata.end(), extra.begin(), extra.end());
       return w;
     };
-    Raster<float> acc = result.filled.like<float>(NAN);
-    const double scale = units_ == "km2" ? 1e-6 : 1.0;
-    for (std::size_t i = 0; i < acc.size(); ++i) acc[i] = float(result.accumulation[i] * scale);
+    Raster<float> acc;
+    if (wanted[2]) {
+      acc = result.filled.like<float>(NAN);
+      const double scale = units_ == "km2" ? 1e-6 : 1.0;
+      for (std::size_t i = 0; i < acc.size(); ++i) acc[i] = float(result.accumulation[i] * scale);
+      result.accumulation = Raster<double>();  // release before writing
+    }
     const std::string acc_unit = units_ == "cells" ? "cells" : units_;
     std::vector<std::string> written;
     try {
@@ -129,16 +156,15 @@ class HydroCommand final : public Command {
         written.push_back((fs::path(out_dir_) / names[i]).string());
         return written.back();
       };
-      write_raster(path(0), result.filled, opts("Conditioned elevation (m), " + fill_ + " depression handling"));
-      write_raster(path(1), encode_d8(result.d8, codes),
+      if (wanted[0]) write_raster(path(0), result.filled, opts("Conditioned elevation (m), " + fill_ + " depression handling"));
+      if (wanted[1]) write_raster(path(1), encode_d8(result.d8, codes),
                    opts("D8 flow direction, " + describe(codes), {{"D8_CODES", codes_}, {"D8_CODES_DESCRIPTION", describe(codes)}}));
-      write_raster(path(2), acc,
+      if (wanted[2]) write_raster(path(2), acc,
                    opts("Upstream " + std::string(units_ == "cells" ? "cell count" : "area (" + acc_unit + ")") + ", " + flow_ +
                             " routing" + (weights_.empty() ? "" : ", weighted"),
                         {{"UNIT", acc_unit}}));
-      write_raster(path(3), result.hydrometry, opts("Hydrometry in [0,1] (" + hydrometry_ + ")"));
-      written.push_back((fs::path(out_dir_) / names[4]).string());
-      write_vector(written.back(), result.streams, overwrite_);
+      if (wanted[3]) write_raster(path(3), result.hydrometry, opts("Hydrometry in [0,1] (" + hydrometry_ + ")"));
+      if (wanted[4]) write_vector(path(4), result.streams, overwrite_);
     } catch (...) {
       // No partial result: new files go, and the folder if this run made it.
       if (!overwrite_ || created)
@@ -146,11 +172,12 @@ class HydroCommand final : public Command {
       if (created) fs::remove_all(out_dir_);
       throw;
     }
-    context.log.info("hydro: wrote " + out_dir_ + " (" + std::to_string(result.streams.features.size()) + " stream reaches)");
+    context.log.info("hydro: wrote " + out_dir_ + (wanted[4] ? " (" + std::to_string(result.streams.features.size()) + " stream reaches)" : ""));
   }
 
  private:
   std::string dem_path_, out_dir_, fill_ = "priority-flood", flow_ = "d8", codes_ = "esri", hydrometry_ = "belhadj";
+  std::string outputs_ = "filled,flowdir,accumulation,hydrometry,streams";
   std::string vertical_ = "metres", share_ = "all", units_ = "m2", weights_, assume_crs_;
   double mfd_exponent_ = 1.1, threshold_ = 1.0 / 1048576, streams_km2_ = 10.0, sea_level_ = NAN;
   int iterations_ = 0;

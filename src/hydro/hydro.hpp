@@ -35,6 +35,8 @@ struct HydroResult {
   Raster<double> accumulation;        ///< in options.unit (x weights), with options.flow routing
   Raster<float> hydrometry;           ///< [0,1], empty when !with_hydrometry
   VectorLayer streams;                ///< D8 streams (streams.hpp fields), empty when !with_streams
+  int hydrometry_iterations = 0;      ///< Belhadj iterations done (0 for the accumulation method)
+  double hydrometry_seconds = 0;      ///< wall time of the Belhadj diffusion (for logs, never written to files)
 };
 
 /// Runs the stage on `dem` (metres, NaN nodata). Throws bad_input on invalid options.
