@@ -14,9 +14,7 @@
 
 namespace terrapolis::hydro {
 namespace {
-// Order in which a receiver gathers from its senders: the row-major order in which the thesis's
-// serial loop visits them (north-west, north, north-east, west, east, south-west, south,
-// south-east), so the floating-point sums equal the literal scatter's.
+// Order in which a sender feeds its neighbours (fixed, so sums are reproducible).
 constexpr int kGatherOrder[8] = {5, 6, 7, 4, 0, 3, 2, 1};
 constexpr int kSafetyCap = 300;
 }  // namespace
@@ -77,7 +75,6 @@ BelhadjModel::BelhadjModel(const Dem& dem, const CellMetrics& metrics, VerticalS
   fy2_ = fy_;
   fz2_ = fz_;
   q2_ = q_;
-  w_.assign(padded, 0.0);
   row_sum_.assign(std::size_t(rows_), 0.0);
 }
 
@@ -93,74 +90,77 @@ namespace {
 #define TP_KERNEL
 #endif
 
-struct RowView {
+struct State {
   const double* __restrict z;
   const double* __restrict valid;
   const double* __restrict fx;
   const double* __restrict fy;
   const double* __restrict fz;
   const double* __restrict q;
-  const double* __restrict w;
+  double* __restrict acc;
+  double* __restrict fx2;
+  double* __restrict fy2;
+  double* __restrict fz2;
+  double* __restrict q2;
 };
 
-/// Pass 1 on a row of `n` cells starting at padded index i0: Σn, w = Q / Σn, Acc += Q.
-TP_KERNEL double sender_row(const RowView& v, std::size_t i0, int n, const std::ptrdiff_t* off, const double* hx,
-                            const double* hy, bool all, double* __restrict sn, double* __restrict w,
-                            double* __restrict acc) {
-  const double* __restrict z = v.z + i0;
-  const double* __restrict fx = v.fx + i0;
-  const double* __restrict fy = v.fy + i0;
-  const double* __restrict fz = v.fz + i0;
-  const double* __restrict q = v.q + i0;
+/// One sender row of `n` cells starting at padded index i0: computes its 8 R_i, N_i = |R_i| and
+/// S_i = R_i . V_i, Σn, Acc += Q, then adds R_i and N_i Q / Σn to the fed receivers (scatter,
+/// as the thesis's loop). `scratch` holds 17 n doubles. Returns Σ Q over the row.
+TP_KERNEL double sender_row(const State& st, std::size_t i0, int n, const std::ptrdiff_t* off, const int* order,
+                            const double* hx, const double* hy, bool all, double* __restrict scratch) {
+  const double* __restrict z = st.z + i0;
+  const double* __restrict fx = st.fx + i0;
+  const double* __restrict fy = st.fy + i0;
+  const double* __restrict fz = st.fz + i0;
+  const double* __restrict q = st.q + i0;
+  double* __restrict sn = scratch;
+  double* __restrict norms = scratch + n;          // 8 rows of N_i
+  double* __restrict fed = scratch + 9 * std::size_t(n);  // 8 rows of 1 (fed, inside) or 0
+  const double keep = all ? 1.0 : 0.0;  // Σn over unfed neighbours too (Algorithm 12 as printed)
   for (int c = 0; c < n; ++c) sn[c] = 0.0;
   for (int k = 0; k < 8; ++k) {
     const double* __restrict zn = z + off[k];
+    const double* __restrict vn = st.valid + i0 + off[k];
+    double* __restrict nk = norms + std::size_t(k) * std::size_t(n);
+    double* __restrict mk = fed + std::size_t(k) * std::size_t(n);
     const double vx = hx[k], vy = hy[k];
     for (int c = 0; c < n; ++c) {
       const double dz = zn[c] - z[c];
       const double rx = fx[c] + vx, ry = fy[c] + vy, rz = fz[c] + dz;
       const double s = rx * vx + ry * vy + rz * dz;
       const double norm = std::sqrt(rx * rx + ry * ry + rz * rz);
-      sn[c] += (all || s > 0) ? norm : 0.0;
+      const double inside = vn[c];  // loaded unconditionally so the loop has no branch
+      nk[c] = norm;
+      mk[c] = s > 0 ? inside : 0.0;
+      sn[c] += s > 0 ? norm : keep * norm;
     }
   }
   double sum = 0;
   for (int c = 0; c < n; ++c) {
-    w[i0 + std::size_t(c)] = sn[c] > 0 ? q[c] / sn[c] : 0.0;
-    acc[i0 + std::size_t(c)] += q[c];
+    st.acc[i0 + std::size_t(c)] += q[c];
+    sn[c] = sn[c] > 0 ? q[c] / sn[c] : 0.0;  // from here on: the share factor Q / Σn
   }
   for (int c = 0; c < n; ++c) sum += q[c];
-  return sum;
-}
-
-/// Pass 2 on a row: each receiver gathers R and |R| w from the senders whose R . V > 0.
-TP_KERNEL void receiver_row(const RowView& v, std::size_t i0, int n, const std::ptrdiff_t* off, const int* order,
-                            const double* const* hx_row, const double* const* hy_row, double* __restrict ax,
-                            double* __restrict ay, double* __restrict az, double* __restrict aq) {
-  const double* __restrict z = v.z + i0;
-  for (int c = 0; c < n; ++c) ax[c] = ay[c] = az[c] = aq[c] = 0.0;
   for (int g = 0; g < 8; ++g) {
     const int k = order[g];
-    const int j = opposite(k);  // the sender's direction towards the receiver
-    const double vx = hx_row[g][j], vy = hy_row[g][j];
-    const std::ptrdiff_t o = off[k];
-    const double* __restrict zn = z + o;
-    const double* __restrict valid = v.valid + i0 + o;
-    const double* __restrict fx = v.fx + i0 + o;
-    const double* __restrict fy = v.fy + i0 + o;
-    const double* __restrict fz = v.fz + i0 + o;
-    const double* __restrict w = v.w + i0 + o;
+    const double* __restrict zn = z + off[k];
+    const double* __restrict nk = norms + std::size_t(k) * std::size_t(n);
+    const double* __restrict mk = fed + std::size_t(k) * std::size_t(n);
+    double* __restrict ox = st.fx2 + i0 + off[k];
+    double* __restrict oy = st.fy2 + i0 + off[k];
+    double* __restrict oz = st.fz2 + i0 + off[k];
+    double* __restrict oq = st.q2 + i0 + off[k];
+    const double vx = hx[k], vy = hy[k];
     for (int c = 0; c < n; ++c) {
-      const double vz = z[c] - zn[c];
-      const double rx = fx[c] + vx, ry = fy[c] + vy, rz = fz[c] + vz;
-      const double s = rx * vx + ry * vy + rz * vz;
-      const double m = s > 0 ? valid[c] : 0.0;
-      ax[c] += m * rx;
-      ay[c] += m * ry;
-      az[c] += m * rz;
-      aq[c] += m * (std::sqrt(rx * rx + ry * ry + rz * rz) * w[c]);
+      const double m = mk[c];
+      ox[c] += m * (fx[c] + vx);
+      oy[c] += m * (fy[c] + vy);
+      oz[c] += m * (fz[c] + (zn[c] - z[c]));
+      oq[c] += m * (nk[c] * sn[c]);
     }
   }
+  return sum;
 }
 
 }  // namespace
@@ -169,42 +169,27 @@ double BelhadjModel::step() {
   std::ptrdiff_t off[8];
   for (int k = 0; k < 8; ++k) off[k] = std::ptrdiff_t(drow[k]) * stride_ + dcol[k];
   const bool all = share_ == BelhadjShare::all_neighbours;
-  const RowView cur{z_.data(), valid_.data(), fx_.data(), fy_.data(), fz_.data(), q_.data(), w_.data()};
-  // Pass 1: each sender's Σn over its 8 neighbours, its share factor w = Q / Σn, Acc += Q.
-  tbb::parallel_for(tbb::blocked_range<int>(0, rows_), [&](const tbb::blocked_range<int>& range) {
-    std::vector<double> sn(static_cast<std::size_t>(cols_));
-    for (int r = range.begin(); r < range.end(); ++r) {
-      const std::size_t pr = std::size_t(r + 1), i0 = pr * std::size_t(stride_) + 1;
-      row_sum_[std::size_t(r)] =
-          sender_row(cur, i0, cols_, off, &hx_[pr * 8], &hy_[pr * 8], all, sn.data(), w_.data(), acc_.data());
-    }
-  });
-  // Pass 2: each receiver gathers from its senders in the thesis's serial order.
-  tbb::parallel_for(tbb::blocked_range<int>(0, rows_), [&](const tbb::blocked_range<int>& range) {
-    std::vector<double> buf(4 * std::size_t(cols_));
-    double* ax = buf.data();
-    double* ay = ax + cols_;
-    double* az = ay + cols_;
-    double* aq = az + cols_;
-    for (int r = range.begin(); r < range.end(); ++r) {
-      const std::size_t pr = std::size_t(r + 1), i0 = pr * std::size_t(stride_) + 1;
-      const double* hx_row[8];
-      const double* hy_row[8];
-      for (int g = 0; g < 8; ++g) {
-        const std::size_t sender_row_index = std::size_t(std::ptrdiff_t(pr) + drow[kGatherOrder[g]]);
-        hx_row[g] = &hx_[sender_row_index * 8];
-        hy_row[g] = &hy_[sender_row_index * 8];
+  std::fill(fx2_.begin(), fx2_.end(), 0.0);
+  std::fill(fy2_.begin(), fy2_.end(), 0.0);
+  std::fill(fz2_.begin(), fz2_.end(), 0.0);
+  std::fill(q2_.begin(), q2_.end(), 0.0);
+  const State st{z_.data(), valid_.data(), fx_.data(), fy_.data(), fz_.data(), q_.data(), acc_.data(),
+                 fx2_.data(), fy2_.data(), fz2_.data(), q2_.data()};
+  // A sender row writes to rows r-1..r+1, so rows 3 apart never write the same cell: three
+  // phases (r mod 3), each parallel over its rows. Every receiver then sums its inputs in the
+  // same order (by phase, then neighbour order) whatever the number of threads.
+  for (int phase = 0; phase < 3; ++phase) {
+    const int count = (rows_ - phase + 2) / 3;
+    tbb::parallel_for(tbb::blocked_range<int>(0, count), [&](const tbb::blocked_range<int>& range) {
+      std::vector<double> scratch(17 * static_cast<std::size_t>(cols_));
+      for (int t = range.begin(); t < range.end(); ++t) {
+        const int r = phase + 3 * t;
+        const std::size_t pr = std::size_t(r + 1), i0 = pr * std::size_t(stride_) + 1;
+        row_sum_[std::size_t(r)] =
+            sender_row(st, i0, cols_, off, kGatherOrder, &hx_[pr * 8], &hy_[pr * 8], all, scratch.data());
       }
-      receiver_row(cur, i0, cols_, off, kGatherOrder, hx_row, hy_row, ax, ay, az, aq);
-      const double* valid = valid_.data() + i0;
-      for (int c = 0; c < cols_; ++c) {
-        fx2_[i0 + std::size_t(c)] = valid[c] * ax[c];
-        fy2_[i0 + std::size_t(c)] = valid[c] * ay[c];
-        fz2_[i0 + std::size_t(c)] = valid[c] * az[c];
-        q2_[i0 + std::size_t(c)] = valid[c] * aq[c];
-      }
-    }
-  });
+    });
+  }
   fx_.swap(fx2_);
   fy_.swap(fy2_);
   fz_.swap(fz2_);

@@ -43,7 +43,8 @@ class BelhadjModel {
   /// sends R_i = F(c) + V_i(c) and the share |R_i| Q(c) / Σ_j |R_j| of its water to every inside
   /// neighbour i with R_i . V_i(c) > 0 (Σ over all 8 neighbours, so the rest is lost);
   /// Acc += Q. Returns the mean Q over valid cells before the step (the thesis's stop test).
-  /// Parallel over rows, each cell gathers from its neighbours in a fixed order: bit-identical
+  /// Parallel over rows in three phases (rows 3 apart never write the same cell), each sum in a
+  /// fixed order: bit-identical
   /// for any thread count.
   double step();
 
@@ -69,7 +70,7 @@ class BelhadjModel {
   std::vector<double> z_, valid_;                 // padded altitude, 1 on valid cells
   std::vector<double> hx_, hy_;                   // per padded row, 8 horizontal steps (east, south)
   std::vector<double> fx_, fy_, fz_, q_, acc_;    // current state
-  std::vector<double> fx2_, fy2_, fz2_, q2_, w_;  // next state; w = Q / Σn of the sender
+  std::vector<double> fx2_, fy2_, fz2_, q2_;      // next state
   std::vector<double> row_sum_;
 };
 

@@ -3,6 +3,8 @@
 #include "hydro/depressions.hpp"
 
 #include <cmath>
+#include <cstring>
+#include <functional>
 #include <deque>
 #include <queue>
 #include <vector>
@@ -12,12 +14,15 @@
 namespace terrapolis::hydro {
 namespace {
 
-struct Node {
-  float z;
-  std::uint32_t i;
-  // std::priority_queue is a max-heap: "greater" puts the lowest elevation (then lowest index) on top.
-  bool operator<(const Node& o) const { return z > o.z || (z == o.z && i > o.i); }
-};
+/// Queue key: the elevation's bits made order-preserving as an unsigned integer, then the cell
+/// index, so one 64-bit comparison orders by elevation and breaks ties by index (determinism).
+inline std::uint64_t key(float z, std::uint32_t i) {
+  std::uint32_t bits;
+  std::memcpy(&bits, &z, sizeof bits);
+  bits = (bits & 0x80000000u) ? ~bits : (bits | 0x80000000u);
+  return (std::uint64_t(bits) << 32) | i;
+}
+using MinQueue = std::priority_queue<std::uint64_t, std::vector<std::uint64_t>, std::greater<>>;
 
 /// The Priority-Flood of Barnes et al. 2014, Algorithm 2 (with its plain queue for cells inside
 /// depressions) or 3 (epsilon). `visit(cell, parent_direction)` is told the neighbour index k from
@@ -28,7 +33,7 @@ void priority_flood(Dem& z, const std::optional<double>& sea_level, bool epsilon
   ProgressStep step(progress, epsilon ? "fill (epsilon)" : "fill");
   const int cols = z.cols(), rows = z.rows();
   std::vector<std::uint8_t> closed(z.size(), 0);
-  std::priority_queue<Node> open;
+  MinQueue open;
   std::deque<std::uint32_t> pit;
   // Seeds: every outlet (border, next to nodata, sea).
   for (int r = 0; r < rows; ++r)
@@ -40,7 +45,7 @@ void priority_flood(Dem& z, const std::optional<double>& sea_level, bool epsilon
       }
       if (touches_outside(z, c, r) || is_sea(z[i], sea_level)) {
         closed[i] = 1;
-        open.push({z[i], std::uint32_t(i)});
+        open.push(key(z[i], std::uint32_t(i)));
       }
     }
   std::size_t done = 0;
@@ -51,7 +56,7 @@ void priority_flood(Dem& z, const std::optional<double>& sea_level, bool epsilon
       i = pit.front();
       pit.pop_front();
     } else {
-      i = open.top().i;
+      i = std::uint32_t(open.top());
       open.pop();
     }
     if (++done % report == 0) step.update(double(done) / double(z.size()));
@@ -69,7 +74,7 @@ void priority_flood(Dem& z, const std::optional<double>& sea_level, bool epsilon
         if (raise) z[n] = spill;
         pit.push_back(std::uint32_t(n));
       } else {
-        open.push({z[n], std::uint32_t(n)});
+        open.push(key(z[n], std::uint32_t(n)));
       }
     }
   }
@@ -119,28 +124,32 @@ FlatGradient resolve_flats(const Dem& filled, const Raster<std::uint8_t>& d8) {
   auto& labels = out.labels;
   std::vector<std::uint32_t> low, high;
   // Edges (Barnes 2014b, Algorithm 3): a low edge drains and has a same-elevation undrained
-  // neighbour; a high edge is undrained with a higher neighbour.
+  // neighbour; a high edge is undrained with a higher neighbour. Only undrained cells and their
+  // neighbours can be edges, so only they are looked at; the waves below depend on the ring
+  // distances only, not on the order of the edges.
+  std::vector<std::uint8_t> is_low(0);
   for (int r = 0; r < rows; ++r)
     for (int c = 0; c < cols; ++c) {
       const std::size_t i = filled.index(c, r);
-      const std::uint8_t d = d8[i];
-      if (d == kNoData || d == kTerminal) continue;
+      if (d8[i] != kNoFlow) continue;
       const float zc = filled[i];
+      bool higher = false;
       for (int k = 0; k < 8; ++k) {
         const int nc = c + dcol[k], nr = r + drow[k];
         if (!filled.inside(nc, nr)) continue;
         const std::size_t n = filled.index(nc, nr);
         const std::uint8_t dn = d8[n];
         if (dn == kNoData || dn == kTerminal) continue;
-        if (d != kNoFlow && dn == kNoFlow && filled[n] == zc) {
-          low.push_back(std::uint32_t(i));
-          break;
-        }
-        if (d == kNoFlow && filled[n] > zc) {
-          high.push_back(std::uint32_t(i));
-          break;
+        if (filled[n] > zc) higher = true;
+        if (dn != kNoFlow && filled[n] == zc) {
+          if (is_low.empty()) is_low.assign(filled.size(), 0);
+          if (!is_low[n]) {
+            is_low[n] = 1;
+            low.push_back(std::uint32_t(n));
+          }
         }
       }
+      if (higher) high.push_back(std::uint32_t(i));
     }
   // Label each flat from its low edges (8-connected cells of equal elevation).
   std::int32_t next_label = 1;
