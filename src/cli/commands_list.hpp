@@ -11,5 +11,7 @@ std::unique_ptr<Command> make_info_command();
 std::unique_ptr<Command> make_convert_command();
 std::unique_ptr<Command> make_run_command();
 std::unique_ptr<Command> make_compare_command();
+std::unique_ptr<Command> make_hydro_command();
+std::unique_ptr<Command> make_catchment_command();
 
 }  // namespace terrapolis::cli

@@ -1,0 +1,191 @@
+// `terrapolis hydro DEM OUTDIR`: conditioned DEM, D8 directions, accumulation, hydrometry, streams.
+// SPDX-License-Identifier: MIT
+#include <CLI/CLI.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <string>
+
+#include "cli/command.hpp"
+#include "cli/commands_list.hpp"
+#include "core/error.hpp"
+#include "hydro/hydro.hpp"
+#include "io/raster_io.hpp"
+#include "io/vector_io.hpp"
+#include "terrapolis/version.hpp"
+
+namespace terrapolis::cli {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace terrapolis::hydro;
+
+template <class E>
+E pick(const std::string& option, const std::string& value, const std::map<std::string, E>& choices) {
+  const auto it = choices.find(value);
+  if (it == choices.end()) throw bad_input(option + ": unknown value '" + value + "'");
+  return it->second;
+}
+
+std::string number(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+class HydroCommand final : public Command {
+ public:
+  std::string name() const override { return "hydro"; }
+  std::string summary() const override {
+    return "Hydrology of a DEM: filled DEM, D8 directions, flow accumulation, hydrometry, streams";
+  }
+
+  void setup(CLI::App& app) override {
+    app.add_option("DEM", dem_path_, "Elevation model (any GDAL raster)")->required();
+    app.add_option("OUTDIR", out_dir_, "Output folder (created if missing)")->required();
+    app.add_option("--fill", fill_, "Depression handling: priority-flood, epsilon, breach, none")
+        ->check(CLI::IsMember({"priority-flood", "epsilon", "breach", "none"}))->capture_default_str();
+    app.add_option("--flow", flow_, "Routing for the accumulation: d8, dinf, mfd")
+        ->check(CLI::IsMember({"d8", "dinf", "mfd"}))->capture_default_str();
+    app.add_option("--mfd-exponent", mfd_exponent_, "MFD slope exponent p (> 0; Freeman 1.1, Holmgren 4-6)")->capture_default_str();
+    app.add_option("--d8-codes", codes_, "Code convention of flowdir.tif: esri, grass, taudem")
+        ->check(CLI::IsMember({"esri", "grass", "taudem"}))->capture_default_str();
+    app.add_option("--hydrometry", hydrometry_, "Hydrometry method: belhadj, accumulation")
+        ->check(CLI::IsMember({"belhadj", "accumulation"}))->capture_default_str();
+    app.add_option("--iterations", iterations_, "Belhadj: iterations (0: until convergence)")->capture_default_str();
+    app.add_option("--threshold", threshold_, "Belhadj: stop when the mean quantity is below this (> 0)")->capture_default_str();
+    app.add_option("--vertical", vertical_, "Belhadj: vertical scale, metres or normalised16 (the thesis's z/65535)")
+        ->check(CLI::IsMember({"metres", "normalised16"}))->capture_default_str();
+    app.add_option("--belhadj-share", share_, "Belhadj: share denominator over all 8 neighbours (as printed) or fed ones")
+        ->check(CLI::IsMember({"all", "fed"}))->capture_default_str();
+    app.add_option("--sea-level", sea_level_, "Cells at or below this elevation (m) are outlets (default: off)");
+    app.add_option("--streams-threshold", streams_km2_, "Upstream area (km2) from which a cell is on a stream")->capture_default_str();
+    app.add_option("--area-units", units_, "Unit of accumulation.tif: m2, km2 or cells")
+        ->check(CLI::IsMember({"m2", "km2", "cells"}))->capture_default_str();
+    app.add_option("--weights", weights_, "Raster of per-cell weights (resampled bilinearly onto the DEM)");
+    app.add_option("--assume-crs", assume_crs_, "CRS for a DEM file that carries none, e.g. EPSG:32611");
+    app.add_option("--outputs", outputs_, "Outputs to write, comma-separated: filled,flowdir,accumulation,hydrometry,streams")
+        ->capture_default_str();
+    app.add_flag("--cog", cog_, "Write Cloud Optimized GeoTIFFs");
+    app.add_flag("--overwrite", overwrite_, "Replace existing outputs");
+  }
+
+  void run(Context& context) override {
+    HydroOptions o;
+    o.fill = pick<FillMethod>("--fill", fill_, {{"priority-flood", FillMethod::priority_flood}, {"epsilon", FillMethod::epsilon},
+                                                {"breach", FillMethod::breach}, {"none", FillMethod::none}});
+    o.flow = pick<FlowMethod>("--flow", flow_, {{"d8", FlowMethod::d8}, {"dinf", FlowMethod::dinf}, {"mfd", FlowMethod::mfd}});
+    o.mfd_exponent = mfd_exponent_;
+    if (!(mfd_exponent_ > 0) || !std::isfinite(mfd_exponent_)) throw bad_input("--mfd-exponent: must be a positive number");
+    const D8Codes codes = pick<D8Codes>("--d8-codes", codes_, {{"esri", D8Codes::esri}, {"grass", D8Codes::grass}, {"taudem", D8Codes::taudem}});
+    o.hydrometry.method = pick<HydrometryMethod>("--hydrometry", hydrometry_,
+                                                 {{"belhadj", HydrometryMethod::belhadj}, {"accumulation", HydrometryMethod::accumulation}});
+    if (iterations_ < 0) throw bad_input("--iterations: must be 0 (until convergence) or positive");
+    if (!(threshold_ > 0)) throw bad_input("--threshold: must be a positive number");
+    if (!(streams_km2_ > 0) || !std::isfinite(streams_km2_)) throw bad_input("--streams-threshold: must be a positive number of km2");
+    o.hydrometry.max_iterations = iterations_;
+    o.hydrometry.threshold = threshold_;
+    o.hydrometry.vertical = vertical_ == "metres" ? VerticalScale::metres : VerticalScale::normalised16;
+    o.hydrometry.share = share_ == "all" ? BelhadjShare::all_neighbours : BelhadjShare::fed_neighbours;
+    if (!std::isnan(sea_level_)) o.sea_level = sea_level_;
+    o.unit = units_ == "cells" ? AccumulationUnit::cells : AccumulationUnit::area_m2;
+    o.streams.threshold_km2 = streams_km2_;
+
+    const std::string names[5] = {"filled.tif", "flowdir.tif", "accumulation.tif", "hydrometry.tif", "streams.geojson"};
+    bool wanted[5] = {false, false, false, false, false};
+    for (std::size_t start = 0; start <= outputs_.size();) {
+      const std::size_t comma = std::min(outputs_.find(',', start), outputs_.size());
+      const std::string item = outputs_.substr(start, comma - start);
+      bool known = false;
+      for (int i = 0; i < 5; ++i)
+        if (item + (i == 4 ? ".geojson" : ".tif") == names[i]) wanted[i] = known = true;
+      if (!known) throw bad_input("--outputs: unknown output '" + item + "'");
+      start = comma + 1;
+    }
+    o.with_hydrometry = wanted[3];
+    o.with_streams = wanted[4];
+
+    ReadOptions read;
+    if (!assume_crs_.empty()) read.assume_crs = assume_crs_;
+    const Dem dem = read_dem(dem_path_, read);
+    if (!weights_.empty()) o.weights = read_resampled(weights_, dem.georef(), dem.cols(), dem.rows(), Resampling::bilinear);
+
+    // Refuse existing outputs before any work.
+    const bool created = !fs::exists(out_dir_);
+    if (!created && !fs::is_directory(out_dir_)) throw bad_input(out_dir_ + ": exists and is not a folder");
+    if (!created)
+      for (int i = 0; i < 5; ++i)
+        if (wanted[i]) check_output_path((fs::path(out_dir_) / names[i]).string(), overwrite_);
+
+    HydroResult result = run_hydro(dem, o, context.progress);
+    if (result.hydrometry_iterations > 0) {
+      char line[160];
+      std::snprintf(line, sizeof line, "belhadj: %d iterations in %.2f ms, %.1f M cell-iterations/s", result.hydrometry_iterations,
+                    result.hydrometry_seconds * 1e3,
+                    double(dem.size()) * result.hydrometry_iterations / result.hydrometry_seconds / 1e6);
+      context.log.detail(line);
+    }
+
+    std::vector<std::pair<std::string, std::string>> provenance = {
+        {"TERRAPOLIS_VERSION", version}, {"TERRAPOLIS_COMMAND", "hydro"}, {"SOURCE_DEM", fs::path(dem_path_).filename().string()},
+        {"FILL", fill_}, {"FLOW", flow_}, {"MFD_EXPONENT", number(mfd_exponent_)}, {"HYDROMETRY", hydrometry_},
+        {"ITERATIONS", std::to_string(iterations_)}, {"THRESHOLD", number(threshold_)}, {"VERTICAL", vertical_},
+        {"BELHADJ_SHARE", share_}, {"SEA_LEVEL", o.sea_level ? number(*o.sea_level) : "off"}};
+    auto opts = [&](const std::string& description, std::vector<std::pair<std::string, std::string>> extra = {}) {
+      WriteOptions w;
+      w.cog = cog_;
+      w.overwrite = overwrite_;
+      w.description = description;
+      w.metadata = provenance;
+      w.metadata.insert(w.metadata.end(), extra.begin(), extra.end());
+      return w;
+    };
+    Raster<float> acc;
+    if (wanted[2]) {
+      acc = result.filled.like<float>(NAN);
+      const double scale = units_ == "km2" ? 1e-6 : 1.0;
+      for (std::size_t i = 0; i < acc.size(); ++i) acc[i] = float(result.accumulation[i] * scale);
+      result.accumulation = Raster<double>();  // release before writing
+    }
+    const std::string acc_unit = units_ == "cells" ? "cells" : units_;
+    std::vector<std::string> written;
+    try {
+      if (created) fs::create_directories(out_dir_);
+      auto path = [&](int i) {
+        written.push_back((fs::path(out_dir_) / names[i]).string());
+        return written.back();
+      };
+      if (wanted[0]) write_raster(path(0), result.filled, opts("Conditioned elevation (m), " + fill_ + " depression handling"));
+      if (wanted[1]) write_raster(path(1), encode_d8(result.d8, codes),
+                   opts("D8 flow direction, " + describe(codes), {{"D8_CODES", codes_}, {"D8_CODES_DESCRIPTION", describe(codes)}}));
+      if (wanted[2]) write_raster(path(2), acc,
+                   opts("Upstream " + std::string(units_ == "cells" ? "cell count" : "area (" + acc_unit + ")") + ", " + flow_ +
+                            " routing" + (weights_.empty() ? "" : ", weighted"),
+                        {{"UNIT", acc_unit}}));
+      if (wanted[3]) write_raster(path(3), result.hydrometry, opts("Hydrometry in [0,1] (" + hydrometry_ + ")"));
+      if (wanted[4]) write_vector(path(4), result.streams, overwrite_);
+    } catch (...) {
+      // No partial result: new files go, and the folder if this run made it.
+      if (!overwrite_ || created)
+        for (const auto& p : written) fs::remove(p);
+      if (created) fs::remove_all(out_dir_);
+      throw;
+    }
+    context.log.info("hydro: wrote " + out_dir_ + (wanted[4] ? " (" + std::to_string(result.streams.features.size()) + " stream reaches)" : ""));
+  }
+
+ private:
+  std::string dem_path_, out_dir_, fill_ = "priority-flood", flow_ = "d8", codes_ = "esri", hydrometry_ = "belhadj";
+  std::string outputs_ = "filled,flowdir,accumulation,hydrometry,streams";
+  std::string vertical_ = "metres", share_ = "all", units_ = "m2", weights_, assume_crs_;
+  double mfd_exponent_ = 1.1, threshold_ = 1.0 / 1048576, streams_km2_ = 10.0, sea_level_ = NAN;
+  int iterations_ = 0;
+  bool cog_ = false, overwrite_ = false;
+};
+
+}  // namespace
+
+std::unique_ptr<Command> make_hydro_command() { return std::make_unique<HydroCommand>(); }
+
+}  // namespace terrapolis::cli

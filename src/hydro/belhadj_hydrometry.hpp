@@ -1,0 +1,97 @@
+// Belhadj's iterative rain-diffusion hydrometry (thesis, Paris 8, 2007, §4.2.2, Algorithm 12).
+// SPDX-License-Identifier: MIT
+#pragma once
+#include <optional>
+#include <vector>
+
+#include "core/geodesy.hpp"
+#include "core/progress.hpp"
+#include "core/raster.hpp"
+
+namespace terrapolis::hydro {
+
+/// Vertical unit of the vectors V_i = (dx, dy, dz) of Algorithm 12.
+enum class VerticalScale {
+  /// dx, dy and dz all in metres (geodesic cell steps on geographic CRSs): slopes are real.
+  metres,
+  /// The thesis: the 16-bit altitude (metres in its NGDC data) divided by 2^16-1, dx, dy in
+  /// cells (1 or -1): the vertical is tiny against the horizontal. Outside cells are at -1.
+  normalised16,
+};
+
+/// What Σn, the denominator of each neighbour's share, sums over.
+enum class BelhadjShare {
+  /// Algorithm 12 as printed: all 8 neighbours, fed or not, so the shares of the neighbours that
+  /// get nothing (R_i . V_i <= 0, or outside the grid) are lost. Converges geometrically.
+  all_neighbours,
+  /// Only the neighbours with R_i . V_i > 0 (outside cells included: their share leaves the
+  /// grid): water is conserved except what leaves through outlets, so it gathers in valleys and
+  /// between obstacles (as the thesis's Fig. 4.1 shows) and converges when it has run off.
+  fed_neighbours,
+};
+
+/// The state of the diffusion on a grid padded with a one-cell halo of "outside" cells
+/// (beyond the border, on nodata, at or below sea level), which get an altitude far below every
+/// cell and never receive water. Kept public so tests can check a single iteration by hand.
+class BelhadjModel {
+ public:
+  /// Initial state: F = (0, 0, -1) (a falling drop: straight down), Q = 1, Acc = 0 on every valid cell.
+  BelhadjModel(const Dem& dem, const CellMetrics& metrics, VerticalScale vertical, std::optional<double> sea_level,
+               BelhadjShare share = BelhadjShare::all_neighbours);
+
+  /// One iteration of Algorithm 12, simultaneously for all cells (double buffer): each cell c
+  /// sends R_i = F(c) + V_i(c) and the share |R_i| Q(c) / Σ_j |R_j| of its water to every inside
+  /// neighbour i with R_i . V_i(c) > 0 (Σ over all 8 neighbours, so the rest is lost);
+  /// Acc += Q. Returns the mean Q over valid cells before the step (the thesis's stop test).
+  /// Parallel over rows in three phases (rows 3 apart never write the same cell), each sum in a
+  /// fixed order: bit-identical
+  /// for any thread count.
+  double step();
+
+  int cols() const { return cols_; }
+  int rows() const { return rows_; }
+  /// State of cell (col,row) of the DEM grid.
+  double q(int col, int row) const { return q_[at(col, row)]; }
+  double acc(int col, int row) const { return acc_[at(col, row)]; }
+  std::array<double, 3> flow(int col, int row) const {
+    const std::size_t i = at(col, row);
+    return {fx_[i], fy_[i], fz_[i]};
+  }
+  /// Altitude used for the outside cells (normalised16: -1; metres: min - (max - min), at least 1 m below).
+  double outside_altitude() const { return z_out_; }
+  bool valid(int col, int row) const { return valid_[at(col, row)] != 0; }
+
+ private:
+  std::size_t at(int col, int row) const { return std::size_t(row + 1) * std::size_t(stride_) + std::size_t(col + 1); }
+  int cols_, rows_, stride_;
+  BelhadjShare share_;
+  std::size_t valid_count_ = 0;
+  double z_out_ = -1;
+  std::vector<double> z_, valid_;                 // padded altitude, 1 on valid cells
+  std::vector<double> hx_, hy_;                   // per padded row, 8 horizontal steps (east, south)
+  std::vector<double> fx_, fy_, fz_, q_, acc_;    // current state
+  std::vector<double> fx2_, fy2_, fz2_, q2_;      // next state
+  std::vector<double> row_sum_;
+};
+
+struct BelhadjOptions {
+  int max_iterations = 0;                ///< 0: until convergence (with a safety cap of 300)
+  double threshold = 1.0 / 1048576;      ///< stop when the mean quantity is below this (2^-20)
+  VerticalScale vertical = VerticalScale::metres;
+  std::optional<double> sea_level;       ///< cells at or below are outside (outlets)
+  BelhadjShare share = BelhadjShare::all_neighbours;
+};
+
+struct BelhadjRun {
+  Raster<float> hydrometry;  ///< Acc rescaled to [0,1] over valid cells; NaN on nodata, 0 on sea
+  int iterations = 0;        ///< iterations done
+  double final_mean = 0;     ///< mean quantity at the last iteration
+};
+
+/// Runs the diffusion until the mean quantity drops below `threshold` or `max_iterations`.
+/// The cap of 300 iterations keeps the flow vectors finite (|F| can grow 8-fold per iteration on a
+/// flat: 8^300 < 1e308); the thesis's cases converge in 20 to 51 iterations.
+BelhadjRun belhadj_hydrometry(const Dem& dem, const CellMetrics& metrics, const BelhadjOptions& options,
+                              Progress& progress);
+
+}  // namespace terrapolis::hydro

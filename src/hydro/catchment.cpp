@@ -1,0 +1,139 @@
+// Catchment delineation: snap, upstream walk on D8, GDALPolygonize of the mask.
+// SPDX-License-Identifier: MIT
+#include "hydro/catchment.hpp"
+
+#include <gdal_alg.h>
+#include <gdal_priv.h>
+#include <ogrsf_frmts.h>
+
+#include <cmath>
+#include <memory>
+#include <vector>
+
+#include "core/error.hpp"
+#include "hydro/grid.hpp"
+#include "io/crs.hpp"
+#include "io/raster_io.hpp"
+
+namespace terrapolis::hydro {
+namespace {
+
+/// Outer ring and holes of the mask's polygons, in CRS coordinates.
+std::vector<Feature> polygonize(const Raster<std::uint8_t>& mask) {
+  init_gdal();
+  GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");
+  if (!mem) throw processing_error("catchment: GDAL's MEM driver is missing");
+  std::unique_ptr<GDALDataset> ds(mem->Create("", mask.cols(), mask.rows(), 1, GDT_Byte, nullptr));
+  GeoTransform gt = mask.georef().transform;
+  ds->SetGeoTransform(gt.data());
+  GDALRasterBand* band = ds->GetRasterBand(1);
+  std::vector<std::uint8_t> binary(mask.size());
+  for (std::size_t i = 0; i < mask.size(); ++i) binary[i] = mask[i] == 1 ? 1 : 0;
+  if (band->RasterIO(GF_Write, 0, 0, mask.cols(), mask.rows(), binary.data(), mask.cols(), mask.rows(), GDT_Byte, 0, 0) !=
+      CE_None)
+    throw processing_error("catchment: cannot fill the in-memory mask");
+  GDALDriver* vmem = GetGDALDriverManager()->GetDriverByName("Memory");
+  if (!vmem) vmem = GetGDALDriverManager()->GetDriverByName("MEM");
+  std::unique_ptr<GDALDataset> vds(vmem->Create("", 0, 0, 0, GDT_Unknown, nullptr));
+  OGRLayer* layer = vds->CreateLayer("catchment", nullptr, wkbPolygon, nullptr);
+  OGRFieldDefn field("value", OFTInteger);
+  layer->CreateField(&field);
+  char** options = CSLSetNameValue(nullptr, "8CONNECTED", "8");
+  const CPLErr err = GDALPolygonize(band, band, layer, 0, options, nullptr, nullptr);
+  CSLDestroy(options);
+  if (err != CE_None) throw processing_error("catchment: GDALPolygonize failed");
+  std::vector<Feature> out;
+  layer->ResetReading();
+  for (auto& feature : *layer) {
+    if (feature->GetFieldAsInteger(0) != 1) continue;
+    const OGRGeometry* g = feature->GetGeometryRef();
+    if (!g || wkbFlatten(g->getGeometryType()) != wkbPolygon) continue;
+    const auto* poly = g->toPolygon();
+    Feature f;
+    auto ring_points = [](const OGRLinearRing* ring) {
+      std::vector<std::array<double, 2>> pts;
+      for (int i = 0; i < ring->getNumPoints(); ++i) pts.push_back({ring->getX(i), ring->getY(i)});
+      return pts;
+    };
+    f.parts.push_back(ring_points(poly->getExteriorRing()));
+    for (int h = 0; h < poly->getNumInteriorRings(); ++h) f.parts.push_back(ring_points(poly->getInteriorRing(h)));
+    out.push_back(std::move(f));
+  }
+  return out;
+}
+
+}  // namespace
+
+Catchment delineate_catchment(const Raster<std::uint8_t>& d8, const Raster<double>& area, const CellMetrics& metrics,
+                              double x, double y, double snap_radius_m, Progress& progress) {
+  if (!(snap_radius_m >= 0) || !std::isfinite(snap_radius_m)) throw bad_input("--snap-radius: must be >= 0 metres");
+  ProgressStep step(progress, "catchment");
+  const GridLocator locator(d8.georef());
+  const auto px = locator.crs_to_pixel(x, y);
+  const int pc = int(std::floor(px[0])), pr = int(std::floor(px[1]));
+  if (!std::isfinite(px[0]) || !d8.inside(pc, pr))
+    throw bad_input("--outlet: the point is outside the DEM");
+  // Snap: highest upstream area within the radius (ties: lowest row, then column).
+  const double cell_min = std::min(metrics.width_m[std::size_t(pr)], metrics.height_m[std::size_t(pr)]);
+  const int reach = int(std::ceil(snap_radius_m / cell_min)) + 1;
+  int best_c = -1, best_r = -1;
+  double best = -1;
+  for (int r = std::max(0, pr - reach); r <= std::min(d8.rows() - 1, pr + reach); ++r)
+    for (int c = std::max(0, pc - reach); c <= std::min(d8.cols() - 1, pc + reach); ++c) {
+      if (d8(c, r) == kNoData) continue;
+      const bool same = c == pc && r == pr;
+      if (!same) {
+        const auto a = d8.georef().cell_centre(c, r);
+        if (crs_distance_m(d8.georef().crs, x, y, a[0], a[1]) > snap_radius_m) continue;
+      }
+      if (area(c, r) > best) {
+        best = area(c, r);
+        best_c = c;
+        best_r = r;
+      }
+    }
+  if (best_c < 0) throw bad_input("--outlet: no valid DEM cell within the snap radius of the point");
+  Catchment out;
+  out.outlet_col = best_c;
+  out.outlet_row = best_r;
+  const auto centre = d8.georef().cell_centre(best_c, best_r);
+  out.outlet_x = centre[0];
+  out.outlet_y = centre[1];
+  out.mask = d8.like<std::uint8_t>(0);
+  out.mask.nodata = 255;
+  for (std::size_t i = 0; i < d8.size(); ++i)
+    if (d8[i] == kNoData) out.mask[i] = 255;
+  std::vector<std::size_t> stack{d8.index(best_c, best_r)};
+  out.mask(best_c, best_r) = 1;
+  double area_m2 = 0;
+  while (!stack.empty()) {
+    const std::size_t i = stack.back();
+    stack.pop_back();
+    const int c = int(i % std::size_t(d8.cols())), r = int(i / std::size_t(d8.cols()));
+    area_m2 += metrics.area_m2[std::size_t(r)];
+    ++out.cells;
+    for (int k = 0; k < 8; ++k) {
+      const int nc = c + dcol[k], nr = r + drow[k];
+      if (!d8.inside(nc, nr)) continue;
+      const std::size_t n = d8.index(nc, nr);
+      if (out.mask[n] == 0 && d8[n] == opposite(k)) {
+        out.mask[n] = 1;
+        stack.push_back(n);
+      }
+    }
+  }
+  out.area_km2 = area_m2 / 1e6;
+  step.update(0.5);
+  out.polygon.name = "catchment";
+  out.polygon.geometry = GeometryType::polygon;
+  out.polygon.crs = d8.georef().crs;
+  out.polygon.fields = {{"area_km2", FieldType::real}, {"cells", FieldType::integer}, {"outlet_x", FieldType::real},
+                        {"outlet_y", FieldType::real}};
+  for (auto& f : polygonize(out.mask)) {
+    f.values = {out.area_km2, std::int64_t(out.cells), out.outlet_x, out.outlet_y};
+    out.polygon.features.push_back(std::move(f));
+  }
+  return out;
+}
+
+}  // namespace terrapolis::hydro

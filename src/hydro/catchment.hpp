@@ -1,0 +1,31 @@
+// Catchment of an outlet: snapping to the stream, upstream mask, polygon and area.
+// SPDX-License-Identifier: MIT
+#pragma once
+#include <cstdint>
+
+#include "core/geodesy.hpp"
+#include "core/progress.hpp"
+#include "core/raster.hpp"
+#include "io/vector_io.hpp"
+
+namespace terrapolis::hydro {
+
+struct Catchment {
+  int outlet_col = 0, outlet_row = 0;  ///< the snapped outlet cell
+  double outlet_x = 0, outlet_y = 0;   ///< its centre in the DEM's CRS
+  Raster<std::uint8_t> mask;           ///< 1 inside the catchment, 0 outside, 255 on nodata
+  double area_km2 = 0;                 ///< geodesic area of the masked cells, km²
+  std::size_t cells = 0;
+  VectorLayer polygon;                 ///< one polygon (8-connected cells, holes kept), DEM CRS
+};
+
+/// The cells whose D8 path passes through the outlet. The outlet (x, y) in the DEM's CRS is
+/// snapped to the cell of highest upstream area whose centre lies within `snap_radius_m` metres
+/// (geodesic on geographic CRSs) of it; radius 0 takes the cell containing the point.
+/// Throws bad_input when the point is off the grid or on nodata with no valid cell in the radius.
+/// The polygon comes from GDALPolygonize (8-connectedness) on the mask; fields `area_km2`,
+/// `cells`, `outlet_x`, `outlet_y`.
+Catchment delineate_catchment(const Raster<std::uint8_t>& d8, const Raster<double>& area_m2, const CellMetrics& metrics,
+                              double x, double y, double snap_radius_m, Progress& progress);
+
+}  // namespace terrapolis::hydro
