@@ -8,6 +8,7 @@ namespace terrapolis::cli {
 std::vector<std::unique_ptr<Command>> all_commands() {
   std::vector<std::unique_ptr<Command>> commands;
   commands.push_back(make_info_command());
+  commands.push_back(make_density_command());
   return commands;
 }
 

@@ -8,5 +8,6 @@
 namespace terrapolis::cli {
 
 std::unique_ptr<Command> make_info_command();
+std::unique_ptr<Command> make_density_command();
 
 }  // namespace terrapolis::cli

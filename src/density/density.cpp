@@ -7,6 +7,8 @@
 #include <tbb/parallel_reduce.h>
 
 #include <algorithm>
+#include <climits>
+#include <cstdint>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -204,6 +206,39 @@ DensityResult compute_density(const Dem& dem, const Raster<float>& hydrometry, c
   stats.ring_bands = std::max(inner.band_count(), outer.band_count());
   stats.ring_exact = inner.exact() && outer.exact();
 
+  // Only land cells need characteristics: each row is worked on over its span of land only
+  // (a big saving on coastal tiles that are mostly sea, and on nodata borders).
+  std::vector<int> span_lo(std::size_t(rows), 0), span_hi(std::size_t(rows), 0);
+  bool any_unknown = false;
+  for (int r = 0; r < rows; ++r) {
+    int lo = cols, hi = 0;
+    for (int x = 0; x < cols; ++x) {
+      const std::uint8_t k = kind[dem.index(x, r)];
+      if (k == land) lo = std::min(lo, x), hi = x + 1;
+      any_unknown = any_unknown || k == unknown;
+    }
+    span_lo[std::size_t(r)] = lo;
+    span_hi[std::size_t(r)] = std::max(lo, hi);
+  }
+  // Summed-area tables cover only the land's bounding box grown by the ring's reach: no cell
+  // outside it falls in the disc of a land cell.
+  Window win;
+  {
+    int r_lo = rows, r_hi = -1, c_lo = cols, c_hi = -1;
+    for (int r = 0; r < rows; ++r)
+      if (span_lo[std::size_t(r)] < span_hi[std::size_t(r)]) {
+        r_lo = std::min(r_lo, r), r_hi = r;
+        c_lo = std::min(c_lo, span_lo[std::size_t(r)]), c_hi = std::max(c_hi, span_hi[std::size_t(r)] - 1);
+      }
+    if (r_hi >= 0) {
+      const int ry = std::max(outer.reach_rows(), inner.reach_rows()), rx = std::max(outer.reach_cols(), inner.reach_cols());
+      win.y0 = std::max(0, r_lo - ry);
+      win.x0 = std::max(0, c_lo - rx);
+      win.rows = std::min(rows, r_hi + ry + 1) - win.y0;
+      win.cols = std::min(cols, c_hi + rx + 1) - win.x0;
+    }
+  }
+
   // ---- plain: standard deviation of land altitudes within r_min ---------------------------
   result.plain = dem.like<float>(nan_f);
   {
@@ -213,9 +248,9 @@ DensityResult compute_density(const Dem& dem, const Raster<float>& hydrometry, c
     for (std::size_t i = 0; i < n; ++i)
       if (kind[i] == land) lo = std::min(lo, dem[i]), hi = std::max(hi, dem[i]);
     const double mid = lo <= hi ? 0.5 * (double(lo) + double(hi)) : 0.0;
-    const SummedArea<std::uint32_t> count(cols, rows, [&](std::size_t i) { return std::uint32_t(kind[i] == land); });
-    const SummedArea<double> s1(cols, rows, [&](std::size_t i) { return kind[i] == land ? double(dem[i]) - mid : 0.0; });
-    const SummedArea<double> s2(cols, rows, [&](std::size_t i) {
+    const SummedArea<std::uint32_t> count(win, cols, [&](std::size_t i) { return std::uint32_t(kind[i] == land); });
+    const SummedArea<double> s1(win, cols, [&](std::size_t i) { return kind[i] == land ? double(dem[i]) - mid : 0.0; });
+    const SummedArea<double> s2(win, cols, [&](std::size_t i) {
       const double d = kind[i] == land ? double(dem[i]) - mid : 0.0;
       return d * d;
     });
@@ -224,15 +259,18 @@ DensityResult compute_density(const Dem& dem, const Raster<float>& hydrometry, c
       std::vector<std::uint32_t> a(std::size_t(cols), 0);
       std::vector<double> b(static_cast<std::size_t>(cols)), c(static_cast<std::size_t>(cols));
       for (int r = r0; r < r1; ++r) {
-        std::fill(a.begin(), a.end(), 0u);
-        std::fill(b.begin(), b.end(), 0.0);
-        std::fill(c.begin(), c.end(), 0.0);
-        add_disc_row(count, inner, r, +1, a.data());
-        add_disc_row(s1, inner, r, +1, b.data());
-        add_disc_row(s2, inner, r, +1, c.data());
-        for (int x = 0; x < cols; ++x) {
+        for (int x = 0; x < cols; ++x)
+          if (kind[dem.index(x, r)] == water) result.plain(x, r) = 0;
+        const int x0 = span_lo[std::size_t(r)], x1 = span_hi[std::size_t(r)];
+        if (x0 >= x1) continue;
+        std::fill(a.begin() + x0, a.begin() + x1, 0u);
+        std::fill(b.begin() + x0, b.begin() + x1, 0.0);
+        std::fill(c.begin() + x0, c.begin() + x1, 0.0);
+        add_disc_row(count, inner, r, +1, a.data(), x0, x1);
+        add_disc_row(s1, inner, r, +1, b.data(), x0, x1);
+        add_disc_row(s2, inner, r, +1, c.data(), x0, x1);
+        for (int x = x0; x < x1; ++x) {
           const std::size_t i = dem.index(x, r);
-          if (kind[i] == water) result.plain[i] = 0;
           if (kind[i] != land) continue;
           const double k = a[std::size_t(x)];
           const double mean = b[std::size_t(x)] / k;
@@ -249,35 +287,47 @@ DensityResult compute_density(const Dem& dem, const Raster<float>& hydrometry, c
   {
     ProgressStep step(progress, "density: coast and plateau");
     // Plateau ground "opposed to plains" (§4.2.1, point 3): altitude within the plateau range,
-    // weighted by how far it is from a plain (cliffs and slopes count, flat tops do not).
-    const SummedArea<std::uint32_t> wet(cols, rows, [&](std::size_t i) { return std::uint32_t(kind[i] == water); });
-    const SummedArea<std::uint32_t> known(cols, rows, [&](std::size_t i) { return std::uint32_t(kind[i] != unknown); });
-    const SummedArea<double> high(cols, rows, [&](std::size_t i) {
+    // weighted by how far it is from a plain (cliffs and slopes count, flat tops do not). The
+    // weight is quantised to `levels` steps so its sums stay exact integers in 32 bits.
+    const double levels = std::min(1024.0, std::floor(double(UINT32_MAX) / std::max(1.0, outer.max_cells())));
+    if (levels < 16) throw bad_input("--r-max: the ring holds too many cells for this grid (" + std::to_string(outer.max_cells()) + ")");
+    const SummedArea<std::uint32_t> wet(win, cols, [&](std::size_t i) { return std::uint32_t(kind[i] == water); });
+    // Without unknown cells every cell is known: count ring cells by arithmetic instead.
+    const SummedArea<std::uint32_t> known = any_unknown ? SummedArea<std::uint32_t>(win, cols, [&](std::size_t i) { return std::uint32_t(kind[i] != unknown); })
+                                                        : SummedArea<std::uint32_t>();
+    const SummedArea<std::uint32_t> high(win, cols, [&](std::size_t i) {
       const float z = dem[i];
       const bool in_range = kind[i] == land && z >= options.plateau_min_m && z <= options.plateau_max_m;
-      return in_range ? 1.0 - double(result.plain[i]) : 0.0;
+      return in_range ? std::uint32_t(std::lround((1.0 - double(result.plain[i])) * levels)) : 0u;
     });
     for_rows(rows, step, [&](int r0, int r1) {
-      std::vector<std::uint32_t> w(static_cast<std::size_t>(cols)), k(static_cast<std::size_t>(cols));
-      std::vector<double> h(static_cast<std::size_t>(cols));
+      std::vector<std::uint32_t> w(static_cast<std::size_t>(cols)), k(static_cast<std::size_t>(cols)), h(static_cast<std::size_t>(cols));
       for (int r = r0; r < r1; ++r) {
-        std::fill(w.begin(), w.end(), 0u);
-        std::fill(k.begin(), k.end(), 0u);
-        std::fill(h.begin(), h.end(), 0.0);
-        add_disc_row(wet, outer, r, +1, w.data());
-        add_disc_row(wet, inner, r, -1, w.data());
-        add_disc_row(known, outer, r, +1, k.data());
-        add_disc_row(known, inner, r, -1, k.data());
-        add_disc_row(high, outer, r, +1, h.data());
-        add_disc_row(high, inner, r, -1, h.data());
-        for (int x = 0; x < cols; ++x) {
+        for (int x = 0; x < cols; ++x)
+          if (kind[dem.index(x, r)] == water) result.coast(x, r) = result.plateau(x, r) = 0;
+        const int x0 = span_lo[std::size_t(r)], x1 = span_hi[std::size_t(r)];
+        if (x0 >= x1) continue;
+        std::fill(w.begin() + x0, w.begin() + x1, 0u);
+        std::fill(k.begin() + x0, k.begin() + x1, 0u);
+        std::fill(h.begin() + x0, h.begin() + x1, 0u);
+        add_disc_row(wet, outer, r, +1, w.data(), x0, x1);
+        add_disc_row(wet, inner, r, -1, w.data(), x0, x1);
+        if (any_unknown) {
+          add_disc_row(known, outer, r, +1, k.data(), x0, x1);
+          add_disc_row(known, inner, r, -1, k.data(), x0, x1);
+        } else {
+          add_disc_count_row(outer, cols, rows, r, +1, k.data(), x0, x1);
+          add_disc_count_row(inner, cols, rows, r, -1, k.data(), x0, x1);
+        }
+        add_disc_row(high, outer, r, +1, h.data(), x0, x1);
+        add_disc_row(high, inner, r, -1, h.data(), x0, x1);
+        for (int x = x0; x < x1; ++x) {
           const std::size_t i = dem.index(x, r);
-          if (kind[i] == water) result.coast[i] = result.plateau[i] = 0;
           if (kind[i] != land) continue;
           const double total = k[std::size_t(x)];
           // Band approximations can make a ring cell count slightly off: keep shares in [0,1].
           result.coast[i] = total > 0 ? float(std::clamp(double(w[std::size_t(x)]) / total, 0.0, 1.0)) : 0.0f;
-          result.plateau[i] = total > 0 ? float(std::clamp(h[std::size_t(x)] / total, 0.0, 1.0)) : 0.0f;
+          result.plateau[i] = total > 0 ? float(std::clamp(double(h[std::size_t(x)]) / levels / total, 0.0, 1.0)) : 0.0f;
         }
       }
     });

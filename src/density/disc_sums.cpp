@@ -34,7 +34,7 @@ class RowGeometry {
 };
 
 /// Rows a disc of radius_m can reach on either side, at most.
-int reach_rows(const CellMetrics& m, double radius_m) {
+int max_reach_rows(const CellMetrics& m, double radius_m) {
   const double min_height = *std::min_element(m.height_m.begin(), m.height_m.end());
   return int(std::ceil(radius_m / min_height)) + 1;
 }
@@ -55,7 +55,7 @@ int DiscPlan::exact_half_cols(const CellMetrics& metrics, int rows, double radiu
 }
 
 DiscPlan::DiscPlan(const CellMetrics& metrics, int rows, double radius_m, int max_bands) {
-  const int reach = reach_rows(metrics, radius_m);
+  const int reach = max_reach_rows(metrics, radius_m);
   const RowGeometry g(metrics, rows, reach + 1);
   const int bands_wanted = std::max(1, max_bands);
   // A projected grid has the same metrics on every row: plan once.
@@ -96,44 +96,69 @@ DiscPlan::DiscPlan(const CellMetrics& metrics, int rows, double radius_m, int ma
       }
     }
     band_count_ = std::max(band_count_, int(bands.size()));
+    double cells = 0;
+    for (const Band& b : bands) cells += double(b.row_hi - b.row_lo + 1) * double(2 * b.half_cols + 1);
+    max_cells_ = std::max(max_cells_, cells);
+    for (const Band& b : bands) {
+      reach_rows_ = std::max({reach_rows_, -b.row_lo, b.row_hi});
+      reach_cols_ = std::max(reach_cols_, b.half_cols);
+    }
   }
 }
 
 namespace {
 
 template <class T, bool Add>
-void disc_row(const SummedArea<T>& table, const DiscPlan& plan, int row, T* acc) {
+void disc_row(const SummedArea<T>& table, const DiscPlan& plan, int row, T* acc, int c_begin, int c_end) {
+  const Window& win = table.window();
   const int cols = table.cols(), rows = table.rows();
   for (const Band& b : plan.bands(row)) {
-    const int y0 = std::clamp(row + b.row_lo, 0, rows), y1 = std::clamp(row + b.row_hi + 1, 0, rows);
+    const int y0 = std::clamp(row - win.y0 + b.row_lo, 0, rows), y1 = std::clamp(row - win.y0 + b.row_hi + 1, 0, rows);
     if (y1 <= y0) continue;
     const T* a0 = table.row(y0);
     const T* a1 = table.row(y1);
     const int w = b.half_cols;
     auto rect = [&](int x0, int x1) { return T((a1[x1] - a1[x0]) - (a0[x1] - a0[x0])); };
+    // Work in window columns: acc is shifted so that acc_w[cw] is acc[cw + win.x0].
+    T* acc_w = acc + win.x0;
     auto put = [&](int c, T v) {
-      if constexpr (Add) acc[c] += v;
-      else acc[c] -= v;
+      if constexpr (Add) acc_w[c] += v;
+      else acc_w[c] -= v;
     };
-    // Columns whose window [c-w, c+w] is inside the grid run without clamping (vectorised).
-    const int left = std::min(w, cols);
-    const int right = std::max(left, cols - w);
-    for (int c = 0; c < left; ++c) put(c, rect(0, std::min(c + w + 1, cols)));
+    const int cb = c_begin - win.x0, ce = c_end - win.x0;
+    // Columns whose window [c-w, c+w] lies inside the table run without clamping (vectorised).
+    const int left = std::clamp(w, cb, ce);
+    const int right = std::clamp(cols - w, left, ce);
+    for (int c = cb; c < left; ++c) put(c, rect(std::clamp(c - w, 0, cols), std::clamp(c + w + 1, 0, cols)));
     for (int c = left; c < right; ++c) put(c, T((a1[c + w + 1] - a1[c - w]) - (a0[c + w + 1] - a0[c - w])));
-    for (int c = right; c < cols; ++c) put(c, rect(std::max(c - w, 0), std::min(c + w + 1, cols)));
+    for (int c = right; c < ce; ++c) put(c, rect(std::clamp(c - w, 0, cols), std::clamp(c + w + 1, 0, cols)));
   }
 }
 
 }  // namespace
 
 template <class T>
-void add_disc_row(const SummedArea<T>& table, const DiscPlan& plan, int row, int sign, T* acc) {
-  if (sign >= 0) disc_row<T, true>(table, plan, row, acc);
-  else disc_row<T, false>(table, plan, row, acc);
+void add_disc_row(const SummedArea<T>& table, const DiscPlan& plan, int row, int sign, T* acc, int c_begin, int c_end) {
+  if (sign >= 0) disc_row<T, true>(table, plan, row, acc, c_begin, c_end);
+  else disc_row<T, false>(table, plan, row, acc, c_begin, c_end);
 }
 
-template void add_disc_row<std::uint32_t>(const SummedArea<std::uint32_t>&, const DiscPlan&, int, int, std::uint32_t*);
-template void add_disc_row<double>(const SummedArea<double>&, const DiscPlan&, int, int, double*);
+template void add_disc_row<std::uint32_t>(const SummedArea<std::uint32_t>&, const DiscPlan&, int, int, std::uint32_t*, int, int);
+template void add_disc_row<double>(const SummedArea<double>&, const DiscPlan&, int, int, double*, int, int);
+
+void add_disc_count_row(const DiscPlan& plan, int cols, int rows, int row, int sign, std::uint32_t* acc, int c_begin,
+                        int c_end) {
+  for (const Band& b : plan.bands(row)) {
+    const int y0 = std::clamp(row + b.row_lo, 0, rows), y1 = std::clamp(row + b.row_hi + 1, 0, rows);
+    if (y1 <= y0) continue;
+    const auto h = std::uint32_t(y1 - y0);
+    const int w = b.half_cols;
+    for (int c = c_begin; c < c_end; ++c) {
+      const auto n = h * std::uint32_t(std::min(c + w + 1, cols) - std::max(c - w, 0));
+      acc[c] += sign >= 0 ? n : std::uint32_t(0) - n;
+    }
+  }
+}
 
 std::vector<double> brute_force_disc_sums(const std::vector<double>& values, const CellMetrics& metrics, int cols,
                                           int rows, double radius_m) {

@@ -12,26 +12,36 @@
 
 namespace terrapolis::density {
 
-/// Summed-area table (Crow 1984, "Summed-area tables for texture mapping") of a cols x rows grid:
-/// at(y, x) is the sum of the cells of rows < y and columns < x, for y in 0..rows, x in 0..cols.
-/// With T = uint32_t the arithmetic is modular and a rectangle sum is exact whenever the true sum
-/// fits in 32 bits (counts of cells); with T = double it is exact for integer data up to 2^53.
-/// Built in a fixed order, so the table does not depend on the thread count.
+/// A rectangle of a grid: columns [x0, x0 + cols), rows [y0, y0 + rows).
+struct Window {
+  int x0 = 0, y0 = 0, cols = 0, rows = 0;
+};
+
+/// Summed-area table (Crow 1984, "Summed-area tables for texture mapping") of a window of a grid:
+/// at(y, x) is the sum of the window's cells of rows < y and columns < x (window coordinates), for y
+/// in 0..rows, x in 0..cols. With T = uint32_t the arithmetic is modular and a rectangle sum is exact
+/// whenever the true sum fits in 32 bits (counts of cells); with T = double it is exact for integer
+/// data up to 2^53. Built in a fixed order, so the table does not depend on the thread count.
 template <class T>
 class SummedArea {
  public:
   SummedArea() = default;
-  /// `value(i)` gives the value of cell i (row-major); called once per cell, possibly in parallel.
+  /// `value(i)` gives the value of cell i (row-major index in the whole grid of `grid_cols`
+  /// columns); called once per cell of the window, possibly in parallel.
   template <class F>
-  SummedArea(int cols, int rows, F value);
-  int cols() const { return cols_; }
-  int rows() const { return rows_; }
-  const T* row(int y) const { return table_.data() + std::size_t(y) * std::size_t(stride()); }
+  SummedArea(const Window& window, int grid_cols, F value);
+  /// A table of a whole cols x rows grid.
+  template <class F>
+  SummedArea(int cols, int rows, F value) : SummedArea(Window{0, 0, cols, rows}, cols, value) {}
+  int cols() const { return window_.cols; }
+  int rows() const { return window_.rows; }
+  const Window& window() const { return window_; }
+  const T* row(int y) const { return table_.data() + std::size_t(y) * stride(); }
   T at(int y, int x) const { return row(y)[x]; }
 
  private:
-  std::size_t stride() const { return std::size_t(cols_) + 1; }
-  int cols_ = 0, rows_ = 0;
+  std::size_t stride() const { return std::size_t(window_.cols) + 1; }
+  Window window_;
   std::vector<T> table_;
 };
 
@@ -69,17 +79,31 @@ class DiscPlan {
   bool exact() const { return exact_; }
   /// Largest number of bands of any row.
   int band_count() const { return band_count_; }
+  /// Largest number of cells of any row's (unclipped) disc.
+  double max_cells() const { return max_cells_; }
+  /// Largest reach of the disc, in rows (north or south) and in columns.
+  int reach_rows() const { return reach_rows_; }
+  int reach_cols() const { return reach_cols_; }
 
  private:
   std::vector<std::vector<Band>> per_row_;
   bool exact_ = true;
   int band_count_ = 0;
+  double max_cells_ = 0;
+  int reach_rows_ = 0, reach_cols_ = 0;
 };
 
-/// Adds (sign = +1) or subtracts (sign = -1) to acc[c], for every column c of centre row `row`,
-/// the sum of the table's cells in the disc of `plan`, clipped to the grid. O(cols x bands).
+/// Adds (sign = +1) or subtracts (sign = -1) to acc[c], for every column c in [c_begin, c_end) of
+/// centre row `row` (grid coordinates), the sum of the table's cells in the disc of `plan`, clipped
+/// to the table's window (which must hold every grid cell of those discs for an unclipped sum).
+/// O((c_end - c_begin) x bands), whatever the radius.
 template <class T>
-void add_disc_row(const SummedArea<T>& table, const DiscPlan& plan, int row, int sign, T* acc);
+void add_disc_row(const SummedArea<T>& table, const DiscPlan& plan, int row, int sign, T* acc, int c_begin, int c_end);
+
+/// Adds to acc[c], c in [c_begin, c_end), the number of grid cells in the disc of `plan` around
+/// (c, row) (the disc clipped to a grid of `cols` x `rows`), by arithmetic alone.
+void add_disc_count_row(const DiscPlan& plan, int cols, int rows, int row, int sign, std::uint32_t* acc, int c_begin,
+                        int c_end);
 
 /// Sums of `values` (row-major, cols x rows) over the disc of every cell; the slow obvious
 /// reference (O(cells x disc cells)) for tests, using DiscPlan::exact_half_cols.
@@ -90,17 +114,18 @@ std::vector<double> brute_force_disc_sums(const std::vector<double>& values, con
 
 template <class T>
 template <class F>
-SummedArea<T>::SummedArea(int cols, int rows, F value)
-    : cols_(cols), rows_(rows), table_((std::size_t(cols) + 1) * (std::size_t(rows) + 1), T{}) {
+SummedArea<T>::SummedArea(const Window& window, int grid_cols, F value)
+    : window_(window), table_((std::size_t(window.cols) + 1) * (std::size_t(window.rows) + 1), T{}) {
   const std::size_t s = stride();
   T* t = table_.data();
+  const int cols = window.cols;
   // Row prefix sums (rows independent), then running sums down the columns (column blocks
   // independent): every entry is computed in one fixed order whatever the threads.
-  tbb::parallel_for(tbb::blocked_range<int>(0, rows, 16), [&](const tbb::blocked_range<int>& range) {
+  tbb::parallel_for(tbb::blocked_range<int>(0, window.rows, 16), [&](const tbb::blocked_range<int>& range) {
     for (int y = range.begin(); y < range.end(); ++y) {
       T run{};
       T* out = t + std::size_t(y + 1) * s;
-      const std::size_t base = std::size_t(y) * std::size_t(cols);
+      const std::size_t base = std::size_t(y + window.y0) * std::size_t(grid_cols) + std::size_t(window.x0);
       for (int x = 0; x < cols; ++x) {
         run += T(value(base + std::size_t(x)));
         out[x + 1] = run;
@@ -108,7 +133,7 @@ SummedArea<T>::SummedArea(int cols, int rows, F value)
     }
   });
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, s, 512), [&](const tbb::blocked_range<std::size_t>& range) {
-    for (int y = 1; y <= rows; ++y) {
+    for (int y = 1; y <= window.rows; ++y) {
       T* cur = t + std::size_t(y) * s;
       const T* prev = cur - s;
       for (std::size_t x = range.begin(); x < range.end(); ++x) cur[x] += prev[x];

@@ -41,7 +41,7 @@ std::vector<double> fast_disc_sums(const std::vector<double>& v, const CellMetri
   const SummedArea<double> table(cols, rows, [&](std::size_t i) { return v[i]; });
   const DiscPlan plan(m, rows, radius, bands);
   std::vector<double> out(v.size(), 0.0);
-  for (int r = 0; r < rows; ++r) add_disc_row(table, plan, r, +1, out.data() + std::size_t(r) * std::size_t(cols));
+  for (int r = 0; r < rows; ++r) add_disc_row(table, plan, r, +1, out.data() + std::size_t(r) * std::size_t(cols), 0, cols);
   return out;
 }
 
