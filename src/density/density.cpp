@@ -209,13 +209,14 @@ DensityResult compute_density(const Dem& dem, const Raster<float>& hydrometry, c
   // Only land cells need characteristics: each row is worked on over its span of land only
   // (a big saving on coastal tiles that are mostly sea, and on nodata borders).
   std::vector<int> span_lo(std::size_t(rows), 0), span_hi(std::size_t(rows), 0);
-  bool any_unknown = false;
+  bool any_unknown = false, any_water = false;
   for (int r = 0; r < rows; ++r) {
     int lo = cols, hi = 0;
     for (int x = 0; x < cols; ++x) {
       const std::uint8_t k = kind[dem.index(x, r)];
       if (k == land) lo = std::min(lo, x), hi = x + 1;
       any_unknown = any_unknown || k == unknown;
+      any_water = any_water || k == water;
     }
     span_lo[std::size_t(r)] = lo;
     span_hi[std::size_t(r)] = std::max(lo, hi);
@@ -291,7 +292,9 @@ DensityResult compute_density(const Dem& dem, const Raster<float>& hydrometry, c
     // weight is quantised to `levels` steps so its sums stay exact integers in 32 bits.
     const double levels = std::min(1024.0, std::floor(double(UINT32_MAX) / std::max(1.0, outer.max_cells())));
     if (levels < 16) throw bad_input("--r-max: the ring holds too many cells for this grid (" + std::to_string(outer.max_cells()) + ")");
-    const SummedArea<std::uint32_t> wet(win, cols, [&](std::size_t i) { return std::uint32_t(kind[i] == water); });
+    // An inland grid has no coast: its water sums are all 0 and need no table.
+    const SummedArea<std::uint32_t> wet = any_water ? SummedArea<std::uint32_t>(win, cols, [&](std::size_t i) { return std::uint32_t(kind[i] == water); })
+                                                    : SummedArea<std::uint32_t>();
     // Without unknown cells every cell is known: count ring cells by arithmetic instead.
     const SummedArea<std::uint32_t> known = any_unknown ? SummedArea<std::uint32_t>(win, cols, [&](std::size_t i) { return std::uint32_t(kind[i] != unknown); })
                                                         : SummedArea<std::uint32_t>();
@@ -310,8 +313,10 @@ DensityResult compute_density(const Dem& dem, const Raster<float>& hydrometry, c
         std::fill(w.begin() + x0, w.begin() + x1, 0u);
         std::fill(k.begin() + x0, k.begin() + x1, 0u);
         std::fill(h.begin() + x0, h.begin() + x1, 0u);
-        add_disc_row(wet, outer, r, +1, w.data(), x0, x1);
-        add_disc_row(wet, inner, r, -1, w.data(), x0, x1);
+        if (any_water) {
+          add_disc_row(wet, outer, r, +1, w.data(), x0, x1);
+          add_disc_row(wet, inner, r, -1, w.data(), x0, x1);
+        }
         if (any_unknown) {
           add_disc_row(known, outer, r, +1, k.data(), x0, x1);
           add_disc_row(known, inner, r, -1, k.data(), x0, x1);
