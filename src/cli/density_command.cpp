@@ -1,11 +1,13 @@
 // `terrapolis density DEM OUTDIR`: the population density model (Belhadj 2007, §4.2) and its rasters.
 // SPDX-License-Identifier: MIT
 #include <CLI/CLI.hpp>
+#include <tbb/parallel_for.h>
 
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <sstream>
 
 #include "cli/command.hpp"
@@ -115,13 +117,17 @@ class DensityCommand final : public Command {
 
     fs::create_directories(dir);
     const auto metadata = provenance(options);
+    // The files are independent: write them in parallel (each is still written atomically).
+    std::vector<std::function<void()>> writes;
     auto write = [&](const std::string& n, const auto& raster) {
-      WriteOptions w;
-      w.cog = cog_;
-      w.overwrite = overwrite_;
-      w.description = density::describe_output(n);
-      w.metadata = metadata;
-      write_raster((dir / (n + ".tif")).string(), raster, w);
+      writes.emplace_back([&, n] {
+        WriteOptions w;
+        w.cog = cog_;
+        w.overwrite = overwrite_;
+        w.description = density::describe_output(n);
+        w.metadata = metadata;
+        write_raster((dir / (n + ".tif")).string(), raster, w);
+      });
     };
     write("coast", result.coast);
     write("plateau", result.plateau);
@@ -132,6 +138,7 @@ class DensityCommand final : public Command {
     if (hydrometry.used && !same) write("hydrometry", result.hydrometry);
     write("buildable", result.buildable);
     write("density", result.density);
+    tbb::parallel_for(std::size_t(0), writes.size(), [&](std::size_t k) { writes[k](); });
     const auto t3 = clock::now();
     context.log.detail("density: read " + seconds(t0, t1) + " s, model " + seconds(t1, t2) + " s, write " + seconds(t2, t3) + " s");
 

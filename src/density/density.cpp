@@ -165,13 +165,15 @@ DensityResult compute_density(const Dem& dem, const Raster<float>& hydrometry, c
         if (!std::isnan(ex[i]) && ex[i] != 0) excluded[i] = 1;
     }
     step.update(0.5);
-    for (std::size_t i = 0; i < n; ++i) {
-      const float z = dem[i];
-      const bool valid = !std::isnan(z);
-      const bool is_water = (valid && z <= options.sea_level_m) || (!valid && options.nodata_is_sea) ||
-                            (mask && !std::isnan((*mask)[i]) && (*mask)[i] != 0);
-      kind[i] = is_water ? water : valid ? land : unknown;
-    }
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1 << 16), [&](const tbb::blocked_range<std::size_t>& range) {
+      for (std::size_t i = range.begin(); i < range.end(); ++i) {
+        const float z = dem[i];
+        const bool valid = !std::isnan(z);
+        const bool is_water = (valid && z <= options.sea_level_m) || (!valid && options.nodata_is_sea) ||
+                              (mask && !std::isnan((*mask)[i]) && (*mask)[i] != 0);
+        kind[i] = is_water ? water : valid ? land : unknown;
+      }
+    });
     // Uninhabitable: water, too high, excluded, river beds, too steep (§4.2.2.2: the thresholds).
     result.hydrometry = dem.like<float>(nan_f);
     result.buildable = dem.like<std::uint8_t>(255);
@@ -208,19 +210,30 @@ DensityResult compute_density(const Dem& dem, const Raster<float>& hydrometry, c
 
   // Only land cells need characteristics: each row is worked on over its span of land only
   // (a big saving on coastal tiles that are mostly sea, and on nodata borders).
-  std::vector<int> span_lo(std::size_t(rows), 0), span_hi(std::size_t(rows), 0);
-  bool any_unknown = false, any_water = false;
-  for (int r = 0; r < rows; ++r) {
-    int lo = cols, hi = 0;
-    for (int x = 0; x < cols; ++x) {
-      const std::uint8_t k = kind[dem.index(x, r)];
-      if (k == land) lo = std::min(lo, x), hi = x + 1;
-      any_unknown = any_unknown || k == unknown;
-      any_water = any_water || k == water;
+  const auto nrows = static_cast<std::size_t>(rows);
+  std::vector<int> span_lo(nrows, 0), span_hi(nrows, 0);
+  std::vector<std::uint8_t> row_unknown(nrows, 0), row_water(nrows, 0);
+  std::vector<float> row_zmin(nrows), row_zmax(nrows);
+  tbb::parallel_for(tbb::blocked_range<int>(0, rows, 8), [&](const tbb::blocked_range<int>& range) {
+    for (int r = range.begin(); r < range.end(); ++r) {
+      int lo = cols, hi = 0;
+      bool u = false, w = false;
+      float zmin = std::numeric_limits<float>::infinity(), zmax = -zmin;
+      for (int x = 0; x < cols; ++x) {
+        const std::size_t i = dem.index(x, r);
+        const std::uint8_t k = kind[i];
+        if (k == land) lo = std::min(lo, x), hi = x + 1, zmin = std::min(zmin, dem[i]), zmax = std::max(zmax, dem[i]);
+        u = u || k == unknown;
+        w = w || k == water;
+      }
+      span_lo[std::size_t(r)] = lo;
+      span_hi[std::size_t(r)] = std::max(lo, hi);
+      row_unknown[std::size_t(r)] = u, row_water[std::size_t(r)] = w;
+      row_zmin[std::size_t(r)] = zmin, row_zmax[std::size_t(r)] = zmax;
     }
-    span_lo[std::size_t(r)] = lo;
-    span_hi[std::size_t(r)] = std::max(lo, hi);
-  }
+  });
+  const bool any_unknown = std::find(row_unknown.begin(), row_unknown.end(), 1) != row_unknown.end();
+  const bool any_water = std::find(row_water.begin(), row_water.end(), 1) != row_water.end();
   // Summed-area tables cover only the land's bounding box grown by the ring's reach: no cell
   // outside it falls in the disc of a land cell.
   Window win;
@@ -245,9 +258,8 @@ DensityResult compute_density(const Dem& dem, const Raster<float>& hydrometry, c
   {
     ProgressStep step(progress, "density: plain");
     // Altitudes are taken relative to the middle of their range to keep the squares small.
-    float lo = std::numeric_limits<float>::infinity(), hi = -lo;
-    for (std::size_t i = 0; i < n; ++i)
-      if (kind[i] == land) lo = std::min(lo, dem[i]), hi = std::max(hi, dem[i]);
+    const float lo = *std::min_element(row_zmin.begin(), row_zmin.end());
+    const float hi = *std::max_element(row_zmax.begin(), row_zmax.end());
     const double mid = lo <= hi ? 0.5 * (double(lo) + double(hi)) : 0.0;
     const SummedArea<std::uint32_t> count(win, cols, [&](std::size_t i) { return std::uint32_t(kind[i] == land); });
     const SummedArea<double> s1(win, cols, [&](std::size_t i) { return kind[i] == land ? double(dem[i]) - mid : 0.0; });
@@ -368,16 +380,32 @@ DensityResult compute_density(const Dem& dem, const Raster<float>& hydrometry, c
     });
   }
 
-  // ---- report figures (sequential sums: deterministic) ------------------------------------
-  double sum = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (kind[i] != unknown) ++stats.known_cells;
-    if (kind[i] == water) ++stats.water_cells;
-    if (result.buildable[i] == 1) {
-      ++stats.buildable_cells;
-      sum += result.density[i];
-      ++stats.histogram[std::size_t(std::min(9, int(result.density[i] * 10)))];
+  // ---- report figures: per-row partial sums added in row order (deterministic) -------------
+  std::vector<DensityStats> per_row(nrows);
+  std::vector<double> row_sum(nrows, 0.0);
+  tbb::parallel_for(tbb::blocked_range<int>(0, rows, 8), [&](const tbb::blocked_range<int>& range) {
+    for (int r = range.begin(); r < range.end(); ++r) {
+      DensityStats& t = per_row[std::size_t(r)];
+      for (int x = 0; x < cols; ++x) {
+        const std::size_t i = dem.index(x, r);
+        if (kind[i] != unknown) ++t.known_cells;
+        if (kind[i] == water) ++t.water_cells;
+        if (result.buildable[i] == 1) {
+          ++t.buildable_cells;
+          row_sum[std::size_t(r)] += result.density[i];
+          ++t.histogram[std::size_t(std::min(9, int(result.density[i] * 10)))];
+        }
+      }
     }
+  });
+  double sum = 0;
+  for (int r = 0; r < rows; ++r) {
+    const DensityStats& t = per_row[std::size_t(r)];
+    stats.known_cells += t.known_cells;
+    stats.water_cells += t.water_cells;
+    stats.buildable_cells += t.buildable_cells;
+    for (std::size_t k = 0; k < 10; ++k) stats.histogram[k] += t.histogram[k];
+    sum += row_sum[std::size_t(r)];
   }
   stats.mean_density = stats.buildable_cells ? sum / double(stats.buildable_cells) : 0.0;
   return result;
