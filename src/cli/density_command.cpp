@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <cstdio>
 #include <filesystem>
 #include <functional>
@@ -112,7 +113,9 @@ class DensityCommand final : public Command {
     const Dem dem = read_dem(dem_path_, read);
     const Hydrometry hydrometry = obtain_hydrometry(dem, options, hydrometry_path_);
     const auto t1 = clock::now();
+    const std::clock_t cpu1 = std::clock();  // processor time of all threads
     const density::DensityResult result = density::compute_density(dem, hydrometry.values, options, context.progress);
+    const std::clock_t cpu2 = std::clock();
     const auto t2 = clock::now();
 
     fs::create_directories(dir);
@@ -140,7 +143,8 @@ class DensityCommand final : public Command {
     write("density", result.density);
     tbb::parallel_for(std::size_t(0), writes.size(), [&](std::size_t k) { writes[k](); });
     const auto t3 = clock::now();
-    context.log.detail("density: read " + seconds(t0, t1) + " s, model " + seconds(t1, t2) + " s, write " + seconds(t2, t3) + " s");
+    context.log.detail("density: read " + seconds(t0, t1) + " s, model " + seconds(t1, t2) + " s (cpu " +
+                       format(double(cpu2 - cpu1) / CLOCKS_PER_SEC, 3) + " s), write " + seconds(t2, t3) + " s");
 
     const auto& s = result.stats;
     const double land = double(s.known_cells - s.water_cells);

@@ -3,13 +3,17 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <cmath>
+#include <random>
 #include <cstdio>
 #include <cstring>
 #include <limits>
 
 #include "core/error.hpp"
 #include "density/density.hpp"
+#include "density/disc_sums.hpp"
+#include "core/geodesy.hpp"
 #include "io/raster_io.hpp"
 
 namespace terrapolis::density {
@@ -209,6 +213,72 @@ TEST(Density, SeaAtZeroOrNodataGivesTheSameCoast) {
       ASSERT_EQ(d.coast[i], 0.0f);
     }
 }
+
+/// Coast and plain of every land cell against brute-force ring and disc sums, on a grid whose land
+/// is a corner (so the tables' window and the land spans are smaller than the grid) with nodata.
+void check_against_brute_force(const Georef& g, std::uint64_t seed) {
+  const int cols = 70, rows = 60;
+  Dem dem(cols, rows, g, -5.0f);
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c) {
+      if (c > 40 || r > 35) continue;                       // sea outside the north-west corner
+      dem(c, r) = float(u(rng) < 0.15 ? -1.0 : 10 + 80 * u(rng));  // land with lagoons
+      if (u(rng) < 0.05) dem(c, r) = nan_f;                 // holes of unknown
+    }
+  SilentProgress p;
+  DensityOptions o;
+  o.weights = {1, 0, 0, 1};
+  const CellMetrics m = cell_metrics(g, cols, rows);
+  double step = 0;
+  for (int r = 0; r < rows; ++r) step = std::max({step, m.width_m[std::size_t(r)], m.height_m[std::size_t(r)]});
+  o.r_min_m = 2.2 * step;
+  o.r_max_m = 6.5 * step;
+  o.ring_bands = 1000;  // exact discs: the comparison is exact
+  const auto res = compute_density(dem, dem.like<float>(0.0f), o, p);
+  ASSERT_TRUE(res.stats.ring_exact);
+  std::vector<double> wet(dem.size()), known(dem.size()), land(dem.size()), z(dem.size()), z2(dem.size());
+  for (std::size_t i = 0; i < dem.size(); ++i) {
+    const bool nd = std::isnan(dem[i]);
+    wet[i] = !nd && dem[i] <= 0;
+    known[i] = !nd;
+    land[i] = !nd && dem[i] > 0;
+    z[i] = land[i] ? dem[i] : 0.0;
+    z2[i] = z[i] * z[i];
+  }
+  auto disc = [&](const std::vector<double>& v, double radius) { return brute_force_disc_sums(v, m, cols, rows, radius); };
+  const auto wet_out = disc(wet, o.r_max_m), wet_in = disc(wet, o.r_min_m);
+  const auto known_out = disc(known, o.r_max_m), known_in = disc(known, o.r_min_m);
+  const auto n_in = disc(land, o.r_min_m), s1 = disc(z, o.r_min_m), s2 = disc(z2, o.r_min_m);
+  std::vector<double> share(dem.size(), 0.0);
+  double best = 0;
+  for (std::size_t i = 0; i < dem.size(); ++i) {
+    if (!land[i]) continue;
+    const double k = known_out[i] - known_in[i];
+    share[i] = k > 0 ? (wet_out[i] - wet_in[i]) / k : 0.0;
+    best = std::max(best, share[i]);
+  }
+  ASSERT_GT(best, 0.0);
+  for (std::size_t i = 0; i < dem.size(); ++i) {
+    if (!land[i]) {
+      if (known[i]) {
+        ASSERT_EQ(res.coast[i], 0.0f);
+      } else {
+        ASSERT_TRUE(std::isnan(res.coast[i]));
+      }
+      continue;
+    }
+    ASSERT_NEAR(res.coast[i], share[i] / best, 1e-5) << i;
+    const double mean = s1[i] / n_in[i];
+    const double sd = std::sqrt(std::max(0.0, s2[i] / n_in[i] - mean * mean));
+    ASSERT_NEAR(res.plain[i], std::clamp(1.0 - sd / 50.0, 0.0, 1.0), 1e-4) << i;
+  }
+}
+
+TEST(Density, CoastAndPlainEqualBruteForceProjected) { check_against_brute_force(projected(100.0), 5); }
+
+TEST(Density, CoastAndPlainEqualBruteForceGeographic) { check_against_brute_force(geographic(62.0, 0.002), 6); }
 
 TEST(Density, Normalisation) {
   const double thesis[4] = {1, 1, 1.5, 0};
