@@ -8,7 +8,10 @@ namespace terrapolis::cli {
 std::vector<std::unique_ptr<Command>> all_commands() {
   std::vector<std::unique_ptr<Command>> commands;
   commands.push_back(make_info_command());
+  commands.push_back(make_convert_command());
   commands.push_back(make_density_command());
+  commands.push_back(make_run_command());
+  commands.push_back(make_compare_command());
   return commands;
 }
 

@@ -8,6 +8,9 @@
 namespace terrapolis::cli {
 
 std::unique_ptr<Command> make_info_command();
+std::unique_ptr<Command> make_convert_command();
 std::unique_ptr<Command> make_density_command();
+std::unique_ptr<Command> make_run_command();
+std::unique_ptr<Command> make_compare_command();
 
 }  // namespace terrapolis::cli

@@ -13,6 +13,7 @@
 
 #include "cli/command.hpp"
 #include "cli/commands_list.hpp"
+#include "cli/dem_input.hpp"
 #include "core/error.hpp"
 #include "density/density.hpp"
 #include "io/raster_io.hpp"
@@ -71,7 +72,7 @@ class DensityCommand final : public Command {
   }
 
   void setup(CLI::App& app) override {
-    app.add_option("DEM", dem_path_, "Elevation model (any GDAL raster)")->required();
+    dem_.add_to(app);
     app.add_option("OUTDIR", out_dir_, "Folder for coast.tif, plateau.tif, plain.tif, hydrometry.tif, buildable.tif, density.tif")->required();
     app.add_option("--weights", weights_, "Weights of coast,hydrometry,plateau,plain; negative repulsive, 0 neutral (default 1,1,1.5,0)");
     app.add_option("--layer", layers_, "User raster and its weight, FILE:WEIGHT (repeatable); values in [0,1] or rescaled from their range");
@@ -88,7 +89,6 @@ class DensityCommand final : public Command {
     app.add_flag("--report", report_, "Print the buildable share and the density histogram");
     app.add_flag("--cog", cog_, "Write Cloud Optimized GeoTIFFs");
     app.add_flag("--overwrite", overwrite_, "Replace existing outputs");
-    app.add_option("--assume-crs", assume_crs_, "CRS for a DEM that carries none, e.g. EPSG:2193");
   }
 
   void run(Context& context) override {
@@ -105,12 +105,10 @@ class DensityCommand final : public Command {
       if (!fs::is_directory(parent)) throw bad_input(out_dir_ + ": its parent folder does not exist");
     }
 
-    ReadOptions read;
-    if (!assume_crs_.empty()) read.assume_crs = assume_crs_;
     using clock = std::chrono::steady_clock;
     const auto seconds = [](clock::time_point a, clock::time_point b) { return format(std::chrono::duration<double>(b - a).count(), 3); };
     const auto t0 = clock::now();
-    const Dem dem = read_dem(dem_path_, read);
+    const Dem dem = dem_.read();
     const Hydrometry hydrometry = obtain_hydrometry(dem, options, hydrometry_path_);
     const auto t1 = clock::now();
     const std::clock_t cpu1 = std::clock();  // processor time of all threads
@@ -187,7 +185,7 @@ class DensityCommand final : public Command {
     std::vector<std::pair<std::string, std::string>> m = {
         {"TERRAPOLIS_VERSION", terrapolis::version},
         {"TERRAPOLIS_STAGE", "density"},
-        {"DEM", fs::path(dem_path_).filename().string()},
+        {"DEM", fs::path(dem_.path).filename().string()},
         {"WEIGHTS_COAST_HYDROMETRY_PLATEAU_PLAIN", w.str()},
         {"R_MIN_M", format(o.r_min_m, 3)},
         {"R_MAX_M", format(o.r_max_m, 3)},
@@ -205,7 +203,7 @@ class DensityCommand final : public Command {
   void print_report(const density::DensityResult& r) const {
     const auto& s = r.stats;
     const double land = double(s.known_cells - s.water_cells);
-    std::printf("Density report: %s\n", dem_path_.c_str());
+    std::printf("Density report: %s\n", dem_.path.c_str());
     std::printf("  cells:      %zu (%zu with data or water, %zu water)\n", s.cells, s.known_cells, s.water_cells);
     std::printf("  buildable:  %zu cells, %.2f %% of land, %.2f %% of the grid\n", s.buildable_cells,
                 land > 0 ? 100.0 * double(s.buildable_cells) / land : 0.0, 100.0 * double(s.buildable_cells) / double(s.cells));
@@ -220,7 +218,8 @@ class DensityCommand final : public Command {
     }
   }
 
-  std::string dem_path_, out_dir_, weights_, hydrometry_path_, max_slope_, river_bed_cap_, assume_crs_;
+  DemInput dem_;
+  std::string out_dir_, weights_, hydrometry_path_, max_slope_, river_bed_cap_;
   std::vector<std::string> layers_, exclusions_;
   density::DensityOptions options_;
   bool report_ = false, cog_ = false, overwrite_ = false;

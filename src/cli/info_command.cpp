@@ -10,6 +10,7 @@
 
 #include "cli/command.hpp"
 #include "cli/commands_list.hpp"
+#include "cli/dem_input.hpp"
 #include "core/geodesy.hpp"
 #include "io/crs.hpp"
 #include "io/raster_io.hpp"
@@ -23,18 +24,14 @@ class InfoCommand final : public Command {
   std::string summary() const override { return "Describe a DEM: size, CRS, cell size in metres, extent in lon/lat, elevations"; }
 
   void setup(CLI::App& app) override {
-    app.add_option("DEM", path_, "Elevation model (any GDAL raster: GeoTIFF, SRTM .hgt, ESRI ASCII grid, VRT...)")->required();
+    input_.add_to(app);
     app.add_flag("--json", json_, "Machine-readable output");
-    app.add_option("--band", band_, "Band to read (required for multi-band files)");
-    app.add_option("--assume-crs", assume_crs_, "CRS for a file that carries none, e.g. EPSG:32611");
   }
 
   void run(Context&) override {
-    ReadOptions options;
-    if (band_ > 0) options.band = band_;
-    if (!assume_crs_.empty()) options.assume_crs = assume_crs_;
-    const RasterHeader header = read_header(path_, options);
-    const Dem dem = read_dem(path_, options);
+    const RasterHeader header = read_header(input_.path, input_.options());
+    const Dem dem = input_.read();
+    const std::string& path_ = input_.path;
 
     double lo = std::numeric_limits<double>::infinity(), hi = -lo, sum = 0;
     std::size_t valid = 0;
@@ -99,8 +96,7 @@ class InfoCommand final : public Command {
   }
 
  private:
-  std::string path_, assume_crs_;
-  int band_ = 0;
+  DemInput input_;
   bool json_ = false;
 };
 

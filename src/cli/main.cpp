@@ -42,6 +42,7 @@ int main(int argc, char** argv) {
   CLI::App app{"Terrapolis: from a georeferenced elevation model to a regional urbanisation plan.", "terrapolis"};
   app.set_version_flag("--version", std::string("terrapolis ") + terrapolis::version);
   app.require_subcommand(1);
+  app.fallthrough();  // global options may follow the subcommand
   bool quiet = false, verbose = false;
   std::string progress_kind = "console";
   int threads = 0;

@@ -1,0 +1,22 @@
+// The DEM argument every command shares.
+// SPDX-License-Identifier: MIT
+#include "cli/dem_input.hpp"
+
+#include <CLI/CLI.hpp>
+
+namespace terrapolis::cli {
+
+void DemInput::add_to(CLI::App& app, const std::string& name) {
+  app.add_option(name, path, "Elevation model (any GDAL raster: GeoTIFF, SRTM .hgt, ESRI ASCII grid, VRT...)")->required();
+  app.add_option("--band", band, "Band to read (required for multi-band files)")->check(CLI::PositiveNumber);
+  app.add_option("--assume-crs", assume_crs, "CRS for a file that carries none, e.g. EPSG:32611");
+}
+
+ReadOptions DemInput::options() const {
+  ReadOptions o;
+  if (band > 0) o.band = band;
+  if (!assume_crs.empty()) o.assume_crs = assume_crs;
+  return o;
+}
+
+}  // namespace terrapolis::cli

@@ -1,0 +1,58 @@
+// `terrapolis run [SCENARIO.json]`: the whole pipeline from one scenario file into one run folder.
+// SPDX-License-Identifier: MIT
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+
+#include "cli/command.hpp"
+#include "cli/commands_list.hpp"
+#include "pipeline/runner.hpp"
+#include "pipeline/scenario.hpp"
+
+namespace terrapolis::cli {
+namespace {
+
+class RunCommand final : public Command {
+ public:
+  std::string name() const override { return "run"; }
+  std::string summary() const override {
+    return "Run a scenario (JSON) from DEM to roads; without a file, the default scenario on the bundled Corsica DEM";
+  }
+  void setup(CLI::App& app) override {
+    app.add_option("SCENARIO", file_, "Scenario file (JSON, see schemas/scenario.schema.json); default: the embedded scenario");
+    app.add_option("--set", sets_, "Override a field: stage.field=value (repeatable), e.g. --set density.weights=[1,1,0,0]");
+    app.add_option("--seed", seed_, "Seed of the run (overrides the scenario's)");
+    app.add_option("-o,--output", output_, "Run folder (overrides the scenario's)");
+    app.add_flag("--overwrite", overwrite_, "Replace the run folder if it exists");
+    app.add_flag("--print-scenario", print_, "Print the resolved scenario (defaults filled) and exit");
+  }
+  void run(Context& context) override {
+    if (!output_.empty()) sets_.push_back("output=\"" + output_ + "\"");
+    std::optional<std::uint64_t> seed;
+    if (seed_ >= 0) seed = std::uint64_t(seed_);
+    const pipeline::Scenario scenario = pipeline::load_scenario(file_, sets_, seed);
+    if (print_) {
+      std::printf("%s\n", scenario.resolved.dump(2).c_str());
+      return;
+    }
+    pipeline::RunOptions options;
+    options.overwrite = overwrite_;
+    const auto manifest = pipeline::run_scenario(scenario, options, context.progress, context.log);
+    if (context.log.level() != LogLevel::quiet) {
+      std::printf("%s", pipeline::format_summary(manifest).c_str());
+      std::printf("Outputs in %s/ (open project.qgs in QGIS; run.json records what was done)\n", scenario.path("output").c_str());
+    }
+  }
+
+ private:
+  std::string file_, output_;
+  std::vector<std::string> sets_;
+  long long seed_ = -1;
+  bool overwrite_ = false, print_ = false;
+};
+
+}  // namespace
+
+std::unique_ptr<Command> make_run_command() { return std::make_unique<RunCommand>(); }
+
+}  // namespace terrapolis::cli

@@ -1,0 +1,200 @@
+// A software renderer for preview.png (OpenImageIO writes the file and draws the legend's text).
+// SPDX-License-Identifier: MIT
+#include "pipeline/preview.hpp"
+
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <filesystem>
+
+#include "core/error.hpp"
+#include "core/geodesy.hpp"
+#include "io/crs.hpp"
+#include "pipeline/hillshade.hpp"
+
+namespace terrapolis::pipeline {
+namespace {
+
+using Rgb = std::array<float, 3>;
+
+Rgb hex(unsigned v) { return {((v >> 16) & 255) / 255.0f, ((v >> 8) & 255) / 255.0f, (v & 255) / 255.0f}; }
+
+class Canvas {
+ public:
+  Canvas(int w, int h) : w_(w), h_(h), px_(std::size_t(w) * h * 3, 1.0f) {}
+  int width() const { return w_; }
+  int height() const { return h_; }
+  void blend(int x, int y, const Rgb& c, float alpha) {
+    if (x < 0 || y < 0 || x >= w_ || y >= h_) return;
+    float* p = &px_[(std::size_t(y) * w_ + x) * 3];
+    for (int i = 0; i < 3; ++i) p[i] = p[i] * (1 - alpha) + c[i] * alpha;
+  }
+  void disc(double cx, double cy, double r, const Rgb& c, float alpha = 1.0f) {
+    for (int y = int(std::floor(cy - r)); y <= int(std::ceil(cy + r)); ++y)
+      for (int x = int(std::floor(cx - r)); x <= int(std::ceil(cx + r)); ++x)
+        if ((x + 0.5 - cx) * (x + 0.5 - cx) + (y + 0.5 - cy) * (y + 0.5 - cy) <= r * r) blend(x, y, c, alpha);
+  }
+  void segment(double x0, double y0, double x1, double y1, double width, const Rgb& c, bool dashed = false) {
+    const double len = std::hypot(x1 - x0, y1 - y0);
+    const int steps = std::max(1, int(len * 2));
+    for (int i = 0; i <= steps; ++i) {
+      if (dashed && (i / 8) % 2) continue;
+      const double t = double(i) / steps;
+      disc(x0 + t * (x1 - x0), y0 + t * (y1 - y0), width / 2, c);
+    }
+  }
+  void rect(int x0, int y0, int x1, int y1, const Rgb& c, float alpha = 1.0f) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = x0; x < x1; ++x) blend(x, y, c, alpha);
+  }
+  const float* data() const { return px_.data(); }
+
+ private:
+  int w_, h_;
+  std::vector<float> px_;
+};
+
+Rgb density_color(float v) {
+  static const Rgb ramp[5] = {hex(0xffffb2), hex(0xfecc5c), hex(0xfd8d3c), hex(0xf03b20), hex(0xbd0026)};
+  const float t = std::clamp(v, 0.0f, 1.0f) * 4;
+  const int i = std::min(3, int(t));
+  const float f = t - i;
+  return {ramp[i][0] * (1 - f) + ramp[i + 1][0] * f, ramp[i][1] * (1 - f) + ramp[i + 1][1] * f, ramp[i][2] * (1 - f) + ramp[i + 1][2] * f};
+}
+
+struct LegendEntry {
+  Rgb color;
+  std::string label;
+  bool line;
+};
+
+}  // namespace
+
+void write_preview(const RunState& state, const std::string& path, int width) {
+  const Dem& dem = state.dem;
+  const CellMetrics m = cell_metrics(dem.georef(), dem.cols(), dem.rows());
+  const double mean_w = m.width_m[dem.rows() / 2], mean_h = m.height_m[dem.rows() / 2];
+  const int height = std::max(16, int(std::lround(width * (dem.rows() * mean_h) / (dem.cols() * mean_w))));
+  Canvas canvas(width, height);
+  const double sx = double(dem.cols()) / width, sy = double(dem.rows()) / height;
+
+  // Terrain: hillshade tinted by land / sea, then density where it exists.
+  const Raster<std::uint8_t> shade = hillshade(dem);
+  for (int y = 0; y < height; ++y) {
+    const int r = std::min(dem.rows() - 1, int((y + 0.5) * sy));
+    for (int x = 0; x < width; ++x) {
+      const int c = std::min(dem.cols() - 1, int((x + 0.5) * sx));
+      const float z = dem(c, r);
+      if (std::isnan(z)) { canvas.blend(x, y, hex(0xdddddd), 1); continue; }
+      const float s = shade(c, r) / 255.0f;
+      const Rgb base = z <= 0 ? hex(0x9ecae1) : hex(0xe8e4d0);
+      canvas.blend(x, y, {base[0] * (0.45f + 0.55f * s), base[1] * (0.45f + 0.55f * s), base[2] * (0.45f + 0.55f * s)}, 1);
+    }
+  }
+  if (state.density) {
+    for (int y = 0; y < height; ++y) {
+      const int r = std::min(dem.rows() - 1, int((y + 0.5) * sy));
+      for (int x = 0; x < width; ++x) {
+        const int c = std::min(dem.cols() - 1, int((x + 0.5) * sx));
+        const float d = (*state.density)(c, r);
+        if (!std::isnan(d) && d > 0) canvas.blend(x, y, density_color(d), 0.55f);
+      }
+    }
+  }
+
+  // Vectors, in the DEM's CRS (layers written in another CRS are transformed).
+  const GridLocator locator(dem.georef());
+  std::vector<LegendEntry> legend;
+  auto to_px = [&](const VectorLayer& layer, std::vector<std::array<double, 2>> pts) {
+    std::optional<CrsTransform> t;
+    if (layer.crs.wkt != dem.georef().crs.wkt) t.emplace(layer.crs, dem.georef().crs);
+    for (auto& p : pts) {
+      if (t) p = (*t)(p[0], p[1]);
+      const auto q = locator.crs_to_pixel(p[0], p[1]);
+      p = {q[0] / sx, q[1] / sy};
+    }
+    return pts;
+  };
+  auto field = [](const VectorLayer& layer, const Feature& f, const std::string& name) -> std::string {
+    const int i = layer.field_index(name);
+    if (i < 0) return "";
+    const auto& v = f.values[std::size_t(i)];
+    if (std::holds_alternative<std::int64_t>(v)) return std::to_string(std::get<std::int64_t>(v));
+    if (std::holds_alternative<std::string>(v)) return std::get<std::string>(v);
+    if (std::holds_alternative<double>(v)) return std::to_string(std::get<double>(v));
+    return "";
+  };
+  const double unit = std::max(1.0, width / 600.0);  // line widths grow with the image
+  for (Style pass : {Style::city_extents, Style::streams, Style::network, Style::road_sections, Style::roads, Style::cities}) {
+    for (const auto& [style, layer] : state.vectors) {
+      if (style != pass) continue;
+      for (const auto& f : layer.features) {
+        if (f.parts.empty()) continue;
+        if (style == Style::cities) {
+          const auto p = to_px(layer, {f.parts[0][0]})[0];
+          const int cls = std::atoi(field(layer, f, "class").c_str());
+          canvas.disc(p[0], p[1], unit * std::max(1.5, 5.0 - cls), hex(0x252525));
+          canvas.disc(p[0], p[1], unit * std::max(1.0, 4.0 - cls), hex(0xcb181d));
+          continue;
+        }
+        Rgb color = hex(0x2171b5);
+        double w = unit;
+        bool dashed = false;
+        if (style == Style::streams) { w = unit * (0.5 + 0.3 * std::atoi(field(layer, f, "strahler").c_str())); }
+        else if (style == Style::network) { if (field(layer, f, "kept") != "1") continue; color = hex(0x636363); w = unit * 0.6; dashed = true; }
+        else if (style == Style::roads) {
+          const std::string cls = field(layer, f, "class");
+          color = cls == "motorway" ? hex(0xe31a1c) : cls == "national" ? hex(0xff7f00) : cls == "maritime" ? hex(0x1f78b4) : hex(0xb8860b);
+          w = unit * (cls == "motorway" ? 2.2 : cls == "national" ? 1.6 : 1.1);
+          dashed = cls == "maritime";
+        } else if (style == Style::road_sections) {
+          const std::string s = field(layer, f, "structure");
+          if (s == "bridge") { color = hex(0x08519c); w = unit * 3; }
+          else if (s == "tunnel") { color = hex(0x8c510a); w = unit * 2.5; dashed = true; }
+          else continue;
+        } else if (style == Style::city_extents) { color = hex(0xa50f15); w = unit * 0.5; }
+        for (const auto& part : f.parts) {
+          const auto px = to_px(layer, part);
+          for (std::size_t i = 1; i < px.size(); ++i) canvas.segment(px[i - 1][0], px[i - 1][1], px[i][0], px[i][1], w, color, dashed);
+        }
+      }
+      if (pass == Style::streams) legend.push_back({hex(0x2171b5), "streams", true});
+      if (pass == Style::network) legend.push_back({hex(0x636363), "network", true});
+      if (pass == Style::roads) legend.push_back({hex(0xe31a1c), "roads", true});
+      if (pass == Style::road_sections) legend.push_back({hex(0x08519c), "bridges", true});
+      if (pass == Style::cities) legend.push_back({hex(0xcb181d), "cities", false});
+    }
+  }
+  if (state.density) legend.insert(legend.begin(), {hex(0xf03b20), "density", false});
+  legend.insert(legend.begin(), {hex(0x9ecae1), "sea", false});
+
+  // Legend box, bottom left.
+  const int row_h = int(14 * unit), box_w = int(110 * unit), box_h = row_h * int(legend.size()) + int(8 * unit);
+  const int bx = int(8 * unit), by = height - box_h - int(8 * unit);
+  canvas.rect(bx, by, bx + box_w, by + box_h, hex(0xffffff), 0.8f);
+  OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::FLOAT);
+  OIIO::ImageBuf buf(spec, const_cast<float*>(canvas.data()));
+  OIIO::ImageBuf image;
+  image.copy(buf, OIIO::TypeDesc::UINT8);
+  const std::string font = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
+  const bool has_font = std::filesystem::exists(font);
+  for (std::size_t i = 0; i < legend.size(); ++i) {
+    const int y = by + int(4 * unit) + int(i) * row_h;
+    const float c[3] = {legend[i].color[0], legend[i].color[1], legend[i].color[2]};
+    const int sw = int(18 * unit), sh = legend[i].line ? std::max(2, int(3 * unit)) : int(9 * unit);
+    const int sy0 = y + (row_h - sh) / 2;
+    OIIO::ImageBufAlgo::fill(image, c, OIIO::ROI(bx + int(5 * unit), bx + int(5 * unit) + sw, sy0, sy0 + sh));
+    if (has_font) {
+      const float black[3] = {0.1f, 0.1f, 0.1f};
+      OIIO::ImageBufAlgo::render_text(image, bx + int(28 * unit), y + row_h - int(3 * unit), legend[i].label, int(11 * unit), font, black);
+    }
+  }
+  const std::string tmp = path + ".tmp.png";
+  if (!image.write(tmp, OIIO::TypeDesc::UINT8, "png")) throw processing_error(path + ": cannot write preview (" + image.geterror() + ")");
+  std::filesystem::rename(tmp, path);
+}
+
+}  // namespace terrapolis::pipeline

@@ -1,0 +1,258 @@
+// QGIS 3 .qml styles and .qgs project, written as XML text (QGIS reads both without any plugin).
+// SPDX-License-Identifier: MIT
+#include "pipeline/qgis_project.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <vector>
+
+#include "core/error.hpp"
+
+namespace terrapolis::pipeline {
+namespace {
+
+struct Stop {
+  double value;
+  const char* color;
+  std::string label;
+};
+
+std::string escape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+std::string num(double v) {
+  std::ostringstream s;
+  s.precision(10);
+  s << v;
+  return s.str();
+}
+
+std::string pseudocolor(const std::vector<Stop>& stops, const char* type = "INTERPOLATED", double opacity = 1.0) {
+  std::ostringstream x;
+  x << "<pipe><rasterrenderer type=\"singlebandpseudocolor\" band=\"1\" opacity=\"" << num(opacity)
+    << "\" alphaBand=\"-1\" classificationMin=\"" << num(stops.front().value) << "\" classificationMax=\"" << num(stops.back().value)
+    << "\"><rastershader><colorrampshader colorRampType=\"" << type << "\" classificationMode=\"1\" clip=\"0\">";
+  for (const auto& s : stops)
+    x << "<item alpha=\"255\" value=\"" << num(s.value) << "\" label=\"" << escape(s.label) << "\" color=\"" << s.color << "\"/>";
+  x << "</colorrampshader></rastershader></rasterrenderer><brightnesscontrast brightness=\"0\" contrast=\"0\"/>"
+       "<rasterresampler maxOversampling=\"2\"/></pipe>";
+  return x.str();
+}
+
+std::string paletted(const std::vector<Stop>& entries, double opacity = 1.0) {
+  std::ostringstream x;
+  x << "<pipe><rasterrenderer type=\"paletted\" band=\"1\" opacity=\"" << num(opacity) << "\" alphaBand=\"-1\"><colorPalette>";
+  for (const auto& e : entries)
+    x << "<paletteEntry value=\"" << num(e.value) << "\" color=\"" << e.color << "\" alpha=\"" << (std::string(e.color) == "#000000" ? 0 : 255)
+      << "\" label=\"" << escape(e.label) << "\"/>";
+  x << "</colorPalette></rasterrenderer><brightnesscontrast brightness=\"0\" contrast=\"0\"/><rasterresampler maxOversampling=\"2\"/></pipe>";
+  return x.str();
+}
+
+std::string gray(double lo, double hi) {
+  return "<pipe><rasterrenderer type=\"singlebandgray\" grayBand=\"1\" gradient=\"BlackToWhite\" opacity=\"1\" alphaBand=\"-1\">"
+         "<contrastEnhancement><minValue>" + num(lo) + "</minValue><maxValue>" + num(hi) +
+         "</maxValue><algorithm>StretchToMinimumMaximum</algorithm></contrastEnhancement></rasterrenderer>"
+         "<brightnesscontrast brightness=\"0\" contrast=\"0\"/><rasterresampler maxOversampling=\"2\"/></pipe>";
+}
+
+/// One QGIS symbol: a line, a marker or a fill, with a few properties.
+std::string symbol(const std::string& name, const std::string& kind, const std::map<std::string, std::string>& props) {
+  const std::string layer_class = kind == "line" ? "SimpleLine" : kind == "marker" ? "SimpleMarker" : "SimpleFill";
+  std::ostringstream x;
+  x << "<symbol name=\"" << name << "\" type=\"" << kind << "\" alpha=\"1\" clip_to_extent=\"1\" force_rhr=\"0\">"
+    << "<layer class=\"" << layer_class << "\" enabled=\"1\" locked=\"0\" pass=\"0\">";
+  for (const auto& [k, v] : props) x << "<prop k=\"" << k << "\" v=\"" << escape(v) << "\"/>";
+  x << "</layer></symbol>";
+  return x.str();
+}
+
+struct Category {
+  std::string value, label, symbol_xml;
+};
+
+std::string categorized(const std::string& field, const std::vector<Category>& cats) {
+  std::ostringstream x;
+  x << "<renderer-v2 type=\"categorizedSymbol\" attr=\"" << escape(field) << "\" forceraster=\"0\" symbollevels=\"0\" enableorderby=\"0\"><categories>";
+  for (std::size_t i = 0; i < cats.size(); ++i)
+    x << "<category render=\"true\" symbol=\"" << i << "\" value=\"" << escape(cats[i].value) << "\" label=\"" << escape(cats[i].label) << "\"/>";
+  x << "</categories><symbols>";
+  for (const auto& c : cats) x << c.symbol_xml;
+  x << "</symbols></renderer-v2>";
+  return x.str();
+}
+
+std::string single(const std::string& symbol_xml) {
+  return "<renderer-v2 type=\"singleSymbol\" forceraster=\"0\" symbollevels=\"0\" enableorderby=\"0\"><symbols>" + symbol_xml +
+         "</symbols></renderer-v2>";
+}
+
+std::string line(const std::string& name, const std::string& color, double width_mm, const std::string& style = "solid") {
+  return symbol(name, "line", {{"line_color", color}, {"line_width", num(width_mm)}, {"line_width_unit", "MM"},
+                               {"line_style", style}, {"capstyle", "round"}, {"joinstyle", "round"}});
+}
+
+std::string marker(const std::string& name, const std::string& color, double size_mm) {
+  return symbol(name, "marker", {{"color", color}, {"name", "circle"}, {"size", num(size_mm)}, {"size_unit", "MM"},
+                                 {"outline_color", "35,35,35,255"}, {"outline_width", "0.2"}});
+}
+
+std::string fill(const std::string& name, const std::string& color, const std::string& outline) {
+  return symbol(name, "fill", {{"color", color}, {"style", "solid"}, {"outline_color", outline}, {"outline_width", "0.3"}});
+}
+
+/// Rank of a layer in drawing order (lower draws first, at the bottom).
+int draw_rank(Style s) {
+  switch (s) {
+    case Style::hillshade: return 0;
+    case Style::elevation: return 1;
+    case Style::flow_direction: case Style::accumulation: case Style::unit_ramp: return 2;
+    case Style::mask: return 3;
+    case Style::density: return 4;
+    case Style::city_extents: return 5;
+    case Style::streams: return 6;
+    case Style::network: return 7;
+    case Style::road_sections: return 8;
+    case Style::roads: return 9;
+    case Style::cities: return 10;
+  }
+  return 5;
+}
+
+std::string layer_id(const OutputFile& o) {
+  std::string id = o.name;
+  std::replace(id.begin(), id.end(), '.', '_');
+  return id;
+}
+
+std::string stem(const std::string& name) { return name.substr(0, name.find_last_of('.')); }
+
+}  // namespace
+
+std::string qgis_style_body(const OutputFile& o, const RunState& state) {
+  switch (o.style) {
+    case Style::elevation: {
+      const double lo = state.summary["terrain"]["min_m"].get<double>(), hi = state.summary["terrain"]["max_m"].get<double>();
+      std::vector<Stop> stops;
+      if (lo < 0) {
+        stops.push_back({lo, "#08306b", num(lo) + " m"});
+        stops.push_back({std::min(0.0, hi) - 1e-3, "#9ecae1", "sea level"});
+      }
+      const double base = std::max(lo, 0.0), top = std::max(hi, base + 1);
+      stops.push_back({base, "#1a9641", num(base) + " m"});
+      stops.push_back({base + 0.25 * (top - base), "#a6d96a", ""});
+      stops.push_back({base + 0.5 * (top - base), "#ffffbf", ""});
+      stops.push_back({base + 0.75 * (top - base), "#c08040", ""});
+      stops.push_back({top, "#ffffff", num(top) + " m"});
+      return pseudocolor(stops, "INTERPOLATED", 0.55);
+    }
+    case Style::hillshade: return gray(1, 255);
+    case Style::unit_ramp:
+      return pseudocolor({{0, "#440154", "0"}, {0.25, "#3b528b", ""}, {0.5, "#21918c", ""}, {0.75, "#5ec962", ""}, {1, "#fde725", "1"}});
+    case Style::density:
+      return pseudocolor({{0, "#ffffb2", "0 (empty)"}, {0.25, "#fecc5c", ""}, {0.5, "#fd8d3c", ""}, {0.75, "#f03b20", ""}, {1, "#bd0026", "1 (most attractive)"}},
+                         "INTERPOLATED", 0.7);
+    case Style::mask: return paletted({{0, "#000000", "not buildable"}, {1, "#4daf4a", "buildable"}}, 0.4);
+    case Style::flow_direction:
+      return paletted({{1, "#e41a1c", "E"}, {2, "#377eb8", "SE"}, {4, "#4daf4a", "S"}, {8, "#984ea3", "SW"},
+                       {16, "#ff7f00", "W"}, {32, "#ffff33", "NW"}, {64, "#a65628", "N"}, {128, "#f781bf", "NE"}});
+    case Style::accumulation:
+      return pseudocolor({{0, "#f7fbff", "0"}, {1e5, "#c6dbef", ""}, {1e6, "#6baed6", "1 km2"}, {1e7, "#2171b5", ""}, {1e8, "#08306b", "100 km2"}});
+    case Style::streams: {
+      std::vector<Category> cats;
+      const char* blues[] = {"#9ecae1", "#6baed6", "#4292c6", "#2171b5", "#08519c", "#08306b", "#08306b", "#08306b"};
+      for (int order = 1; order <= 8; ++order)
+        cats.push_back({std::to_string(order), "order " + std::to_string(order), line(std::to_string(order - 1), blues[order - 1], 0.2 + 0.25 * order)});
+      return categorized("strahler", cats);
+    }
+    case Style::cities: {
+      std::vector<Category> cats;
+      const char* colors[] = {"#67000d", "#a50f15", "#cb181d", "#ef3b2c", "#fb6a4a", "#fc9272"};
+      for (int c = 0; c < 6; ++c)
+        cats.push_back({std::to_string(c), "class " + std::to_string(c), marker(std::to_string(c), colors[c], 4.5 - 0.6 * c)});
+      return categorized("class", cats);
+    }
+    case Style::city_extents: return single(fill("0", "239,59,44,60", "165,15,21,255"));
+    case Style::network:
+      return categorized("kept", {{"1", "kept link", line("0", "#252525", 0.5)}, {"0", "removed candidate", line("1", "#bdbdbd", 0.2, "dash")}});
+    case Style::roads:
+      return categorized("class", {{"motorway", "motorway", line("0", "#e31a1c", 1.2)},
+                                   {"national", "national", line("1", "#ff7f00", 0.8)},
+                                   {"departmental", "departmental", line("2", "#ffd92f", 0.5)},
+                                   {"maritime", "maritime link", line("3", "#1f78b4", 0.5, "dash")}});
+    case Style::road_sections:
+      return categorized("structure", {{"road", "road", line("0", "#636363", 0.4)},
+                                       {"bridge", "bridge", line("1", "#1f78b4", 1.4)},
+                                       {"tunnel", "tunnel", line("2", "#8c510a", 1.0, "dash")},
+                                       {"ferry", "ferry", line("3", "#a6cee3", 0.6, "dot")}});
+  }
+  return "";
+}
+
+void write_qgis_styles_and_project(const RunState& state) {
+  const Crs& crs = state.dem.georef().crs;
+  // With an EPSG code, QGIS takes the official definition (its axis order); otherwise the WKT.
+  const std::string srs = crs.epsg ? "<spatialrefsys><authid>EPSG:" + std::to_string(*crs.epsg) + "</authid></spatialrefsys>"
+                                   : "<spatialrefsys><wkt>" + escape(crs.wkt) + "</wkt><description>" + escape(crs.name) + "</description></spatialrefsys>";
+  const std::string srs_lonlat = "<spatialrefsys><authid>EPSG:4326</authid></spatialrefsys>";
+
+  std::vector<const OutputFile*> layers;
+  for (const auto& o : state.outputs) layers.push_back(&o);
+  std::stable_sort(layers.begin(), layers.end(), [](auto* a, auto* b) { return draw_rank(a->style) > draw_rank(b->style); });
+
+  std::ostringstream tree, project_layers, order;
+  std::map<std::string, std::vector<const OutputFile*>> by_stage;
+  std::vector<std::string> stage_order;
+  for (auto* o : layers) {
+    if (!by_stage.count(o->stage)) stage_order.push_back(o->stage);
+    by_stage[o->stage].push_back(o);
+  }
+  for (const auto& stage : stage_order) {
+    tree << "<layer-tree-group name=\"" << escape(stage) << "\" checked=\"Qt::Checked\" expanded=\"1\"><customproperties/>";
+    for (auto* o : by_stage[stage]) {
+      // Only the most useful layers are shown at first; the rest are one click away.
+      const bool visible = o->style != Style::elevation && o->style != Style::flow_direction && o->style != Style::accumulation &&
+                           o->style != Style::unit_ramp && o->style != Style::mask && o->style != Style::network;
+      tree << "<layer-tree-layer id=\"" << layer_id(*o) << "\" name=\"" << escape(stem(o->name)) << "\" source=\"./" << o->name
+           << "\" providerKey=\"" << (o->raster ? "gdal" : "ogr") << "\" checked=\"" << (visible ? "Qt::Checked" : "Qt::Unchecked")
+           << "\" expanded=\"0\"><customproperties/></layer-tree-layer>";
+    }
+    tree << "</layer-tree-group>";
+  }
+  for (auto* o : layers) {
+    const std::string body = qgis_style_body(*o, state);
+    const std::string qml = "<!DOCTYPE qgis PUBLIC 'http://mrcc.com/qgis.dtd' 'SYSTEM'>\n<qgis version=\"3.22.16\" styleCategories=\"AllStyleCategories\">" +
+                            body + "<blendMode>0</blendMode></qgis>\n";
+    std::ofstream(state.folder / (stem(o->name) + ".qml")) << qml;
+    project_layers << "<maplayer type=\"" << (o->raster ? "raster" : "vector") << "\""
+                   << (o->raster ? "" : " geometry=\"\"") << "><id>" << layer_id(*o) << "</id><datasource>./" << o->name
+                   << "</datasource><layername>" << escape(stem(o->name)) << "</layername><srs>" << (o->raster ? srs : srs_lonlat)
+                   << "</srs><abstract>" << escape(o->description) << "</abstract><provider>" << (o->raster ? "gdal" : "ogr")
+                   << "</provider>" << body << "<blendMode>0</blendMode></maplayer>";
+    order << "<item>" << layer_id(*o) << "</item>";
+  }
+  std::ofstream out(state.folder / "project.qgs");
+  out << "<!DOCTYPE qgis PUBLIC 'http://mrcc.com/qgis.dtd' 'SYSTEM'>\n"
+      << "<qgis projectname=\"Terrapolis run\" version=\"3.22.16\"><title>Terrapolis run</title>"
+      << "<projectCrs>" << srs << "</projectCrs>"
+      << "<layer-tree-group><customproperties/>" << tree.str() << "<custom-order enabled=\"0\">" << order.str() << "</custom-order></layer-tree-group>"
+      << "<projectlayers>" << project_layers.str() << "</projectlayers>"
+      << "<properties><Paths><Absolute type=\"bool\">false</Absolute></Paths></properties></qgis>\n";
+  if (!out) throw processing_error((state.folder / "project.qgs").string() + ": cannot write");
+}
+
+}  // namespace terrapolis::pipeline

@@ -1,0 +1,52 @@
+// What the stages of one run share: the scenario, the DEM, each stage's typed results, the files written.
+// SPDX-License-Identifier: MIT
+#pragma once
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "core/progress.hpp"
+#include "core/raster.hpp"
+#include "io/raster_io.hpp"
+#include "io/vector_io.hpp"
+#include "pipeline/scenario.hpp"
+
+namespace terrapolis::pipeline {
+
+/// How a layer is drawn in QGIS and in the preview.
+enum class Style { elevation, hillshade, unit_ramp, density, mask, flow_direction, accumulation,
+                   streams, cities, city_extents, network, roads, road_sections };
+
+/// One file of the run folder.
+struct OutputFile {
+  std::string name;         ///< file name inside the run folder
+  std::string stage;        ///< stage that wrote it
+  std::string description;  ///< what it is
+  Style style;
+  bool raster = true;
+  std::size_t features = 0;  ///< vector layers: number of features
+};
+
+struct RunState {
+  const Scenario& scenario;
+  std::filesystem::path folder;  ///< the run folder being written (a temporary name until the end)
+  std::string dem_sha256;
+  Dem dem;
+  // Typed results of the stages, filled in data-flow order.
+  std::optional<Raster<float>> hydrometry;
+  std::optional<Raster<float>> density;
+  std::vector<OutputFile> outputs;
+  std::vector<std::pair<Style, VectorLayer>> vectors;  ///< vector layers written, kept for the preview
+  nlohmann::ordered_json summary = nlohmann::ordered_json::object();  ///< per-stage figures for the summary and compare
+
+  /// Writes a raster of the run with provenance metadata, and records it.
+  template <class T>
+  void write(const std::string& stage, const std::string& name, const Raster<T>& raster, const std::string& description, Style style);
+  /// Writes a vector layer of the run and records it.
+  void write(const std::string& stage, const std::string& name, const VectorLayer& layer, const std::string& description, Style style);
+};
+
+}  // namespace terrapolis::pipeline

@@ -1,0 +1,147 @@
+// Scenario loading and validation (valijson against the embedded JSON Schema).
+// SPDX-License-Identifier: MIT
+#include "pipeline/scenario.hpp"
+
+#include <valijson/adapters/nlohmann_json_adapter.hpp>
+#include <valijson/schema.hpp>
+#include <valijson/schema_parser.hpp>
+#include <valijson/validator.hpp>
+
+#include <fstream>
+#include <sstream>
+
+#include "core/error.hpp"
+
+namespace terrapolis::pipeline {
+namespace {
+
+using json = nlohmann::ordered_json;
+
+const nlohmann::json& schema_json_for_validation(nlohmann::json& storage) {
+  storage = nlohmann::json::parse(scenario_schema_text());
+  return storage;
+}
+
+/// Defaults of an object schema, recursively ("default" of each property; objects from their properties).
+json defaults_of(const nlohmann::json& schema) {
+  if (schema.value("type", "") == "object" && schema.contains("properties")) {
+    json out = json::object();
+    for (const auto& [key, sub] : schema["properties"].items()) {
+      json d = defaults_of(sub);
+      if (!d.is_null()) out[key] = d;
+    }
+    return out;
+  }
+  if (schema.contains("default")) return json(schema["default"]);
+  return nullptr;
+}
+
+/// The complete scenario in the schema's key order: the user's value where given, else the default
+/// (objects merged recursively), so equal scenarios print and hash the same however they were typed.
+json with_defaults(const json& doc, const json& defaults) {
+  json out = json::object();
+  for (const auto& [key, value] : defaults.items()) {
+    if (!doc.contains(key)) out[key] = value;
+    else if (value.is_object() && doc[key].is_object()) out[key] = with_defaults(doc[key], value);
+    else out[key] = doc[key];
+  }
+  return out;
+}
+
+std::string pointer_of(const std::vector<std::string>& context) {
+  std::string p;
+  for (const auto& c : context) {
+    if (c == "<root>") continue;
+    std::string_view token = c;
+    if (token.size() >= 2 && token.front() == '[' && token.back() == ']') token = token.substr(1, token.size() - 2);
+    if (token.size() >= 2 && token.front() == '"' && token.back() == '"') token = token.substr(1, token.size() - 2);
+    p.push_back('/');
+    p.append(token);
+  }
+  return p.empty() ? "/" : p;
+}
+
+void apply_set(json& doc, const std::string& set) {
+  const auto eq = set.find('=');
+  if (eq == std::string::npos || eq == 0) throw bad_input("--set " + set + ": expected stage.field=value");
+  const std::string key = set.substr(0, eq), text = set.substr(eq + 1);
+  json value;
+  try {
+    value = json::parse(text);
+  } catch (const json::parse_error&) {
+    value = text;  // a bare word is a string
+  }
+  json* node = &doc;
+  std::stringstream parts(key);
+  std::string part;
+  std::vector<std::string> path;
+  while (std::getline(parts, part, '.')) path.push_back(part);
+  for (std::size_t i = 0; i + 1 < path.size(); ++i) {
+    json& next = (*node)[path[i]];
+    if (next.is_null()) next = json::object();
+    if (!next.is_object()) throw bad_input("--set " + set + ": " + path[i] + " is not a section");
+    node = &next;
+  }
+  (*node)[path.back()] = value;
+}
+
+}  // namespace
+
+std::string Scenario::path(const std::string& field) const {
+  const std::filesystem::path p = resolved.at(field).get<std::string>();
+  if (p.is_absolute()) return p.string();
+  if (!base_dir.empty()) return (base_dir / p).lexically_normal().string();
+  // The default scenario names the bundled DEM relative to the source tree; find it from elsewhere too.
+  std::error_code ec;
+  const std::filesystem::path bundled = std::filesystem::path(TERRAPOLIS_SOURCE_DIR) / p;
+  if (field == "dem" && !std::filesystem::exists(p, ec) && std::filesystem::exists(bundled, ec)) return bundled.string();
+  return p.string();
+}
+
+json schema_defaults() { return defaults_of(nlohmann::json::parse(scenario_schema_text())); }
+
+std::string validate_scenario(const json& scenario) {
+  nlohmann::json schema_doc;
+  schema_json_for_validation(schema_doc);
+  valijson::Schema schema;
+  valijson::SchemaParser parser;
+  valijson::adapters::NlohmannJsonAdapter schema_adapter(schema_doc);
+  parser.populateSchema(schema_adapter, schema);
+  const nlohmann::json doc = nlohmann::json::parse(scenario.dump());
+  valijson::Validator validator;
+  valijson::ValidationResults results;
+  valijson::adapters::NlohmannJsonAdapter target(doc);
+  if (validator.validate(schema, target, &results)) return "";
+  // The deepest error is the most specific one (valijson also reports the enclosing objects).
+  valijson::ValidationResults::Error best;
+  for (const auto& e : results)
+    if (e.context.size() > best.context.size()) best = e;
+  return pointer_of(best.context) + ": " + best.description;
+}
+
+Scenario load_scenario(const std::string& file, const std::vector<std::string>& sets, std::optional<std::uint64_t> seed) {
+  Scenario s;
+  json doc = json::object();
+  if (file.empty()) {
+    s.source = "(default scenario)";
+  } else {
+    s.source = file;
+    std::ifstream in(file);
+    if (!in) throw bad_input(file + ": no such scenario file");
+    try {
+      doc = json::parse(in);
+    } catch (const json::parse_error& e) {
+      throw bad_input(file + ": not valid JSON (" + std::string(e.what()) + ")");
+    }
+    if (!doc.is_object()) throw bad_input(file + ": /: a scenario is a JSON object");
+    s.base_dir = std::filesystem::path(file).parent_path();
+  }
+  for (const auto& set : sets) apply_set(doc, set);
+  if (seed) doc["seed"] = *seed;
+  const std::string problem = validate_scenario(doc);
+  if (!problem.empty()) throw bad_input(s.source + ": " + problem);
+  s.resolved = with_defaults(doc, schema_defaults());
+  return s;
+}
+
+}  // namespace terrapolis::pipeline

@@ -1,0 +1,27 @@
+# Helpers sourced by the command-line test cases (not a test itself: it has no "case" in its name).
+# Usage in a case: source "$(dirname "$0")/lib.sh" "$@"
+set -euo pipefail
+TP=$1
+SAMPLES=$2
+SOURCE=${3:-}
+WORK=$(mktemp -d)
+trap 'rm -rf "$WORK"' EXIT
+
+fail() { echo "FAIL: $*" >&2; exit 1; }
+
+# expect_fail CODE PATTERN CMD...: the command exits with CODE and its stderr matches PATTERN (grep -E).
+expect_fail() {
+  local code=$1 pattern=$2; shift 2
+  local rc=0
+  "$@" >"$WORK/stdout" 2>"$WORK/stderr" || rc=$?
+  [[ $rc -eq $code ]] || fail "expected exit $code, got $rc: $* ($(cat "$WORK/stderr"))"
+  grep -Eq "$pattern" "$WORK/stderr" || fail "stderr of '$*' does not match '$pattern': $(cat "$WORK/stderr")"
+  [[ $(grep -c . "$WORK/stderr") -ge 1 ]] || fail "no error message"
+}
+
+# no_leftovers DIR: nothing but what was there before (no partial or temporary outputs).
+no_leftovers() {
+  local found
+  found=$(find "$1" -name '*.tmp-*' -o -name '*.aux.xml' | head -1)
+  [[ -z $found ]] || fail "left behind: $found"
+}
