@@ -94,9 +94,14 @@ class DensityCommand final : public Command {
   void run(Context& context) override {
     density::DensityOptions options = options_;
     parse_options(options);
-    const std::vector<std::string> names = {"coast", "plateau", "plain", "hydrometry", "buildable", "density"};
     // Refuse existing outputs before any work; the folder itself is created only at the end.
+    // hydrometry.tif is written only when used, and never over the --hydrometry file it came from.
     const fs::path dir(out_dir_);
+    const fs::path hydro_out = dir / "hydrometry.tif";
+    const bool reuse = !hydrometry_path_.empty() && fs::exists(hydro_out) && fs::equivalent(hydrometry_path_, hydro_out);
+    const bool write_hydro = (options.weights[1] != 0 || options.river_bed_cap.has_value()) && !reuse;
+    std::vector<std::string> names = {"coast", "plateau", "plain", "buildable", "density"};
+    if (write_hydro) names.push_back("hydrometry");
     if (fs::exists(dir)) {
       if (!fs::is_directory(dir)) throw bad_input(out_dir_ + ": exists and is not a folder");
       for (const auto& n : names) check_output_path((dir / (n + ".tif")).string(), overwrite_);
@@ -133,10 +138,7 @@ class DensityCommand final : public Command {
     write("coast", result.coast);
     write("plateau", result.plateau);
     write("plain", result.plain);
-    // Hydrometry is written only when it took part; never over the file it was read from.
-    const fs::path hydro_out = dir / "hydrometry.tif";
-    const bool same = !hydrometry_path_.empty() && fs::exists(hydro_out) && fs::equivalent(hydrometry_path_, hydro_out);
-    if (hydrometry.used && !same) write("hydrometry", result.hydrometry);
+    if (write_hydro) write("hydrometry", result.hydrometry);
     write("buildable", result.buildable);
     write("density", result.density);
     tbb::parallel_for(std::size_t(0), writes.size(), [&](std::size_t k) { writes[k](); });
