@@ -261,7 +261,10 @@ DensityResult compute_density(const Dem& dem, const Raster<float>& hydrometry, c
     const float lo = *std::min_element(row_zmin.begin(), row_zmin.end());
     const float hi = *std::max_element(row_zmax.begin(), row_zmax.end());
     const double mid = lo <= hi ? 0.5 * (double(lo) + double(hi)) : 0.0;
-    const SummedArea<std::uint32_t> count(win, cols, [&](std::size_t i) { return std::uint32_t(kind[i] == land); });
+    // When every cell is land, land cells in a disc are counted by arithmetic instead.
+    const bool all_land = !any_water && !any_unknown;
+    const SummedArea<std::uint32_t> count = all_land ? SummedArea<std::uint32_t>()
+                                                     : SummedArea<std::uint32_t>(win, cols, [&](std::size_t i) { return std::uint32_t(kind[i] == land); });
     const SummedArea<double> s1(win, cols, [&](std::size_t i) { return kind[i] == land ? double(dem[i]) - mid : 0.0; });
     const SummedArea<double> s2(win, cols, [&](std::size_t i) {
       const double d = kind[i] == land ? double(dem[i]) - mid : 0.0;
@@ -279,7 +282,8 @@ DensityResult compute_density(const Dem& dem, const Raster<float>& hydrometry, c
         std::fill(a.begin() + x0, a.begin() + x1, 0u);
         std::fill(b.begin() + x0, b.begin() + x1, 0.0);
         std::fill(c.begin() + x0, c.begin() + x1, 0.0);
-        add_disc_row(count, inner, r, +1, a.data(), x0, x1);
+        if (all_land) add_disc_count_row(inner, cols, rows, r, +1, a.data(), x0, x1);
+        else add_disc_row(count, inner, r, +1, a.data(), x0, x1);
         add_disc_row(s1, inner, r, +1, b.data(), x0, x1);
         add_disc_row(s2, inner, r, +1, c.data(), x0, x1);
         for (int x = x0; x < x1; ++x) {
