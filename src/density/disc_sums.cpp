@@ -62,47 +62,55 @@ DiscPlan::DiscPlan(const CellMetrics& metrics, int rows, double radius_m, int ma
   const bool uniform = std::all_of(metrics.width_m.begin(), metrics.width_m.end(), [&](double w) { return w == metrics.width_m[0]; }) &&
                        std::all_of(metrics.height_m.begin(), metrics.height_m.end(), [&](double h) { return h == metrics.height_m[0]; });
   per_row_.resize(std::size_t(rows));
-  std::vector<int> widths;
-  for (int row = 0; row < rows; ++row) {
-    if (uniform && row > 0) {
-      per_row_[std::size_t(row)] = per_row_[0];
-      continue;
-    }
+  auto plan_row = [&](int row) {
     int north = 0, south = 0;
     while (north < reach && half_cols(g, radius_m, row, -(north + 1)) >= 0) ++north;
     while (south < reach && half_cols(g, radius_m, row, south + 1) >= 0) ++south;
     const int count = north + south + 1;
-    widths.resize(std::size_t(count));
+    std::vector<int> widths(static_cast<std::size_t>(count));
     for (int dr = -north; dr <= south; ++dr) widths[std::size_t(dr + north)] = half_cols(g, radius_m, row, dr);
     std::vector<Band>& bands = per_row_[std::size_t(row)];
     if (count <= bands_wanted) {
       for (int dr = -north; dr <= south; ++dr) bands.push_back({dr, dr, widths[std::size_t(dr + north)]});
-    } else {
-      exact_ = false;
-      // Equal-angle bands: theta = asin(dy / R) cut into bands_wanted equal steps over [-pi/2, pi/2].
-      auto band_of = [&](int dr) {
-        const double s = std::clamp((g.y(row + dr) - g.y(row)) / radius_m, -1.0, 1.0);
-        const double theta = std::asin(s) + std::numbers::pi / 2;
-        return std::min(bands_wanted - 1, int(theta / std::numbers::pi * bands_wanted));
-      };
-      int start = -north;
-      while (start <= south) {
-        const int id = band_of(start);
-        int end = start;
-        double sum = 0;
-        while (end <= south && band_of(end) == id) sum += widths[std::size_t(end + north)], ++end;
-        bands.push_back({start, end - 1, int(std::lround(sum / double(end - start)))});
-        start = end;
-      }
+      return;
     }
-    band_count_ = std::max(band_count_, int(bands.size()));
+    // Equal-angle bands: theta = asin(dy / R) cut into bands_wanted equal steps over [-pi/2, pi/2].
+    auto band_of = [&](int dr) {
+      const double s = std::clamp((g.y(row + dr) - g.y(row)) / radius_m, -1.0, 1.0);
+      const double theta = std::asin(s) + std::numbers::pi / 2;
+      return std::min(bands_wanted - 1, int(theta / std::numbers::pi * bands_wanted));
+    };
+    int start = -north;
+    while (start <= south) {
+      const int id = band_of(start);
+      int end = start;
+      double sum = 0;
+      while (end <= south && band_of(end) == id) sum += widths[std::size_t(end + north)], ++end;
+      bands.push_back({start, end - 1, int(std::lround(sum / double(end - start)))});
+      start = end;
+    }
+  };
+  if (uniform) {
+    if (rows > 0) plan_row(0);
+    for (int row = 1; row < rows; ++row) per_row_[std::size_t(row)] = per_row_[0];
+  } else {
+    // Rows are planned independently (geographic grids: one plan per latitude).
+    tbb::parallel_for(tbb::blocked_range<int>(0, rows, 16), [&](const tbb::blocked_range<int>& range) {
+      for (int row = range.begin(); row < range.end(); ++row) plan_row(row);
+    });
+  }
+  for (const std::vector<Band>& bands : per_row_) {
     double cells = 0;
-    for (const Band& b : bands) cells += double(b.row_hi - b.row_lo + 1) * double(2 * b.half_cols + 1);
-    max_cells_ = std::max(max_cells_, cells);
+    bool single_rows = true;
     for (const Band& b : bands) {
+      cells += double(b.row_hi - b.row_lo + 1) * double(2 * b.half_cols + 1);
       reach_rows_ = std::max({reach_rows_, -b.row_lo, b.row_hi});
       reach_cols_ = std::max(reach_cols_, b.half_cols);
+      single_rows = single_rows && b.row_lo == b.row_hi;
     }
+    exact_ = exact_ && single_rows;
+    band_count_ = std::max(band_count_, int(bands.size()));
+    max_cells_ = std::max(max_cells_, cells);
   }
 }
 
