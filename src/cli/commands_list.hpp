@@ -9,6 +9,7 @@ namespace terrapolis::cli {
 
 std::unique_ptr<Command> make_info_command();
 std::unique_ptr<Command> make_convert_command();
+std::unique_ptr<Command> make_density_command();
 std::unique_ptr<Command> make_run_command();
 std::unique_ptr<Command> make_compare_command();
 std::unique_ptr<Command> make_hydro_command();

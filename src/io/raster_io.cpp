@@ -198,7 +198,7 @@ Raster<float> read_resampled(const std::string& path, const Georef& like, int co
   Raster<float> out(cols, rows, like, std::numeric_limits<float>::quiet_NaN());
   GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");
   DatasetPtr dst(mem->Create("", cols, rows, 0, GDT_Float32, nullptr));
-  char pointer[64];
+  char pointer[64] = {};  // CPLPrintPointer does not write a terminating NUL
   CPLPrintPointer(pointer, out.data(), sizeof(pointer));
   const std::string opt = std::string("DATAPOINTER=") + pointer;
   char* band_options[] = {const_cast<char*>(opt.c_str()), nullptr};
@@ -260,7 +260,7 @@ void write_raster(const std::string& path, const Raster<T>& raster, const WriteO
   detail::check_output(path, options.overwrite);
   GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");
   DatasetPtr src(mem->Create("", raster.cols(), raster.rows(), 0, gdal_type(T{}), nullptr));
-  char pointer[64];
+  char pointer[64] = {};  // CPLPrintPointer does not write a terminating NUL
   CPLPrintPointer(pointer, const_cast<T*>(raster.data()), sizeof(pointer));
   const std::string opt = std::string("DATAPOINTER=") + pointer;
   char* band_options[] = {const_cast<char*>(opt.c_str()), nullptr};

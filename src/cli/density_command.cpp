@@ -1,0 +1,234 @@
+// `terrapolis density DEM OUTDIR`: the population density model (Belhadj 2007, §4.2) and its rasters.
+// SPDX-License-Identifier: MIT
+#include <CLI/CLI.hpp>
+#include <tbb/parallel_for.h>
+
+#include <chrono>
+#include <cmath>
+#include <ctime>
+#include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <sstream>
+
+#include "cli/command.hpp"
+#include "cli/commands_list.hpp"
+#include "cli/dem_input.hpp"
+#include "core/error.hpp"
+#include "density/density.hpp"
+#include "io/raster_io.hpp"
+#include "terrapolis/version.hpp"
+
+namespace terrapolis::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+double parse_number(const std::string& option, const std::string& text) {
+  std::size_t used = 0;
+  double v = 0;
+  try {
+    v = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != text.size() || !std::isfinite(v)) throw bad_input(option + ": '" + text + "' is not a number");
+  return v;
+}
+
+/// The hydrometry the density model uses, on the DEM's grid, and whether it is worth writing.
+/// This is the ONE place that decides where hydrometry comes from: a file given with --hydrometry
+/// (resampled bilinearly to the DEM's grid), nothing when neither its weight nor a river-bed cap
+/// needs it (all zeros, not written), otherwise the hydrology stage.
+struct Hydrometry {
+  Raster<float> values;
+  bool used = false;
+};
+
+Hydrometry obtain_hydrometry(const Dem& dem, const density::DensityOptions& options, const std::string& path) {
+  Hydrometry h;
+  h.used = options.weights[1] != 0 || options.river_bed_cap.has_value();
+  if (!path.empty()) {
+    h.values = read_resampled(path, dem.georef(), dem.cols(), dem.rows(), Resampling::bilinear);
+    for (std::size_t i = 0; i < h.values.size(); ++i) {
+      const float v = h.values[i];
+      if (!std::isnan(v) && (v < -1e-6f || v > 1 + 1e-6f))
+        throw bad_input("--hydrometry " + path + ": values must lie in [0,1] (found " + std::to_string(v) + ")");
+    }
+    return h;
+  }
+  if (!h.used) {
+    h.values = dem.like<float>(0.0f);
+    return h;
+  }
+  throw bad_input("--hydrometry FILE is required when the hydrometry weight is not 0 or --river-bed-cap is set");
+}
+
+class DensityCommand final : public Command {
+ public:
+  std::string name() const override { return "density"; }
+  std::string summary() const override {
+    return "Population density model from terrain: coast, hydrometry, plateau, plain, user layers (Belhadj 2007, 4.2)";
+  }
+
+  void setup(CLI::App& app) override {
+    dem_.add_to(app);
+    app.add_option("OUTDIR", out_dir_, "Folder for coast.tif, plateau.tif, plain.tif, hydrometry.tif, buildable.tif, density.tif")->required();
+    app.add_option("--weights", weights_, "Weights of coast,hydrometry,plateau,plain; negative repulsive, 0 neutral (default 1,1,1.5,0)");
+    app.add_option("--layer", layers_, "User raster and its weight, FILE:WEIGHT (repeatable); values in [0,1] or rescaled from their range");
+    app.add_option("--exclude", exclusions_, "Exclusion raster: non-zero cells are uninhabitable (repeatable)");
+    app.add_option("--hydrometry", hydrometry_path_, "Hydrometry raster in [0,1], resampled to the DEM grid");
+    app.add_option("--water-mask", options_.water_mask, "Raster whose non-zero cells are water");
+    app.add_flag("--nodata-is-sea", options_.nodata_is_sea, "Nodata cells are sea (SRTM and similar coasts)");
+    app.add_option("--sea-level", options_.sea_level_m, "Cells at or below this altitude are water, metres")->capture_default_str();
+    app.add_option("--r-min", options_.r_min_m, "Inner ring radius and plain disc radius (a hamlet), metres")->capture_default_str();
+    app.add_option("--r-max", options_.r_max_m, "Outer ring radius (a large city), metres")->capture_default_str();
+    app.add_option("--max-altitude", options_.max_altitude_m, "Cells above this altitude are uninhabitable, metres")->capture_default_str();
+    app.add_option("--max-slope", max_slope_, "Cells steeper than this are uninhabitable, degrees (default: no limit)");
+    app.add_option("--river-bed-cap", river_bed_cap_, "Cells whose hydrometry exceeds this (0..1) are river beds, uninhabitable");
+    app.add_flag("--report", report_, "Print the buildable share and the density histogram");
+    app.add_flag("--cog", cog_, "Write Cloud Optimized GeoTIFFs");
+    app.add_flag("--overwrite", overwrite_, "Replace existing outputs");
+  }
+
+  void run(Context& context) override {
+    density::DensityOptions options = options_;
+    parse_options(options);
+    // Refuse existing outputs before any work; the folder itself is created only at the end.
+    // hydrometry.tif is written only when used, and never over the --hydrometry file it came from.
+    const fs::path dir(out_dir_);
+    const fs::path hydro_out = dir / "hydrometry.tif";
+    const bool reuse = !hydrometry_path_.empty() && fs::exists(hydro_out) && fs::equivalent(hydrometry_path_, hydro_out);
+    const bool write_hydro = (options.weights[1] != 0 || options.river_bed_cap.has_value()) && !reuse;
+    std::vector<std::string> names = {"coast", "plateau", "plain", "buildable", "density"};
+    if (write_hydro) names.push_back("hydrometry");
+    if (fs::exists(dir)) {
+      if (!fs::is_directory(dir)) throw bad_input(out_dir_ + ": exists and is not a folder");
+      for (const auto& n : names) check_output_path((dir / (n + ".tif")).string(), overwrite_);
+    } else {
+      const fs::path parent = dir.has_parent_path() ? dir.parent_path() : fs::path(".");
+      if (!fs::is_directory(parent)) throw bad_input(out_dir_ + ": its parent folder does not exist");
+    }
+
+    using clock = std::chrono::steady_clock;
+    const auto seconds = [](clock::time_point a, clock::time_point b) { return format(std::chrono::duration<double>(b - a).count(), 3); };
+    const auto t0 = clock::now();
+    const Dem dem = dem_.read();
+    const Hydrometry hydrometry = obtain_hydrometry(dem, options, hydrometry_path_);
+    const auto t1 = clock::now();
+    const std::clock_t cpu1 = std::clock();  // processor time of all threads
+    const density::DensityResult result = density::compute_density(dem, hydrometry.values, options, context.progress);
+    const std::clock_t cpu2 = std::clock();
+    const auto t2 = clock::now();
+
+    fs::create_directories(dir);
+    const auto metadata = provenance(options);
+    // The files are independent: write them in parallel (each is still written atomically).
+    std::vector<std::function<void()>> writes;
+    auto write = [&](const std::string& n, const auto& raster) {
+      writes.emplace_back([&, n] {
+        WriteOptions w;
+        w.cog = cog_;
+        w.overwrite = overwrite_;
+        w.description = density::describe_output(n);
+        w.metadata = metadata;
+        write_raster((dir / (n + ".tif")).string(), raster, w);
+      });
+    };
+    write("coast", result.coast);
+    write("plateau", result.plateau);
+    write("plain", result.plain);
+    if (write_hydro) write("hydrometry", result.hydrometry);
+    write("buildable", result.buildable);
+    write("density", result.density);
+    tbb::parallel_for(std::size_t(0), writes.size(), [&](std::size_t k) { writes[k](); });
+    const auto t3 = clock::now();
+    context.log.detail("density: read " + seconds(t0, t1) + " s, model " + seconds(t1, t2) + " s (cpu " +
+                       format(double(cpu2 - cpu1) / CLOCKS_PER_SEC, 3) + " s), write " + seconds(t2, t3) + " s");
+
+    const auto& s = result.stats;
+    const double land = double(s.known_cells - s.water_cells);
+    context.log.info("density: " + std::to_string(s.buildable_cells) + " buildable cells (" +
+                     format(land > 0 ? 100.0 * double(s.buildable_cells) / land : 0.0) + " % of land), mean density " +
+                     format(s.mean_density, 3) + ", written to " + out_dir_);
+    if (report_) print_report(result);
+  }
+
+ private:
+  static std::string format(double v, int digits = 1) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.*f", digits, v);
+    return buf;
+  }
+
+  void parse_options(density::DensityOptions& options) const {
+    if (!weights_.empty()) {
+      std::stringstream ss(weights_);
+      std::string part;
+      std::vector<double> w;
+      while (std::getline(ss, part, ',')) w.push_back(parse_number("--weights", part));
+      if (w.size() != 4) throw bad_input("--weights: expected 4 numbers C,H,P,L but got '" + weights_ + "'");
+      for (int i = 0; i < 4; ++i) options.weights[std::size_t(i)] = w[std::size_t(i)];
+    }
+    for (const std::string& l : layers_) {
+      const auto colon = l.rfind(':');
+      if (colon == std::string::npos || colon == 0) throw bad_input("--layer: expected FILE:WEIGHT but got '" + l + "'");
+      options.layers.emplace_back(l.substr(0, colon), parse_number("--layer " + l.substr(0, colon), l.substr(colon + 1)));
+    }
+    options.exclusions = exclusions_;
+    if (!max_slope_.empty()) options.max_slope_deg = parse_number("--max-slope", max_slope_);
+    if (!river_bed_cap_.empty()) options.river_bed_cap = parse_number("--river-bed-cap", river_bed_cap_);
+  }
+
+  std::vector<std::pair<std::string, std::string>> provenance(const density::DensityOptions& o) const {
+    std::ostringstream w;
+    w << o.weights[0] << ',' << o.weights[1] << ',' << o.weights[2] << ',' << o.weights[3];
+    for (const auto& [path, weight] : o.layers) w << ';' << fs::path(path).filename().string() << ':' << weight;
+    std::vector<std::pair<std::string, std::string>> m = {
+        {"TERRAPOLIS_VERSION", terrapolis::version},
+        {"TERRAPOLIS_STAGE", "density"},
+        {"DEM", fs::path(dem_.path).filename().string()},
+        {"WEIGHTS_COAST_HYDROMETRY_PLATEAU_PLAIN", w.str()},
+        {"R_MIN_M", format(o.r_min_m, 3)},
+        {"R_MAX_M", format(o.r_max_m, 3)},
+        {"SEA_LEVEL_M", format(o.sea_level_m, 3)},
+        {"NODATA_IS_SEA", o.nodata_is_sea ? "yes" : "no"},
+        {"MAX_ALTITUDE_M", format(o.max_altitude_m, 3)},
+        {"PLATEAU_M", format(o.plateau_min_m, 1) + ".." + format(o.plateau_max_m, 1)},
+        {"PLAIN_MAX_VARIATION_M", format(o.plain_max_variation_m, 3)},
+    };
+    if (o.max_slope_deg) m.emplace_back("MAX_SLOPE_DEG", format(*o.max_slope_deg, 3));
+    if (o.river_bed_cap) m.emplace_back("RIVER_BED_CAP", format(*o.river_bed_cap, 4));
+    return m;
+  }
+
+  void print_report(const density::DensityResult& r) const {
+    const auto& s = r.stats;
+    const double land = double(s.known_cells - s.water_cells);
+    std::printf("Density report: %s\n", dem_.path.c_str());
+    std::printf("  cells:      %zu (%zu with data or water, %zu water)\n", s.cells, s.known_cells, s.water_cells);
+    std::printf("  buildable:  %zu cells, %.2f %% of land, %.2f %% of the grid\n", s.buildable_cells,
+                land > 0 ? 100.0 * double(s.buildable_cells) / land : 0.0, 100.0 * double(s.buildable_cells) / double(s.cells));
+    std::printf("  radii:      r_min %.1f m, r_max %.1f m (%s, up to %d bands per disc)\n", s.r_min_m, s.r_max_m,
+                s.ring_exact ? "exact discs" : "banded discs", s.ring_bands);
+    std::printf("  density:    mean %.3f over buildable cells\n", s.mean_density);
+    std::printf("  histogram of density over buildable cells:\n");
+    for (int k = 0; k < 10; ++k) {
+      const double share = s.buildable_cells ? 100.0 * double(s.histogram[std::size_t(k)]) / double(s.buildable_cells) : 0.0;
+      std::printf("    [%.1f, %.1f%c %6.2f %%  %s\n", k / 10.0, (k + 1) / 10.0, k == 9 ? ']' : ')', share,
+                  std::string(std::size_t(std::lround(share / 2)), '#').c_str());
+    }
+  }
+
+  DemInput dem_;
+  std::string out_dir_, weights_, hydrometry_path_, max_slope_, river_bed_cap_;
+  std::vector<std::string> layers_, exclusions_;
+  density::DensityOptions options_;
+  bool report_ = false, cog_ = false, overwrite_ = false;
+};
+
+}  // namespace
+
+std::unique_ptr<Command> make_density_command() { return std::make_unique<DensityCommand>(); }
+
+}  // namespace terrapolis::cli

@@ -1,0 +1,418 @@
+// The population density model: water and buildable masks, coast, plateau, plain, combination.
+// SPDX-License-Identifier: MIT
+#include "density/density.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
+#include <algorithm>
+#include <climits>
+#include <cstdint>
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <numbers>
+
+#include "core/error.hpp"
+#include "core/geodesy.hpp"
+#include "density/disc_sums.hpp"
+#include "io/raster_io.hpp"
+
+namespace terrapolis::density {
+namespace {
+
+constexpr float nan_f = std::numeric_limits<float>::quiet_NaN();
+
+/// What a cell is for the model.
+enum CellKind : std::uint8_t { land = 0, water = 1, unknown = 2 };
+
+/// Runs fn(row) for every row in parallel, in ~32 chunks so the step can report progress and be
+/// cancelled between them (ProgressStep is not called from worker threads).
+void for_rows(int rows, ProgressStep& step, const std::function<void(int, int)>& fn) {
+  const int chunks = std::min(rows, 32);
+  for (int k = 0; k < chunks; ++k) {
+    const int lo = int(std::int64_t(rows) * k / chunks), hi = int(std::int64_t(rows) * (k + 1) / chunks);
+    tbb::parallel_for(tbb::blocked_range<int>(lo, hi, 1), [&](const tbb::blocked_range<int>& r) { fn(r.begin(), r.end()); });
+    step.update(double(k + 1) / chunks);
+  }
+}
+
+/// Largest value of `r` over habitable cells (0 when none), deterministic (max is exact).
+float habitable_max(const Raster<float>& r, const Raster<std::uint8_t>& buildable) {
+  return tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, r.size(), 1 << 16), 0.0f,
+      [&](const tbb::blocked_range<std::size_t>& range, float m) {
+        for (std::size_t i = range.begin(); i < range.end(); ++i)
+          if (buildable[i] == 1 && r[i] > m) m = r[i];
+        return m;
+      },
+      [](float a, float b) { return std::max(a, b); });
+}
+
+/// Rescales a characteristic so its largest value on habitable land is 1 (thesis §4.2.1: "ré-échelonnées
+/// dans [0,1]"); uninhabitable land may hold more and is clamped to 1.
+void divide_land_by_max(Raster<float>& r, const std::vector<std::uint8_t>& kind, const Raster<std::uint8_t>& buildable) {
+  const float m = habitable_max(r, buildable);
+  if (m <= 0) return;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, r.size(), 1 << 16), [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t i = range.begin(); i < range.end(); ++i)
+      if (kind[i] == land) r[i] = std::min(1.0f, r[i] / m);
+  });
+}
+
+void check_options(const Dem& dem, const Raster<float>& hydrometry, const DensityOptions& o) {
+  if (hydrometry.cols() != dem.cols() || hydrometry.rows() != dem.rows())
+    throw bad_input("hydrometry: grid is " + std::to_string(hydrometry.cols()) + "x" + std::to_string(hydrometry.rows()) +
+                    ", the DEM's is " + std::to_string(dem.cols()) + "x" + std::to_string(dem.rows()));
+  if (!(o.r_min_m > 0) || !std::isfinite(o.r_min_m)) throw bad_input("--r-min: must be a positive number of metres");
+  if (!(o.r_max_m > o.r_min_m) || !std::isfinite(o.r_max_m)) throw bad_input("--r-max: must be larger than --r-min (metres)");
+  if (!(o.plateau_max_m >= o.plateau_min_m)) throw bad_input("plateau: maximum altitude is below the minimum");
+  if (!(o.plain_max_variation_m > 0)) throw bad_input("plain: maximum variation must be positive (metres)");
+  if (std::isnan(o.sea_level_m)) throw bad_input("--sea-level: not a number");
+  if (std::isnan(o.max_altitude_m)) throw bad_input("--max-altitude: not a number");
+  if (o.max_slope_deg && !(*o.max_slope_deg > 0 && *o.max_slope_deg <= 90)) throw bad_input("--max-slope: must be in (0, 90] degrees");
+  if (o.river_bed_cap && !std::isfinite(*o.river_bed_cap)) throw bad_input("--river-bed-cap: not a number");
+  if (o.ring_bands < 1) throw bad_input("ring bands: must be at least 1");
+  bool any = false;
+  for (double w : o.weights) {
+    if (!std::isfinite(w)) throw bad_input("--weights: weights must be finite numbers");
+    any = any || w != 0;
+  }
+  for (const auto& [path, w] : o.layers) {
+    if (!std::isfinite(w)) throw bad_input("--layer " + path + ": weight must be a finite number");
+    any = any || w != 0;
+  }
+  if (!any) throw bad_input("--weights: every weight is 0, the density would be undefined");
+}
+
+/// Slope in degrees from central differences in metres (one-sided at edges and next to nodata).
+float slope_deg(const Dem& dem, const CellMetrics& m, int c, int r) {
+  auto z = [&](int cc, int rr) { return dem.inside(cc, rr) ? dem(cc, rr) : nan_f; };
+  const float z0 = dem(c, r);
+  auto derivative = [&](float before, float after, double d_before, double d_after) {
+    const bool b = !std::isnan(before), a = !std::isnan(after);
+    if (a && b) return (double(after) - double(before)) / (d_before + d_after);
+    if (a) return (double(after) - z0) / d_after;
+    if (b) return (double(z0) - before) / d_before;
+    return 0.0;
+  };
+  const double dx = derivative(z(c - 1, r), z(c + 1, r), m.width_m[std::size_t(r)], m.width_m[std::size_t(r)]);
+  const double dy = derivative(z(c, r - 1), z(c, r + 1), m.height_m[std::size_t(r)], m.height_m[std::size_t(r) + 1]);
+  return float(std::atan(std::hypot(dx, dy)) * 180.0 / std::numbers::pi);
+}
+
+/// A user layer on the DEM grid, in [0,1]: used as is when its values already lie in [0,1],
+/// otherwise rescaled linearly from its [min, max] over the grid; NaN (no data) reads as 0.
+Raster<float> read_layer(const std::string& path, const Dem& dem) {
+  Raster<float> layer = read_resampled(path, dem.georef(), dem.cols(), dem.rows(), Resampling::bilinear);
+  float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+  for (std::size_t i = 0; i < layer.size(); ++i)
+    if (!std::isnan(layer[i])) lo = std::min(lo, layer[i]), hi = std::max(hi, layer[i]);
+  const bool rescale = lo < 0 || hi > 1;
+  for (std::size_t i = 0; i < layer.size(); ++i) {
+    float& v = layer[i];
+    if (std::isnan(v)) v = 0;
+    else if (rescale) v = hi > lo ? (v - lo) / (hi - lo) : 0.0f;
+  }
+  return layer;
+}
+
+}  // namespace
+
+double combine(const double* weights, const double* values, std::size_t n) {
+  double negative = 0, total = 0, sum = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    sum += weights[i] * values[i];
+    total += std::abs(weights[i]);
+    if (weights[i] < 0) negative += weights[i];
+  }
+  if (total == 0) throw bad_input("--weights: every weight is 0, the density would be undefined");
+  return std::clamp((sum - negative) / total, 0.0, 1.0);
+}
+
+std::string describe_output(const std::string& name) {
+  if (name == "coast") return "Coast: share of water between r_min and r_max around the cell, over its maximum on land (0..1; 0 on water)";
+  if (name == "plateau") return "Plateau: share of rough ground between plateau_min and plateau_max altitudes in the ring r_min..r_max, over its maximum on land (0..1)";
+  if (name == "plain") return "Plain: 1 - standard deviation of altitude within r_min / maximum variation, clamped (0..1; 0 on water)";
+  if (name == "hydrometry") return "Hydrometry used by the density model (0..1)";
+  if (name == "buildable") return "Buildable: 1 habitable, 0 uninhabitable (water, too high, too steep, river bed, excluded), 255 no data";
+  if (name == "density") return "Human population density model (MNDPH, Belhadj 2007 4.2): weighted characteristics, 0..1, 0 where uninhabitable";
+  return name;
+}
+
+DensityResult compute_density(const Dem& dem, const Raster<float>& hydrometry, const DensityOptions& options,
+                              Progress& progress) {
+  check_options(dem, hydrometry, options);
+  const int cols = dem.cols(), rows = dem.rows();
+  const std::size_t n = dem.size();
+  const CellMetrics metrics = cell_metrics(dem.georef(), cols, rows);
+  DensityResult result;
+  DensityStats& stats = result.stats;
+  stats.cells = n;
+
+  // ---- masks -------------------------------------------------------------------------------
+  std::vector<std::uint8_t> kind(n);
+  std::vector<std::uint8_t> excluded(n, 0);
+  {
+    ProgressStep step(progress, "density: masks");
+    std::optional<Raster<float>> mask;
+    if (!options.water_mask.empty())
+      mask = read_resampled(options.water_mask, dem.georef(), cols, rows, Resampling::nearest);
+    for (const std::string& path : options.exclusions) {
+      const Raster<float> ex = read_resampled(path, dem.georef(), cols, rows, Resampling::nearest);
+      for (std::size_t i = 0; i < n; ++i)
+        if (!std::isnan(ex[i]) && ex[i] != 0) excluded[i] = 1;
+    }
+    step.update(0.5);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1 << 16), [&](const tbb::blocked_range<std::size_t>& range) {
+      for (std::size_t i = range.begin(); i < range.end(); ++i) {
+        const float z = dem[i];
+        const bool valid = !std::isnan(z);
+        const bool is_water = (valid && z <= options.sea_level_m) || (!valid && options.nodata_is_sea) ||
+                              (mask && !std::isnan((*mask)[i]) && (*mask)[i] != 0);
+        kind[i] = is_water ? water : valid ? land : unknown;
+      }
+    });
+    // Uninhabitable: water, too high, excluded, river beds, too steep (§4.2.2.2: the thresholds).
+    result.hydrometry = dem.like<float>(nan_f);
+    result.buildable = dem.like<std::uint8_t>(255);
+    result.buildable.nodata = 255;
+    tbb::parallel_for(tbb::blocked_range<int>(0, rows, 8), [&](const tbb::blocked_range<int>& range) {
+      for (int r = range.begin(); r < range.end(); ++r)
+        for (int x = 0; x < cols; ++x) {
+          const std::size_t i = dem.index(x, r);
+          if (kind[i] == unknown) continue;
+          const float hv = std::isnan(hydrometry[i]) ? 0.0f : std::clamp(hydrometry[i], 0.0f, 1.0f);
+          result.hydrometry[i] = kind[i] == water ? 0.0f : hv;
+          bool ok = kind[i] == land && dem[i] <= options.max_altitude_m && !excluded[i];
+          if (ok && options.river_bed_cap && hv > *options.river_bed_cap) ok = false;
+          if (ok && options.max_slope_deg && slope_deg(dem, metrics, x, r) > *options.max_slope_deg) ok = false;
+          result.buildable[i] = ok ? 1 : 0;
+        }
+    });
+  }
+
+  // The plain disc must hold at least the 4-neighbours: raise r_min to the largest cell step.
+  double largest_step = 0;
+  for (int r = 0; r < rows; ++r)
+    largest_step = std::max({largest_step, metrics.width_m[std::size_t(r)], metrics.height_m[std::size_t(r)],
+                             metrics.height_m[std::size_t(r) + 1]});
+  const double r_min = std::max(options.r_min_m, largest_step * (1 + 1e-9));
+  if (!(options.r_max_m > r_min))
+    throw bad_input("--r-max: must be larger than r_min (" + std::to_string(r_min) + " m once raised to the cell size)");
+  stats.r_min_m = r_min;
+  stats.r_max_m = options.r_max_m;
+  const DiscPlan inner(metrics, rows, r_min, options.ring_bands);
+  const DiscPlan outer(metrics, rows, options.r_max_m, options.ring_bands);
+  stats.ring_bands = std::max(inner.band_count(), outer.band_count());
+  stats.ring_exact = inner.exact() && outer.exact();
+
+  // Only land cells need characteristics: each row is worked on over its span of land only
+  // (a big saving on coastal tiles that are mostly sea, and on nodata borders).
+  const auto nrows = static_cast<std::size_t>(rows);
+  std::vector<int> span_lo(nrows, 0), span_hi(nrows, 0);
+  std::vector<std::uint8_t> row_unknown(nrows, 0), row_water(nrows, 0);
+  std::vector<float> row_zmin(nrows), row_zmax(nrows);
+  tbb::parallel_for(tbb::blocked_range<int>(0, rows, 8), [&](const tbb::blocked_range<int>& range) {
+    for (int r = range.begin(); r < range.end(); ++r) {
+      int lo = cols, hi = 0;
+      bool u = false, w = false;
+      float zmin = std::numeric_limits<float>::infinity(), zmax = -zmin;
+      for (int x = 0; x < cols; ++x) {
+        const std::size_t i = dem.index(x, r);
+        const std::uint8_t k = kind[i];
+        if (k == land) lo = std::min(lo, x), hi = x + 1, zmin = std::min(zmin, dem[i]), zmax = std::max(zmax, dem[i]);
+        u = u || k == unknown;
+        w = w || k == water;
+      }
+      span_lo[std::size_t(r)] = lo;
+      span_hi[std::size_t(r)] = std::max(lo, hi);
+      row_unknown[std::size_t(r)] = u, row_water[std::size_t(r)] = w;
+      row_zmin[std::size_t(r)] = zmin, row_zmax[std::size_t(r)] = zmax;
+    }
+  });
+  const bool any_unknown = std::find(row_unknown.begin(), row_unknown.end(), 1) != row_unknown.end();
+  const bool any_water = std::find(row_water.begin(), row_water.end(), 1) != row_water.end();
+  // Summed-area tables cover only the land's bounding box grown by the ring's reach: no cell
+  // outside it falls in the disc of a land cell.
+  Window win;
+  {
+    int r_lo = rows, r_hi = -1, c_lo = cols, c_hi = -1;
+    for (int r = 0; r < rows; ++r)
+      if (span_lo[std::size_t(r)] < span_hi[std::size_t(r)]) {
+        r_lo = std::min(r_lo, r), r_hi = r;
+        c_lo = std::min(c_lo, span_lo[std::size_t(r)]), c_hi = std::max(c_hi, span_hi[std::size_t(r)] - 1);
+      }
+    if (r_hi >= 0) {
+      const int ry = std::max(outer.reach_rows(), inner.reach_rows()), rx = std::max(outer.reach_cols(), inner.reach_cols());
+      win.y0 = std::max(0, r_lo - ry);
+      win.x0 = std::max(0, c_lo - rx);
+      win.rows = std::min(rows, r_hi + ry + 1) - win.y0;
+      win.cols = std::min(cols, c_hi + rx + 1) - win.x0;
+    }
+  }
+
+  // ---- plain: standard deviation of land altitudes within r_min ---------------------------
+  result.plain = dem.like<float>(nan_f);
+  {
+    ProgressStep step(progress, "density: plain");
+    // Altitudes are taken relative to the middle of their range to keep the squares small.
+    const float lo = *std::min_element(row_zmin.begin(), row_zmin.end());
+    const float hi = *std::max_element(row_zmax.begin(), row_zmax.end());
+    const double mid = lo <= hi ? 0.5 * (double(lo) + double(hi)) : 0.0;
+    // When every cell is land, land cells in a disc are counted by arithmetic instead.
+    const bool all_land = !any_water && !any_unknown;
+    const SummedArea<std::uint32_t> count = all_land ? SummedArea<std::uint32_t>()
+                                                     : SummedArea<std::uint32_t>(win, cols, [&](std::size_t i) { return std::uint32_t(kind[i] == land); });
+    const SummedArea<double> s1(win, cols, [&](std::size_t i) { return kind[i] == land ? double(dem[i]) - mid : 0.0; });
+    const SummedArea<double> s2(win, cols, [&](std::size_t i) {
+      const double d = kind[i] == land ? double(dem[i]) - mid : 0.0;
+      return d * d;
+    });
+    const double max_var = options.plain_max_variation_m;
+    for_rows(rows, step, [&](int r0, int r1) {
+      std::vector<std::uint32_t> a(std::size_t(cols), 0);
+      std::vector<double> b(static_cast<std::size_t>(cols)), c(static_cast<std::size_t>(cols));
+      for (int r = r0; r < r1; ++r) {
+        for (int x = 0; x < cols; ++x)
+          if (kind[dem.index(x, r)] == water) result.plain(x, r) = 0;
+        const int x0 = span_lo[std::size_t(r)], x1 = span_hi[std::size_t(r)];
+        if (x0 >= x1) continue;
+        std::fill(a.begin() + x0, a.begin() + x1, 0u);
+        std::fill(b.begin() + x0, b.begin() + x1, 0.0);
+        std::fill(c.begin() + x0, c.begin() + x1, 0.0);
+        if (all_land) add_disc_count_row(inner, cols, rows, r, +1, a.data(), x0, x1);
+        else add_disc_row(count, inner, r, +1, a.data(), x0, x1);
+        add_disc_row(s1, inner, r, +1, b.data(), x0, x1);
+        add_disc_row(s2, inner, r, +1, c.data(), x0, x1);
+        for (int x = x0; x < x1; ++x) {
+          const std::size_t i = dem.index(x, r);
+          if (kind[i] != land) continue;
+          const double k = a[std::size_t(x)];
+          const double mean = b[std::size_t(x)] / k;
+          const double sd = std::sqrt(std::max(0.0, c[std::size_t(x)] / k - mean * mean));
+          result.plain[i] = float(std::clamp(1.0 - sd / max_var, 0.0, 1.0));
+        }
+      }
+    });
+  }
+
+  // ---- coast and plateau: shares of the ring r_min..r_max ---------------------------------
+  result.coast = dem.like<float>(nan_f);
+  result.plateau = dem.like<float>(nan_f);
+  {
+    ProgressStep step(progress, "density: coast and plateau");
+    // Plateau ground "opposed to plains" (§4.2.1, point 3): altitude within the plateau range,
+    // weighted by how far it is from a plain (cliffs and slopes count, flat tops do not). The
+    // weight is quantised to `levels` steps so its sums stay exact integers in 32 bits.
+    const double levels = std::min(1024.0, std::floor(double(UINT32_MAX) / std::max(1.0, outer.max_cells())));
+    if (levels < 16) throw bad_input("--r-max: the ring holds too many cells for this grid (" + std::to_string(outer.max_cells()) + ")");
+    // An inland grid has no coast: its water sums are all 0 and need no table.
+    const SummedArea<std::uint32_t> wet = any_water ? SummedArea<std::uint32_t>(win, cols, [&](std::size_t i) { return std::uint32_t(kind[i] == water); })
+                                                    : SummedArea<std::uint32_t>();
+    // Without unknown cells every cell is known: count ring cells by arithmetic instead.
+    const SummedArea<std::uint32_t> known = any_unknown ? SummedArea<std::uint32_t>(win, cols, [&](std::size_t i) { return std::uint32_t(kind[i] != unknown); })
+                                                        : SummedArea<std::uint32_t>();
+    const SummedArea<std::uint32_t> high(win, cols, [&](std::size_t i) {
+      const float z = dem[i];
+      const bool in_range = kind[i] == land && z >= options.plateau_min_m && z <= options.plateau_max_m;
+      return in_range ? std::uint32_t(std::lround((1.0 - double(result.plain[i])) * levels)) : 0u;
+    });
+    for_rows(rows, step, [&](int r0, int r1) {
+      std::vector<std::uint32_t> w(static_cast<std::size_t>(cols)), k(static_cast<std::size_t>(cols)), h(static_cast<std::size_t>(cols));
+      for (int r = r0; r < r1; ++r) {
+        for (int x = 0; x < cols; ++x)
+          if (kind[dem.index(x, r)] == water) result.coast(x, r) = result.plateau(x, r) = 0;
+        const int x0 = span_lo[std::size_t(r)], x1 = span_hi[std::size_t(r)];
+        if (x0 >= x1) continue;
+        std::fill(w.begin() + x0, w.begin() + x1, 0u);
+        std::fill(k.begin() + x0, k.begin() + x1, 0u);
+        std::fill(h.begin() + x0, h.begin() + x1, 0u);
+        if (any_water) {
+          add_disc_row(wet, outer, r, +1, w.data(), x0, x1);
+          add_disc_row(wet, inner, r, -1, w.data(), x0, x1);
+        }
+        if (any_unknown) {
+          add_disc_row(known, outer, r, +1, k.data(), x0, x1);
+          add_disc_row(known, inner, r, -1, k.data(), x0, x1);
+        } else {
+          add_disc_count_row(outer, cols, rows, r, +1, k.data(), x0, x1);
+          add_disc_count_row(inner, cols, rows, r, -1, k.data(), x0, x1);
+        }
+        add_disc_row(high, outer, r, +1, h.data(), x0, x1);
+        add_disc_row(high, inner, r, -1, h.data(), x0, x1);
+        for (int x = x0; x < x1; ++x) {
+          const std::size_t i = dem.index(x, r);
+          if (kind[i] != land) continue;
+          const double total = k[std::size_t(x)];
+          // Band approximations can make a ring cell count slightly off: keep shares in [0,1].
+          result.coast[i] = total > 0 ? float(std::clamp(double(w[std::size_t(x)]) / total, 0.0, 1.0)) : 0.0f;
+          result.plateau[i] = total > 0 ? float(std::clamp(double(h[std::size_t(x)]) / levels / total, 0.0, 1.0)) : 0.0f;
+        }
+      }
+    });
+    divide_land_by_max(result.coast, kind, result.buildable);
+    divide_land_by_max(result.plateau, kind, result.buildable);
+  }
+
+  // ---- hydrometry, layers, buildable, combination -----------------------------------------
+  result.density = dem.like<float>(nan_f);
+  {
+    ProgressStep step(progress, "density: combine");
+    std::vector<Raster<float>> layers;
+    for (const auto& [path, weight] : options.layers) layers.push_back(read_layer(path, dem));
+    std::vector<double> weights(options.weights.begin(), options.weights.end());
+    for (const auto& [path, weight] : options.layers) weights.push_back(weight);
+    for_rows(rows, step, [&](int r0, int r1) {
+      std::vector<double> values(weights.size());
+      for (int r = r0; r < r1; ++r)
+        for (int x = 0; x < cols; ++x) {
+          const std::size_t i = dem.index(x, r);
+          if (kind[i] == unknown) continue;
+          if (result.buildable[i] != 1) {
+            result.density[i] = 0;
+            continue;
+          }
+          values[0] = result.coast[i];
+          values[1] = result.hydrometry[i];
+          values[2] = result.plateau[i];
+          values[3] = result.plain[i];
+          for (std::size_t l = 0; l < layers.size(); ++l) values[4 + l] = layers[l][i];
+          result.density[i] = float(combine(weights.data(), values.data(), weights.size()));
+        }
+    });
+  }
+
+  // ---- report figures: per-row partial sums added in row order (deterministic) -------------
+  std::vector<DensityStats> per_row(nrows);
+  std::vector<double> row_sum(nrows, 0.0);
+  tbb::parallel_for(tbb::blocked_range<int>(0, rows, 8), [&](const tbb::blocked_range<int>& range) {
+    for (int r = range.begin(); r < range.end(); ++r) {
+      DensityStats& t = per_row[std::size_t(r)];
+      for (int x = 0; x < cols; ++x) {
+        const std::size_t i = dem.index(x, r);
+        if (kind[i] != unknown) ++t.known_cells;
+        if (kind[i] == water) ++t.water_cells;
+        if (result.buildable[i] == 1) {
+          ++t.buildable_cells;
+          row_sum[std::size_t(r)] += result.density[i];
+          ++t.histogram[std::size_t(std::min(9, int(result.density[i] * 10)))];
+        }
+      }
+    }
+  });
+  double sum = 0;
+  for (int r = 0; r < rows; ++r) {
+    const DensityStats& t = per_row[std::size_t(r)];
+    stats.known_cells += t.known_cells;
+    stats.water_cells += t.water_cells;
+    stats.buildable_cells += t.buildable_cells;
+    for (std::size_t k = 0; k < 10; ++k) stats.histogram[k] += t.histogram[k];
+    sum += row_sum[std::size_t(r)];
+  }
+  stats.mean_density = stats.buildable_cells ? sum / double(stats.buildable_cells) : 0.0;
+  return result;
+}
+
+}  // namespace terrapolis::density

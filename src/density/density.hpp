@@ -1,0 +1,104 @@
+// The human population density model (MNDPH) of Belhadj 2007, §4.2: masks, four terrain
+// characteristics, user layers and their weighted combination into a raster in [0,1].
+// SPDX-License-Identifier: MIT
+#pragma once
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/progress.hpp"
+#include "core/raster.hpp"
+
+namespace terrapolis::density {
+
+/// Everything the density model needs besides the DEM and its hydrometry. Defaults are the
+/// thesis's (Belhadj 2007, §4.2.1 and §4.2.2.2, Corsica example) unless said otherwise.
+struct DensityOptions {
+  // ---- water -------------------------------------------------------------------------------
+  /// Cells at or below this altitude (metres) are water (SRTM seas are exactly 0 m).
+  double sea_level_m = 0.0;
+  /// Nodata cells are sea (SRTM/NZ coasts) rather than unknown.
+  bool nodata_is_sea = false;
+  /// Optional raster (any GDAL format, read with nearest resampling): non-zero cells are water.
+  std::string water_mask;
+
+  // ---- uninhabitable cells (density 0) -------------------------------------------------------
+  /// Cells above this altitude (metres) are uninhabitable (thesis: 4000 m, after Potosí, 3967 m).
+  double max_altitude_m = 4000.0;
+  /// Cells steeper than this (degrees, 0..90) are uninhabitable; unset: no slope limit.
+  std::optional<double> max_slope_deg;
+  /// Cells whose hydrometry (0..1) is above this are river beds, uninhabitable; unset: none.
+  std::optional<double> river_bed_cap;
+
+  // ---- radii ---------------------------------------------------------------------------------
+  /// Inner radius of the ring and radius of the plain disc, metres (a hamlet's radius). 500 m is
+  /// the thesis's Corsica radius step dr (one 500 m cell). Raised to the largest cell step of the
+  /// grid when smaller, so the plain disc always holds the 4-neighbours.
+  double r_min_m = 500.0;
+  /// Outer radius of the ring, metres (a large city's radius): 5 km, i.e. two million people by
+  /// the thesis's x = 400 r (§4.3.1.1). Must exceed r_min.
+  double r_max_m = 5000.0;
+  /// Rows per disc above which a disc is approximated by this many bands of rows (see DiscPlan).
+  int ring_bands = 16;
+
+  // ---- plateau and plain ---------------------------------------------------------------------
+  /// Altitudes (metres) of plateau ground: [plateau_min_m, plateau_max_m].
+  double plateau_min_m = 400.0, plateau_max_m = 4000.0;
+  /// Standard deviation of altitude (metres) within r_min at and above which a cell is no plain.
+  double plain_max_variation_m = 50.0;
+
+  // ---- combination ---------------------------------------------------------------------------
+  /// Weights of (coast, hydrometry, plateau, plain): negative repulsive, 0 neutral, positive attractive.
+  std::array<double, 4> weights{1, 1, 1.5, 0};
+  /// User rasters (any GDAL raster, resampled bilinearly to the DEM grid) and their weights.
+  std::vector<std::pair<std::string, double>> layers;
+  /// User exclusion rasters (nearest resampling): non-zero cells are uninhabitable.
+  std::vector<std::string> exclusions;
+};
+
+/// Figures for the calibration report.
+struct DensityStats {
+  std::size_t cells = 0;             ///< all cells of the grid
+  std::size_t known_cells = 0;       ///< cells that are land with data or water
+  std::size_t water_cells = 0;       ///< water cells
+  std::size_t buildable_cells = 0;   ///< habitable cells
+  std::array<std::size_t, 10> histogram{};  ///< buildable cells per density decile [0,0.1) .. [0.9,1]
+  double mean_density = 0.0;         ///< mean density over buildable cells
+  double r_min_m = 0.0, r_max_m = 0.0;  ///< radii actually used (r_min may have been raised)
+  int ring_bands = 0;                ///< largest number of bands per disc (rows when exact)
+  bool ring_exact = true;            ///< every disc was summed row by row
+};
+
+/// The model's rasters, all on the DEM's grid and CRS. Float rasters are in [0,1], NaN where the
+/// DEM has no data and the cell is not water; characteristics are 0 on water.
+struct DensityResult {
+  Raster<float> coast;       ///< share of water in the ring [r_min, r_max], divided by its maximum over land
+  Raster<float> plateau;     ///< share of rough plateau ground in the ring, divided by its maximum over land
+  Raster<float> plain;       ///< 1 - std(altitude within r_min) / plain_max_variation, clamped to [0,1]
+  Raster<float> hydrometry;  ///< the hydrometry used (input), 0 on water
+  Raster<float> density;     ///< the weighted combination, 0 where uninhabitable
+  Raster<std::uint8_t> buildable;  ///< 1 habitable, 0 uninhabitable (water, too high, too steep...), 255 nodata
+  DensityStats stats;
+};
+
+/// Maps sum_i P_i D_i (D_i in [0,1]) onto [0,1] by its exact bounds: with N = sum of negative
+/// weights and |P| = sum |P_i|, D = (sum_i P_i D_i - N) / |P|. Equals the thesis's sum P_i D_i /
+/// sum P_i when no weight is negative, and stays meaningful when sum P_i <= 0 (the thesis's
+/// (0, 1, -1.5, 0.3) sums to -0.2): a repulsive characteristic counts as the attractiveness of its
+/// absence, |P_i| (1 - D_i). Throws bad_input when every weight is 0.
+double combine(const double* weights, const double* values, std::size_t n);
+
+/// Computes the density model (Belhadj 2007, §4.2.1 and Fig. 4.2-4.3).
+/// `hydrometry` is on the DEM's grid, values in [0,1] (NaN read as 0). Deterministic whatever the
+/// thread count. Throws bad_input for inconsistent options or unreadable user rasters.
+DensityResult compute_density(const Dem& dem, const Raster<float>& hydrometry, const DensityOptions& options,
+                              Progress& progress);
+
+/// Describes each output for its metadata ("coast.tif" -> one line).
+std::string describe_output(const std::string& name);
+
+}  // namespace terrapolis::density
