@@ -8,6 +8,8 @@ namespace terrapolis::cli {
 std::vector<std::unique_ptr<Command>> all_commands() {
   std::vector<std::unique_ptr<Command>> commands;
   commands.push_back(make_info_command());
+  commands.push_back(make_sites_command());
+  commands.push_back(make_network_command());
   return commands;
 }
 

@@ -8,5 +8,7 @@
 namespace terrapolis::cli {
 
 std::unique_ptr<Command> make_info_command();
+std::unique_ptr<Command> make_sites_command();
+std::unique_ptr<Command> make_network_command();
 
 }  // namespace terrapolis::cli
