@@ -43,7 +43,8 @@ VectorLayer city_extents_layer(const SitesResult& result, const Crs& crs, int ve
   layer.name = "city_extents";
   layer.geometry = GeometryType::polygon;
   layer.crs = wgs84();
-  layer.fields = {{"id", FieldType::integer}, {"radius_m", FieldType::real}, {"class", FieldType::integer}, {"seed", FieldType::integer}};
+  layer.fields = {{"id", FieldType::integer}, {"radius_m", FieldType::real}, {"class", FieldType::integer}, {"depth", FieldType::integer},
+                  {"seed", FieldType::integer}};
   const CrsTransform to_lonlat(crs, wgs84());
   const Ellipsoid wgs84_ellipsoid;
   for (const Site& s : result.sites) {
@@ -57,7 +58,8 @@ VectorLayer city_extents_layer(const SitesResult& result, const Crs& crs, int ve
     f.values[0] = std::int64_t(s.id);
     f.values[1] = s.radius_m;
     f.values[2] = std::int64_t(s.radius_class);
-    f.values[3] = std::int64_t(result.seed);
+    f.values[3] = std::int64_t(s.depth);
+    f.values[4] = std::int64_t(result.seed);
     layer.features.push_back(std::move(f));
   }
   return layer;

@@ -14,7 +14,7 @@ namespace terrapolis::sites {
 /// depth (int) and seed (int, the placement's seed). Field names are a contract with the roads stage.
 VectorLayer cities_layer(const SitesResult& result, const Crs& crs);
 
-/// `city_extents`: each disc as a geodesic circle of `vertices` points (WGS 84), fields id, radius_m, class, seed.
+/// `city_extents`: each disc as a geodesic circle of `vertices` points (WGS 84), fields id, radius_m, class, depth, seed.
 VectorLayer city_extents_layer(const SitesResult& result, const Crs& crs, int vertices = 72);
 
 /// Sites from a cities layer (a planner's own or `cities_layer`'s): points with radius_m

@@ -8,6 +8,8 @@
 #include <limits>
 #include <numeric>
 #include <random>
+#include <string>
+#include <unordered_map>
 
 #include "core/error.hpp"
 #include "sites/sites.hpp"
@@ -107,6 +109,25 @@ class DiscTester {
   std::vector<std::uint16_t> row_gap_;
 };
 
+/// Cells whose centre lies strictly inside one of the discs of `sites` (the centre test of the
+/// inclusion rules).
+std::vector<std::uint8_t> covered_cells(const std::vector<Site>& sites, const GridDistance& distance, int cols, int rows) {
+  std::vector<std::uint8_t> covered(std::size_t(cols) * std::size_t(rows), 0);
+  for (const Site& s : sites) {
+    const double y0 = distance.northing(s.row);
+    for (int dir : {1, -1})
+      for (int r = dir == 1 ? s.row : s.row - 1; r >= 0 && r < rows; r += dir) {
+        const double dy = std::abs(distance.northing(r) - y0);
+        if (dy >= s.radius_m) break;
+        const double w = distance.width_between(s.row, r);
+        const int reach = int(std::sqrt(s.radius_m * s.radius_m - dy * dy) / w) + 1;
+        for (int c = std::max(0, s.col - reach); c <= std::min(cols - 1, s.col + reach); ++c)
+          if (distance(s.col, s.row, c, r) < s.radius_m) covered[std::size_t(r) * std::size_t(cols) + std::size_t(c)] = 1;
+      }
+  }
+  return covered;
+}
+
 }  // namespace
 
 SitesResult place_sites(const Raster<float>& density, const Raster<std::uint8_t>& buildable, const SitesOptions& options,
@@ -171,20 +192,23 @@ SitesResult place_sites(const Raster<float>& density, const Raster<std::uint8_t>
     return i;
   };
 
-  std::vector<Site> placed;
-  {
-    ProgressStep step(progress, "sites: growth");
-    int remaining = table.total();
+  // Growth (Algorithm 14) from candidate `next` on, with quota[] left, skipping candidates whose
+  // cell is `covered`; appends the sites to `out`. Disc tests run in parallel a batch ahead; the
+  // quota bookkeeping is sequential, in density order.
+  std::size_t next = 0;
+  std::unordered_map<std::uint32_t, std::size_t> rank_of;  // candidate cell -> position in density order
+  auto grow = [&](const std::vector<std::uint8_t>* covered, std::vector<Site>& out, ProgressStep& step) {
+    int remaining = std::accumulate(quota.begin(), quota.end(), 0);
     std::vector<int> limit;
     const std::size_t batch = 4096;
-    // Disc tests run in parallel a batch ahead; the quota bookkeeping is sequential, in density order.
-    for (std::size_t begin = 0; begin < m && remaining > 0; begin += batch) {
-      const std::size_t end = std::min(m, begin + batch);
+    while (next < m && remaining > 0) {
+      const std::size_t begin = next, end = std::min(m, begin + batch);
       limit.assign(end - begin, 0);
       tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, 16), [&](const tbb::blocked_range<std::size_t>& range) {
-        for (std::size_t k = range.begin(); k < range.end(); ++k) limit[k - begin] = clear_classes(pool[k]);
+        for (std::size_t k = range.begin(); k < range.end(); ++k)
+          limit[k - begin] = covered && (*covered)[pool[k]] ? 0 : clear_classes(pool[k]);
       });
-      for (std::size_t k = begin; k < end && remaining > 0; ++k) {
+      for (std::size_t k = begin; k < end && remaining > 0; ++k, next = k) {
         int j = limit[k - begin] - 1;
         while (j >= 0 && quota[std::size_t(j)] == 0) --j;  // the largest valid class with quota left
         if (j < 0) continue;                                 // supprimer(L_sites, S)
@@ -201,18 +225,47 @@ SitesResult place_sites(const Raster<float>& density, const Raster<std::uint8_t>
         s.radius_class = n - 1 - j;
         s.population = std::llround(options.people_per_m * s.radius_m);
         s.density = density[pool[k]];
-        placed.push_back(s);
+        rank_of[pool[k]] = k;
+        out.push_back(s);
       }
-      step.update(double(end) / double(m));
+      if (next < end && remaining > 0) next = end;
+      step.update(double(next) / double(m));
     }
-  }
+  };
+  // By radius, decreasing; equal radii keep the density order.
+  auto by_size = [&](const Site& a, const Site& b) {
+    if (a.radius_m != b.radius_m) return a.radius_m > b.radius_m;
+    return rank_of.at(std::uint32_t(a.row) * std::uint32_t(cols) + std::uint32_t(a.col)) <
+           rank_of.at(std::uint32_t(b.row) * std::uint32_t(cols) + std::uint32_t(b.col));
+  };
 
+  std::vector<Site> placed;
+  {
+    ProgressStep step(progress, "sites: growth");
+    grow(nullptr, placed, step);
+  }
   {
     ProgressStep step(progress, "sites: inclusions");
-    // By radius, decreasing; equal radii keep the density order (stable).
-    std::stable_sort(placed.begin(), placed.end(), [](const Site& a, const Site& b) { return a.radius_m > b.radius_m; });
+    std::sort(placed.begin(), placed.end(), by_size);
     result.sites = resolve_inclusions(placed, options.mode, distance, cols, rows);
     step.update(1.0);
+  }
+  // Refill (Belhadj §4.3.1.2 names it as the remedy for the imbalance left by the inclusion
+  // removal): the quota of removed sites goes back to the growth, which resumes on the
+  // candidates not reached yet, skipping those whose centre lies in a kept disc.
+  for (int round = 0; round < options.refill_rounds && next < m; ++round) {
+    std::vector<int> kept(static_cast<std::size_t>(n), 0);
+    for (const Site& s : result.sites) ++kept[std::size_t(n - 1 - s.radius_class)];
+    for (int i = 0; i < n; ++i) quota[std::size_t(i)] = table.classes[std::size_t(n - 1 - i)].quota - kept[std::size_t(i)];
+    if (std::accumulate(quota.begin(), quota.end(), 0) == 0) break;
+    ProgressStep step(progress, "sites: refill " + std::to_string(round + 1));
+    const std::vector<std::uint8_t> covered = covered_cells(result.sites, distance, cols, rows);
+    std::vector<Site> merged = result.sites;
+    const std::size_t before = merged.size();
+    grow(&covered, merged, step);
+    if (merged.size() == before) break;
+    std::sort(merged.begin(), merged.end(), by_size);
+    result.sites = resolve_inclusions(merged, options.mode, distance, cols, rows);
   }
   for (const Site& s : result.sites) ++table.classes[std::size_t(s.radius_class)].kept;
   result.quotas = table.classes;

@@ -29,6 +29,7 @@ void check_options(const SitesOptions& o) {
   if (!(std::isfinite(o.r_min_m) && o.r_min_m >= 0)) throw bad_input("sites: r_min must be >= 0 metres (0: automatic)");
   if (!(std::isfinite(o.r_max_m) && o.r_max_m >= 0)) throw bad_input("sites: r_max must be >= 0 metres (0: automatic)");
   if (o.candidates < 0) throw bad_input("sites: candidates must be >= 0 (0: automatic)");
+  if (o.refill_rounds < 0) throw bad_input("sites: refill rounds must be >= 0");
 }
 
 }  // namespace

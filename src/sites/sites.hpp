@@ -43,14 +43,18 @@ struct SitesOptions {
   /// distance transform in metres; perimeter: only the discrete circle of each radius, as the
   /// thesis's intersecte_seuil does (obstacles between two radii slip inside, its Fig. 4.5).
   enum class DiscTest { exact, perimeter } disc_test = DiscTest::exact;
+  /// Refill rounds after the inclusion removal: the quota of removed sites goes back to the
+  /// growth, which resumes on the candidates not reached yet whose centre is in no kept disc,
+  /// then inclusions are removed again. 0 is Algorithm 14 as printed (the imbalance stays).
+  int refill_rounds = 8;
 };
 
 /// One radius class of the quota table (Algorithm 13).
 struct QuotaClass {
   double radius_m = 0;  ///< class radius, metres
   int quota = 0;        ///< Q[i] = floor(f(g(radius)))
-  int placed = 0;       ///< sites given this class by the growth (never above quota)
-  int kept = 0;         ///< of those, sites left after inclusion removal
+  int placed = 0;       ///< sites given this class by the growth, all rounds (first round: never above quota)
+  int kept = 0;         ///< sites of this class in the result (never above quota)
 };
 
 /// The quota table: classes ordered from the largest radius (class 0) to the smallest.

@@ -77,7 +77,10 @@ void check_invariants(const fixtures::SitesScenario& s, const SitesResult& r, co
   std::vector<int> per_class(r.quotas.size(), 0);
   for (const Site& site : r.sites) ++per_class[std::size_t(site.radius_class)];
   for (std::size_t k = 0; k < r.quotas.size(); ++k) {
-    EXPECT_LE(r.quotas[k].placed, r.quotas[k].quota) << "class " << k;
+    EXPECT_LE(r.quotas[k].kept, r.quotas[k].quota) << "class " << k;
+    if (o.refill_rounds == 0) {
+      EXPECT_LE(r.quotas[k].placed, r.quotas[k].quota) << "class " << k;
+    }
     EXPECT_LE(r.quotas[k].kept, r.quotas[k].placed);
     EXPECT_EQ(r.quotas[k].kept, per_class[k]);
   }
@@ -139,14 +142,19 @@ bool same_sites(const std::vector<Site>& a, const std::vector<Site>& b) {
 TEST(Placement, CorsicaGeographicInvariants) {
   const auto s = fixtures::scenario_from_sample("gebco2022_15s_north_corsica_capcorse.asc");
   SilentProgress progress;
-  for (auto mode : {SitesOptions::Mode::paris, SitesOptions::Mode::manhattan}) {
+  for (auto [mode, refill] : {std::pair{SitesOptions::Mode::paris, 8}, {SitesOptions::Mode::manhattan, 8}, {SitesOptions::Mode::paris, 0}}) {
     SitesOptions o;
     o.seed = 7;
     o.mode = mode;
+    o.refill_rounds = refill;
     const SitesResult r = place_sites(s.density, s.buildable, o, progress);
     EXPECT_GT(r.sites.size(), 20u);
       EXPECT_EQ(r.dr_m, 462.0);  // 15" GEBCO at 43 N: cells 462.9 m north-south
     check_invariants(s, r, o, true);
+    if (refill == 0) {
+      const auto with_refill = [&] { SitesOptions f = o; f.refill_rounds = 8; return place_sites(s.density, s.buildable, f, progress); }();
+      EXPECT_GT(with_refill.sites.size(), r.sites.size()) << "refill adds sites";
+    }
     if (mode == SitesOptions::Mode::paris) {
       int children = 0;
       for (const Site& t : r.sites) children += t.parent >= 0;
