@@ -2,6 +2,7 @@
 // SPDX-License-Identifier: MIT
 #include <CLI/CLI.hpp>
 
+#include <chrono>
 #include <cstdio>
 
 #include "cli/command.hpp"
@@ -34,11 +35,17 @@ class NetworkCommand final : public Command {
     OutputDir outputs(out_, {"network.geojson"}, overwrite_);
     // Lengths are geodesic whatever the file's CRS: work in WGS 84 longitude/latitude.
     const Crs crs = wgs84();
+    const auto t0 = std::chrono::steady_clock::now();
     const VectorLayer layer = read_vector(cities_, crs);
     const std::vector<sites::Site> sites = sites::sites_from_layer(layer, cities_);
+    const auto t1 = std::chrono::steady_clock::now();
     const network::SiteGraph graph = network::build_network(sites, crs, options_, context.progress);
+    const auto t2 = std::chrono::steady_clock::now();
     const VectorLayer lines = network::network_layer(graph, sites, crs);
     outputs.write_all([&](std::size_t, const std::string& path, bool overwrite) { write_vector(path, lines, overwrite); });
+    const auto t3 = std::chrono::steady_clock::now();
+    const auto seconds = [](auto a, auto b) { return std::to_string(std::chrono::duration<double>(b - a).count()); };
+    context.log.detail("network: read " + seconds(t0, t1) + " s, network " + seconds(t1, t2) + " s, write " + seconds(t2, t3) + " s");
 
     std::size_t kept = 0, family = 0;
     double length = 0;

@@ -2,6 +2,7 @@
 // SPDX-License-Identifier: MIT
 #include <CLI/CLI.hpp>
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -69,6 +70,9 @@ class SitesCommand final : public Command {
     app.add_option("--r-min", options_.r_min_m, "Smallest radius, metres (0: the class step dr)")->check(CLI::NonNegativeNumber);
     app.add_option("--r-max", options_.r_max_m, "Radii run up to r_max - dr, metres (0: 1e6 people / 400 + dr)")->check(CLI::NonNegativeNumber);
     app.add_option("--dr-min", options_.dr_min_m, "Smallest class step, metres; dr = max(dr_min, cell size)")->capture_default_str();
+    app.add_option("--refill", options_.refill_rounds, "Rounds giving the quota of removed sites back to the growth (0: Algorithm 14 as printed)")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
     app.add_flag("--report", report_, "Print the quota table");
     app.add_flag("--overwrite", overwrite_, "Replace existing outputs");
   }
@@ -77,12 +81,18 @@ class SitesCommand final : public Command {
     options_.mode = mode_ == "manhattan" ? sites::SitesOptions::Mode::manhattan : sites::SitesOptions::Mode::paris;
     options_.disc_test = disc_test_ == "perimeter" ? sites::SitesOptions::DiscTest::perimeter : sites::SitesOptions::DiscTest::exact;
     OutputDir outputs(out_, {"cities.geojson", "city_extents.geojson"}, overwrite_);
+    const auto t0 = std::chrono::steady_clock::now();
     const DensityInputs in = read_density_dir(dir_);
+    const auto t1 = std::chrono::steady_clock::now();
     const sites::SitesResult result = sites::place_sites(in.density, in.buildable, options_, context.progress);
+    const auto t2 = std::chrono::steady_clock::now();
     const Crs& crs = in.density.georef().crs;
     const VectorLayer cities = sites::cities_layer(result, crs);
     const VectorLayer extents = sites::city_extents_layer(result, crs);
     outputs.write_all([&](std::size_t i, const std::string& path, bool overwrite) { write_vector(path, i == 0 ? cities : extents, overwrite); });
+    const auto t3 = std::chrono::steady_clock::now();
+    const auto seconds = [](auto a, auto b) { return std::to_string(std::chrono::duration<double>(b - a).count()); };
+    context.log.detail("sites: read " + seconds(t0, t1) + " s, placement " + seconds(t1, t2) + " s, write " + seconds(t2, t3) + " s");
 
     int roots = 0, placed = 0, quota = 0;
     for (const auto& s : result.sites) roots += s.parent < 0;

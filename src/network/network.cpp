@@ -14,6 +14,7 @@
 #include <limits>
 #include <numeric>
 #include <string>
+#include <tuple>
 
 #include "core/error.hpp"
 #include "core/geodesy.hpp"
@@ -74,23 +75,58 @@ void delaunay_edges(const std::vector<Point>& points, const std::vector<int>& me
   }
 }
 
-/// Dijkstra from `a` towards `b` over edges not removed and other than `skip`, cutting every
-/// path at `bound` metres. Returns the length of the shortest path under `bound`, or NaN.
+/// A lower bound, in metres, of the geodesic distance between two sites, cheap enough to
+/// evaluate at every node of a search. Projected CRS: the Euclidean distance. Geographic CRS:
+/// the great-circle angle between the geodetic positions times a(1 - e^2) = b^2/a, the smallest
+/// radius of curvature of the ellipsoid (its meridian radius at the equator): the ellipsoid's
+/// metric is at least that sphere's in every direction, so no path can be shorter.
+class DistanceBound {
+ public:
+  DistanceBound(const std::vector<sites::Site>& sites, const Crs& crs) : geographic_(crs.geographic) {
+    const double f = crs.ellipsoid.flattening();
+    radius_ = crs.ellipsoid.semi_major_m * (1 - f) * (1 - f) * (1 - 1e-9);
+    unit_ = crs.linear_unit_m * (1 - 1e-12);
+    for (const auto& s : sites) {
+      const double lat = s.y * M_PI / 180.0, lon = s.x * M_PI / 180.0;
+      nodes_.push_back(geographic_ ? Node{lat, lon, std::cos(lat)} : Node{s.x, s.y, 0});
+    }
+  }
+  double operator()(int u, int v) const {
+    const Node &p = nodes_[std::size_t(u)], &q = nodes_[std::size_t(v)];
+    if (!geographic_) return std::hypot(p.a - q.a, p.b - q.b) * unit_;
+    const double sin_dlat = std::sin(0.5 * (q.a - p.a)), sin_dlon = std::sin(0.5 * (q.b - p.b));
+    const double h = sin_dlat * sin_dlat + p.c * q.c * sin_dlon * sin_dlon;
+    return 2 * radius_ * std::asin(std::min(1.0, std::sqrt(h)));
+  }
+
+ private:
+  struct Node {
+    double a, b, c;  // lat, lon (radians), cos(lat); or x, y in CRS units
+  };
+  bool geographic_;
+  double radius_ = 0, unit_ = 1;
+  std::vector<Node> nodes_;
+};
+
+/// Shortest path from `a` to `b` over edges not removed and other than `skip`, cutting every
+/// path that cannot stay under `bound` metres: Belhadj's pruned Dijkstra, guided towards `b` by
+/// an admissible and consistent lower bound (A*), which prunes the same paths and more, and
+/// returns the same length. Returns the length of the shortest path under `bound`, or NaN.
 class DetourSearch {
  public:
   DetourSearch(int nodes, const std::vector<std::uint32_t>& offsets, const std::vector<std::pair<int, int>>& adjacency,
-               const std::vector<double>& length, const std::vector<char>& removed)
+               const std::vector<double>& length, const std::vector<char>& removed, const DistanceBound& lower_bound)
       : dist_(std::size_t(nodes), std::numeric_limits<double>::infinity()),
-        offsets_(offsets), adjacency_(adjacency), length_(length), removed_(removed) {}
+        offsets_(offsets), adjacency_(adjacency), length_(length), removed_(removed), lower_bound_(lower_bound) {}
 
   double operator()(int a, int b, int skip, double bound) {
     double found = kNaN;
     dist_[std::size_t(a)] = 0;
     touched_.push_back(a);
-    heap_.push_back({0.0, a});
+    heap_.push_back({lower_bound_(a, b), 0.0, a});
     while (!heap_.empty()) {
       std::pop_heap(heap_.begin(), heap_.end(), std::greater<>());
-      const auto [d, u] = heap_.back();
+      const auto [f, d, u] = heap_.back();
       heap_.pop_back();
       if (d > dist_[std::size_t(u)]) continue;
       if (u == b) {
@@ -101,12 +137,13 @@ class DetourSearch {
         const auto [v, e] = adjacency_[k];
         if (e == skip || removed_[std::size_t(e)]) continue;
         const double nd = d + length_[std::size_t(e)];
-        if (nd < bound && nd < dist_[std::size_t(v)]) {
-          if (dist_[std::size_t(v)] == std::numeric_limits<double>::infinity()) touched_.push_back(v);
-          dist_[std::size_t(v)] = nd;
-          heap_.push_back({nd, v});
-          std::push_heap(heap_.begin(), heap_.end(), std::greater<>());
-        }
+        if (nd >= bound || nd >= dist_[std::size_t(v)]) continue;
+        const double estimate = nd + lower_bound_(v, b);
+        if (estimate >= bound) continue;  // no path through v can stay under the bound
+        if (dist_[std::size_t(v)] == std::numeric_limits<double>::infinity()) touched_.push_back(v);
+        dist_[std::size_t(v)] = nd;
+        heap_.push_back({estimate, nd, v});
+        std::push_heap(heap_.begin(), heap_.end(), std::greater<>());
       }
     }
     for (int v : touched_) dist_[std::size_t(v)] = std::numeric_limits<double>::infinity();
@@ -118,11 +155,12 @@ class DetourSearch {
  private:
   std::vector<double> dist_;
   std::vector<int> touched_;
-  std::vector<std::pair<double, int>> heap_;
+  std::vector<std::tuple<double, double, int>> heap_;
   const std::vector<std::uint32_t>& offsets_;
   const std::vector<std::pair<int, int>>& adjacency_;
   const std::vector<double>& length_;
   const std::vector<char>& removed_;
+  const DistanceBound& lower_bound_;
 };
 
 void check_sites(const std::vector<sites::Site>& sites) {
@@ -267,7 +305,8 @@ SiteGraph build_network(const std::vector<sites::Site>& sites, const Crs& crs, c
   {
     ProgressStep step(progress, "network: simplification");
     std::vector<char> removed(m, 0);
-    DetourSearch search(n, offsets, adjacency, length, removed);
+    const DistanceBound lower_bound(sites, crs);
+    DetourSearch search(n, offsets, adjacency, length, removed, lower_bound);
     for (std::size_t k = 0; k < order.size(); ++k) {
       const int e = order[k];
       Edge& edge = graph.edges[std::size_t(e)];
