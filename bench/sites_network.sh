@@ -38,6 +38,7 @@ for tile in S46W066 N47E009; do
   read -r s mb < <(measure "$BIN" --progress none sites "$T/$tile/in" "$T/$tile/out" --overwrite)
   summary=$("$BIN" --progress none sites "$T/$tile/in" "$T/$tile/out" --overwrite)
   printf "%-28s %10s %10s  %s\n" "sites $tile" "$s" "$mb" "${summary#sites: }"
+  "$BIN" -v --progress none sites "$T/$tile/in" "$T/$tile/out" --overwrite 2>&1 >/dev/null | sed 's/^/  phases (one run): /' 
   read -r s mb < <(measure "$BIN" --progress none network "$T/$tile/out/cities.geojson" "$T/$tile/out" --overwrite)
   summary=$("$BIN" --progress none network "$T/$tile/out/cities.geojson" "$T/$tile/out" --overwrite)
   printf "%-28s %10s %10s  %s\n" "network $tile" "$s" "$mb" "${summary#network: }"
@@ -61,6 +62,7 @@ awk 'BEGIN {
 read -r s mb < <(measure "$BIN" --progress none network "$T/random100k.geojson" "$T/r" --overwrite)
 summary=$("$BIN" --progress none network "$T/random100k.geojson" "$T/r" --overwrite)
 printf "%-28s %10s %10s  %s\n" "network 100k random" "$s" "$mb" "${summary#network: }"
+"$BIN" -v --progress none network "$T/random100k.geojson" "$T/r" --overwrite 2>&1 >/dev/null | sed 's/^/  phases (one run): /' 
 ours=$s
 read -r s mb < <(measure ogrinfo -q -dialect sqlite -sql \
   "select ST_NumGeometries(ST_DelaunayTriangulation(ST_Collect(geometry), 1)) as edges from random100k" "$T/random100k.geojson")

@@ -16,7 +16,7 @@ gdal_calc.py --quiet -A "$DEM" --outfile "$T/in/density.tif" --type Float32 --ca
 # Frame: the cities' extent plus a margin.
 read -r x0 x1 y0 y1 < <(ogrinfo -so -al "$T/out/city_extents.geojson" | sed -n 's/^Extent: (\(.*\), \(.*\)) - (\(.*\), \(.*\))/\1 \3 \2 \4/p')
 read -r x0 y0 x1 y1 < <(awk -v a="$x0" -v b="$y0" -v c="$x1" -v d="$y1" 'BEGIN { m = 0.08 * (c - a); print a - m, b - m, c + m, d + m }')
-gdalwarp -q -t_srs EPSG:4326 -te "$x0" "$y0" "$x1" "$y1" -ts 640 0 -r bilinear "$DEM" "$T/dem.tif"
+gdalwarp -q -t_srs EPSG:4326 -te "$x0" "$y0" "$x1" "$y1" -ts 560 0 -r bilinear "$DEM" "$T/dem.tif"
 gdaldem hillshade -q -z 3 -s 111120 "$T/dem.tif" "$T/hs.tif"
 gdal_calc.py --quiet -A "$T/dem.tif" --outfile "$T/sea.tif" --type Byte --calc "A<=0"
 for band in "r:150:0.55:100" "g:185:0.55:95" "b:215:0.5:70"; do

@@ -45,7 +45,8 @@ DensityInputs read_density_dir(const std::string& dir) {
     if (std::abs(header.georef.transform[std::size_t(k)] - in.density.georef().transform[std::size_t(k)]) >
         1e-9 * std::max(1.0, std::abs(in.density.georef().transform[std::size_t(k)])))
       throw bad_input(buildable_path + ": not on the grid of density.tif (different geotransform)");
-  const Raster<float> mask = read_resampled(buildable_path, in.density.georef(), in.density.cols(), in.density.rows(), Resampling::nearest);
+  // Same grid (checked above): read the mask as is, nodata as NaN, without warping.
+  const Raster<float> mask = read_dem(buildable_path);
   in.buildable = in.density.like<std::uint8_t>(0);
   for (std::size_t i = 0; i < mask.size(); ++i) in.buildable[i] = mask[i] == 1.0f ? 1 : 0;  // nodata (NaN) is not buildable
   return in;
