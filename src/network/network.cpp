@@ -172,11 +172,13 @@ void check_sites(const std::vector<sites::Site>& sites) {
     if (s.parent < -1 || s.parent >= n || s.parent == i)
       throw bad_input("network: site " + std::to_string(s.id) + " has a parent that is not another site");
   }
-  // Every chain of parents must reach a root within n steps, else it loops.
+  // Every chain of parents must reach a root, else it loops: walk each chain once (linear time).
+  std::vector<char> state(sites.size(), 0);  // 0 unseen, 1 on the current chain, 2 reaches a root
   for (int i = 0; i < n; ++i) {
-    int p = i, steps = 0;
-    while (p >= 0 && steps <= n) p = sites[std::size_t(p)].parent, ++steps;
-    if (p >= 0) throw bad_input("network: the parents of site " + std::to_string(sites[std::size_t(i)].id) + " form a cycle");
+    int p = i;
+    while (p >= 0 && state[std::size_t(p)] == 0) state[std::size_t(p)] = 1, p = sites[std::size_t(p)].parent;
+    if (p >= 0 && state[std::size_t(p)] == 1) throw bad_input("network: the parents of site " + std::to_string(sites[std::size_t(p)].id) + " form a cycle");
+    for (p = i; p >= 0 && state[std::size_t(p)] == 1; p = sites[std::size_t(p)].parent) state[std::size_t(p)] = 2;
   }
   std::vector<int> order(sites.size());
   std::iota(order.begin(), order.end(), 0);

@@ -2,6 +2,9 @@
 // SPDX-License-Identifier: MIT
 #include "sites/layers.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <cmath>
 #include <map>
 #include <optional>
@@ -46,22 +49,28 @@ VectorLayer city_extents_layer(const SitesResult& result, const Crs& crs, int ve
   layer.fields = {{"id", FieldType::integer}, {"radius_m", FieldType::real}, {"class", FieldType::integer}, {"depth", FieldType::integer},
                   {"seed", FieldType::integer}};
   const CrsTransform to_lonlat(crs, wgs84());
+  std::vector<std::array<double, 2>> centres;
+  for (const Site& s : result.sites) centres.push_back(to_lonlat(s.x, s.y));
   const Ellipsoid wgs84_ellipsoid;
-  for (const Site& s : result.sites) {
-    const auto centre = to_lonlat(s.x, s.y);
-    std::vector<std::array<double, 2>> ring;
-    for (int k = 0; k <= vertices; ++k)  // clockwise from north, closed
-      ring.push_back(k == vertices ? ring.front() : geodesic_destination(wgs84_ellipsoid, centre[0], centre[1], 360.0 * k / vertices, s.radius_m));
-    Feature f;
-    f.parts = {ring};
-    f.values.resize(layer.fields.size());
-    f.values[0] = std::int64_t(s.id);
-    f.values[1] = s.radius_m;
-    f.values[2] = std::int64_t(s.radius_class);
-    f.values[3] = std::int64_t(s.depth);
-    f.values[4] = std::int64_t(result.seed);
-    layer.features.push_back(std::move(f));
-  }
+  layer.features.resize(result.sites.size());
+  // Each circle is independent (and the geodesic problems are the cost): in parallel.
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, result.sites.size(), 64), [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t i = range.begin(); i < range.end(); ++i) {
+      const Site& s = result.sites[i];
+      std::vector<std::array<double, 2>> ring;
+      for (int k = 0; k < vertices; ++k)  // clockwise from north
+        ring.push_back(geodesic_destination(wgs84_ellipsoid, centres[i][0], centres[i][1], 360.0 * k / vertices, s.radius_m));
+      ring.push_back(ring.front());
+      Feature& f = layer.features[i];
+      f.parts = {ring};
+      f.values.resize(layer.fields.size());
+      f.values[0] = std::int64_t(s.id);
+      f.values[1] = s.radius_m;
+      f.values[2] = std::int64_t(s.radius_class);
+      f.values[3] = std::int64_t(s.depth);
+      f.values[4] = std::int64_t(result.seed);
+    }
+  });
   return layer;
 }
 
