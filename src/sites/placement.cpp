@@ -228,7 +228,6 @@ SitesResult place_sites(const Raster<float>& density, const Raster<std::uint8_t>
         rank_of[pool[k]] = k;
         out.push_back(s);
       }
-      if (next < end && remaining > 0) next = end;
       step.update(double(next) / double(m));
     }
   };

@@ -264,3 +264,23 @@ TEST(Network, BadInputs) {
   EXPECT_EQ(g.edges.size(), 3u);
   check_network(line, metres_crs(), g, 1.8);
 }
+
+// Geographic CRS far north, where the plane of the triangulations is most distorted and the
+// A* lower bound (great circle on the b^2/a sphere) is tightest: decisions equal an unpruned
+// Dijkstra's on geodesic lengths.
+TEST(Network, HighLatitudeGeographicReplay) {
+  Crs crs;
+  crs.wkt = "GEOGCS[\"WGS 84\"]";
+  crs.geographic = true;
+  std::mt19937_64 rng(9);
+  std::uniform_real_distribution<double> lon(20, 23), lat(69, 70), r(100, 3000);
+  std::vector<Site> s;
+  for (int i = 0; i < 300; ++i) s.push_back(site(lon(rng), lat(rng), r(rng), i >= 200 ? i % 50 : -1));
+  s = numbered(s);
+  SilentProgress progress;
+  const SiteGraph g = build_network(s, crs, {}, progress);
+  check_network(s, crs, g, 1.8);
+  NetworkOptions loose;
+  loose.k = 3.0;
+  check_network(s, crs, build_network(s, crs, loose, progress), 3.0);
+}
