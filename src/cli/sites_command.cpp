@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 
 #include "cli/command.hpp"
 #include "cli/commands_list.hpp"
@@ -60,7 +61,10 @@ class SitesCommand final : public Command {
   void setup(CLI::App& app) override {
     app.add_option("DENSITY_DIR", dir_, "Folder holding density.tif (float, [0,1]) and buildable.tif (1 = buildable) on the DEM grid")->required();
     app.add_option("OUTDIR", out_, "Output folder: cities.geojson, city_extents.geojson")->required();
-    app.add_option("--seed", options_.seed, "Seed of the candidate draw; recorded in the outputs")->capture_default_str();
+    // The seed is recorded as a 64-bit signed integer field: keep it in that range.
+    app.add_option("--seed", options_.seed, "Seed of the candidate draw (0 .. 2^63-1); recorded in the outputs")
+        ->check(CLI::Range(std::uint64_t(0), std::uint64_t(std::numeric_limits<std::int64_t>::max())))
+        ->capture_default_str();
     app.add_option("--mode", mode_, "Inclusions: paris keeps half-size suburbs (radio-concentric), manhattan removes every inclusion")
         ->check(CLI::IsMember({"paris", "manhattan"}))
         ->capture_default_str();

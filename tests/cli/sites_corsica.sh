@@ -74,6 +74,7 @@ mkdir "$T/half"
 cp "$T/in/density.tif" "$T/half/"
 expect_fail "$T/x2" "buildable.tif" "$T/half"
 expect_fail "$T/x3" "r_max" "$T/in" --r-min 3000 --r-max 3100
+expect_fail "$T/x5" "seed" "$T/in" --seed 18446744073709551615
 gdal_calc.py --quiet -A "$DEM" --outfile "$T/half/buildable.tif" --type Byte --calc "A*0"
 expect_fail "$T/x4" "no buildable cell" "$T/half"
 echo OK
