@@ -12,6 +12,8 @@ std::vector<std::unique_ptr<Command>> all_commands() {
   commands.push_back(make_hydro_command());
   commands.push_back(make_catchment_command());
   commands.push_back(make_density_command());
+  commands.push_back(make_sites_command());
+  commands.push_back(make_network_command());
   commands.push_back(make_run_command());
   commands.push_back(make_compare_command());
   return commands;

@@ -14,5 +14,7 @@ std::unique_ptr<Command> make_run_command();
 std::unique_ptr<Command> make_compare_command();
 std::unique_ptr<Command> make_hydro_command();
 std::unique_ptr<Command> make_catchment_command();
+std::unique_ptr<Command> make_sites_command();
+std::unique_ptr<Command> make_network_command();
 
 }  // namespace terrapolis::cli

@@ -1,0 +1,71 @@
+// `terrapolis network CITIES OUTDIR`: the agglomeration network joining the cities (Belhadj §4.3.2).
+// SPDX-License-Identifier: MIT
+#include <CLI/CLI.hpp>
+
+#include <chrono>
+#include <cstdio>
+
+#include "cli/command.hpp"
+#include "cli/commands_list.hpp"
+#include "cli/output_dir.hpp"
+#include "io/crs.hpp"
+#include "io/vector_io.hpp"
+#include "network/layers.hpp"
+#include "network/network.hpp"
+#include "sites/layers.hpp"
+
+namespace terrapolis::cli {
+namespace {
+
+class NetworkCommand final : public Command {
+ public:
+  std::string name() const override { return "network"; }
+  std::string summary() const override { return "Join cities by a simplified union of Delaunay triangulations (Belhadj §4.3.2)"; }
+
+  void setup(CLI::App& app) override {
+    app.add_option("CITIES", cities_, "City points with radius_m (metres), optional id and parent (e.g. cities.geojson from `sites`)")->required();
+    app.add_option("OUTDIR", out_, "Output folder: network.geojson")->required();
+    app.add_option("--k", options_.k, "Detour factor (> 1): an edge goes when another path is shorter than k x its length")
+        ->capture_default_str();
+    app.add_flag("--overwrite", overwrite_, "Replace existing outputs");
+  }
+
+  void run(Context& context) override {
+    if (!(options_.k > 1)) throw bad_input("--k: must be greater than 1");
+    OutputDir outputs(out_, {"network.geojson"}, overwrite_);
+    // Lengths are geodesic whatever the file's CRS: work in WGS 84 longitude/latitude.
+    const Crs crs = wgs84();
+    const auto t0 = std::chrono::steady_clock::now();
+    const VectorLayer layer = read_vector(cities_, crs);
+    const std::vector<sites::Site> sites = sites::sites_from_layer(layer, cities_);
+    const auto t1 = std::chrono::steady_clock::now();
+    const network::SiteGraph graph = network::build_network(sites, crs, options_, context.progress);
+    const auto t2 = std::chrono::steady_clock::now();
+    const VectorLayer lines = network::network_layer(graph, sites, crs);
+    outputs.write_all([&](std::size_t, const std::string& path, bool overwrite) { write_vector(path, lines, overwrite); });
+    const auto t3 = std::chrono::steady_clock::now();
+    const auto seconds = [](auto a, auto b) { return std::to_string(std::chrono::duration<double>(b - a).count()); };
+    context.log.detail("network: read " + seconds(t0, t1) + " s, network " + seconds(t1, t2) + " s, write " + seconds(t2, t3) + " s");
+
+    std::size_t kept = 0, family = 0;
+    double length = 0;
+    for (const auto& e : graph.edges) {
+      kept += e.kept;
+      family += e.kind == network::EdgeKind::parent_child;
+      if (e.kept) length += e.length_m;
+    }
+    std::printf("network: %zu cities, %zu candidate edges, %zu kept (%zu parent-child), %.1f km of links, k %.2f\n", sites.size(),
+                graph.edges.size(), kept, family, length / 1000.0, options_.k);
+  }
+
+ private:
+  std::string cities_, out_;
+  network::NetworkOptions options_;
+  bool overwrite_ = false;
+};
+
+}  // namespace
+
+std::unique_ptr<Command> make_network_command() { return std::make_unique<NetworkCommand>(); }
+
+}  // namespace terrapolis::cli

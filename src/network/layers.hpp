@@ -1,0 +1,17 @@
+// The network as a vector layer of line strings.
+// SPDX-License-Identifier: MIT
+#pragma once
+#include <vector>
+
+#include "io/vector_io.hpp"
+#include "network/network.hpp"
+
+namespace terrapolis::network {
+
+/// `network`: every candidate edge as a two-point LineString in `crs` (the sites' CRS), with
+/// fields from, to (int, the sites' ids), kind (inter_urban | parent_child | all_sites), kept
+/// (int 0/1), length_m (real, geodesic metres) and detour_ratio (real, null when no detour
+/// under k x length was found). Field names are a contract with the roads stage.
+VectorLayer network_layer(const SiteGraph& graph, const std::vector<sites::Site>& sites, const Crs& crs);
+
+}  // namespace terrapolis::network

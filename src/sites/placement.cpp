@@ -1,0 +1,274 @@
+// Placement of the sites: seeded candidates, disc growth under quotas (Belhadj 2007, §4.3.1.2, Algorithm 14).
+// SPDX-License-Identifier: MIT
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <random>
+#include <string>
+#include <unordered_map>
+
+#include "core/error.hpp"
+#include "sites/sites.hpp"
+
+namespace terrapolis::sites {
+namespace {
+
+/// Uniform integer in [0, n) from a 64-bit generator, by rejection: unlike
+/// std::uniform_int_distribution its output is the same with every standard library.
+std::uint64_t bounded(std::mt19937_64& generator, std::uint64_t n) {
+  const std::uint64_t threshold = (0 - n) % n;  // 2^64 mod n
+  std::uint64_t x;
+  do x = generator();
+  while (x < threshold);
+  return x % n;
+}
+
+constexpr std::uint16_t kFar = std::numeric_limits<std::uint16_t>::max();
+
+/// The disc tests of Algorithm 14 (intersecte_seuil), for discs centred on cell centres.
+/// A disc of radius r touches a cell when the cell's centre is within r metres of its centre.
+class DiscTester {
+ public:
+  DiscTester(const std::vector<std::uint8_t>& habitable, int cols, int rows, const GridDistance& distance)
+      : habitable_(habitable), cols_(cols), rows_(rows), distance_(distance) {}
+
+  /// Row pass of a separable distance transform: for every cell, the number of columns to
+  /// the nearest uninhabitable cell of its row (the columns just outside the grid count as
+  /// uninhabitable), capped at 65535. The column pass is evaluated exactly, per candidate,
+  /// in clear_distance_m.
+  void build_row_pass() {
+    row_gap_.assign(habitable_.size(), kFar);
+    tbb::parallel_for(tbb::blocked_range<int>(0, rows_), [&](const tbb::blocked_range<int>& range) {
+      for (int r = range.begin(); r < range.end(); ++r) {
+        const std::size_t base = std::size_t(r) * std::size_t(cols_);
+        long last = -1;  // the virtual column west of the grid
+        for (int c = 0; c < cols_; ++c) {
+          if (!habitable_[base + std::size_t(c)]) last = c;
+          row_gap_[base + std::size_t(c)] = std::uint16_t(std::min<long>(c - last, kFar));
+        }
+        last = cols_;  // the virtual column east of the grid
+        for (int c = cols_ - 1; c >= 0; --c) {
+          if (!habitable_[base + std::size_t(c)]) last = c;
+          auto& g = row_gap_[base + std::size_t(c)];
+          g = std::uint16_t(std::min<long>({long(g), last - c, long(kFar)}));
+        }
+      }
+    });
+  }
+
+  /// Metres from the centre of (c0,r0) to the nearest uninhabitable cell centre (rows and
+  /// columns just outside the grid included), or `cap` if none is nearer. Rows are visited
+  /// outwards and the search stops once the north-south distance alone reaches the best found.
+  double clear_distance_m(int c0, int r0, double cap) const {
+    double best = cap;
+    const double y0 = distance_.northing(r0);
+    for (int dir : {1, -1}) {
+      for (int d = (dir == 1 ? 0 : 1);; ++d) {
+        const int r = r0 + dir * d;
+        const double dy = std::abs(distance_.northing(r) - y0);
+        if (dy >= best) break;
+        if (r < 0 || r >= rows_) {  // a whole virtual row of uninhabitable cells
+          best = dy;
+          break;
+        }
+        const double gap = row_gap_[std::size_t(r) * std::size_t(cols_) + std::size_t(c0)];
+        const double dx = gap * distance_.width_between(r0, r);
+        best = std::min(best, std::sqrt(dx * dx + dy * dy));
+      }
+    }
+    return best;
+  }
+
+  /// True when the discrete circle of radius `radius_m` around (c0,r0) crosses an
+  /// uninhabitable cell or leaves the grid: the thesis's intersecte_seuil, sampled at least
+  /// every half cell along the circle so that the discrete circle has no gaps.
+  bool circle_hits(int c0, int r0, double radius_m) const {
+    const CellMetrics& m = distance_.metrics();
+    const double h = m.height_m[std::size_t(r0)];
+    const double step = 0.5 * std::min(m.width_m[std::size_t(r0)], h);
+    const int samples = std::max(16, int(std::ceil(2 * M_PI * radius_m / step)));
+    for (int k = 0; k < samples; ++k) {
+      const double theta = 2 * M_PI * k / samples;
+      const double north = radius_m * std::cos(theta), east = radius_m * std::sin(theta);
+      const int r = r0 - int(std::lround(north / h));
+      const int c = c0 + int(std::lround(east / distance_.width_between(r0, r)));
+      if (c < 0 || r < 0 || c >= cols_ || r >= rows_) return true;
+      if (!habitable_[std::size_t(r) * std::size_t(cols_) + std::size_t(c)]) return true;
+    }
+    return false;
+  }
+
+ private:
+  const std::vector<std::uint8_t>& habitable_;
+  int cols_, rows_;
+  const GridDistance& distance_;
+  std::vector<std::uint16_t> row_gap_;
+};
+
+/// Cells whose centre lies strictly inside one of the discs of `sites` (the centre test of the
+/// inclusion rules).
+std::vector<std::uint8_t> covered_cells(const std::vector<Site>& sites, const GridDistance& distance, int cols, int rows) {
+  std::vector<std::uint8_t> covered(std::size_t(cols) * std::size_t(rows), 0);
+  for (const Site& s : sites) {
+    const double y0 = distance.northing(s.row);
+    for (int dir : {1, -1})
+      for (int r = dir == 1 ? s.row : s.row - 1; r >= 0 && r < rows; r += dir) {
+        const double dy = std::abs(distance.northing(r) - y0);
+        if (dy >= s.radius_m) break;
+        const double w = distance.width_between(s.row, r);
+        const int reach = int(std::sqrt(s.radius_m * s.radius_m - dy * dy) / w) + 1;
+        for (int c = std::max(0, s.col - reach); c <= std::min(cols - 1, s.col + reach); ++c)
+          if (distance(s.col, s.row, c, r) < s.radius_m) covered[std::size_t(r) * std::size_t(cols) + std::size_t(c)] = 1;
+      }
+  }
+  return covered;
+}
+
+}  // namespace
+
+SitesResult place_sites(const Raster<float>& density, const Raster<std::uint8_t>& buildable, const SitesOptions& options,
+                        Progress& progress) {
+  const int cols = density.cols(), rows = density.rows();
+  if (buildable.cols() != cols || buildable.rows() != rows)
+    throw bad_input("sites: the buildable mask and the density model are not on the same grid");
+  if (cols < 1 || rows < 1) throw bad_input("sites: empty density grid");
+  const GridDistance distance(density.georef(), cols, rows);
+  const CellMetrics& metrics = distance.metrics();
+  // The DEM's scale e of Algorithm 13 (1/e = metres per cell): the coarser side of a cell at the centre row.
+  const int centre = rows / 2;
+  const double cell_size = std::max(metrics.width_m[std::size_t(centre)], metrics.height_m[std::size_t(centre)]);
+  QuotaTable table = compute_quotas(cell_size, options);
+  const int n = int(table.classes.size());
+  // Ascending radius index i of Algorithm 14 (r = r_min + i dr); class = n - 1 - i.
+  std::vector<double> radius(static_cast<std::size_t>(n));
+  std::vector<int> quota(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    radius[std::size_t(i)] = table.classes[std::size_t(n - 1 - i)].radius_m;
+    quota[std::size_t(i)] = table.classes[std::size_t(n - 1 - i)].quota;
+  }
+
+  SitesResult result;
+  result.dr_m = table.dr_m;
+  result.seed = options.seed;
+
+  // Habitable cells: buildable == 1 with a density value.
+  std::vector<std::uint8_t> habitable(density.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, density.size(), 1 << 16), [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t i = range.begin(); i < range.end(); ++i)
+      habitable[i] = buildable[i] == 1 && !buildable.is_nodata(i) && std::isfinite(density[i]);
+  });
+  std::vector<std::uint32_t> pool;
+  if (density.size() > std::numeric_limits<std::uint32_t>::max()) throw bad_input("sites: grid larger than 2^32 cells");
+  for (std::size_t i = 0; i < habitable.size(); ++i)
+    if (habitable[i]) pool.push_back(std::uint32_t(i));
+  if (pool.empty()) throw bad_input("sites: no buildable cell in the density model");
+
+  // Draw M distinct candidates uniformly among buildable cells (partial Fisher-Yates).
+  const std::int64_t wanted = options.candidates > 0 ? std::int64_t(options.candidates) : 20 * std::int64_t(table.total());
+  const std::size_t m = std::size_t(std::clamp<std::int64_t>(wanted, 1, std::int64_t(pool.size())));
+  std::mt19937_64 generator(options.seed);
+  for (std::size_t k = 0; k < m; ++k) std::swap(pool[k], pool[k + bounded(generator, pool.size() - k)]);
+  pool.resize(m);
+  result.candidates = int(m);
+  // By density, decreasing; equal densities keep the draw order, itself random.
+  std::stable_sort(pool.begin(), pool.end(), [&](std::uint32_t a, std::uint32_t b) { return density[a] > density[b]; });
+
+  DiscTester tester(habitable, cols, rows, distance);
+  if (options.disc_test == SitesOptions::DiscTest::exact) tester.build_row_pass();
+  const double cap = radius.back() + 1.0;
+  // Number of leading classes whose disc is clear: the growth stops at the first intersection.
+  auto clear_classes = [&](std::uint32_t cell) {
+    const int c = int(cell % std::uint32_t(cols)), r = int(cell / std::uint32_t(cols));
+    if (options.disc_test == SitesOptions::DiscTest::exact) {
+      const double d = tester.clear_distance_m(c, r, cap);
+      return int(std::lower_bound(radius.begin(), radius.end(), d) - radius.begin());  // classes with radius < d
+    }
+    int i = 0;
+    while (i < n && !tester.circle_hits(c, r, radius[std::size_t(i)])) ++i;
+    return i;
+  };
+
+  // Growth (Algorithm 14) from candidate `next` on, with quota[] left, skipping candidates whose
+  // cell is `covered`; appends the sites to `out`. Disc tests run in parallel a batch ahead; the
+  // quota bookkeeping is sequential, in density order.
+  std::size_t next = 0;
+  std::unordered_map<std::uint32_t, std::size_t> rank_of;  // candidate cell -> position in density order
+  auto grow = [&](const std::vector<std::uint8_t>* covered, std::vector<Site>& out, ProgressStep& step) {
+    int remaining = std::accumulate(quota.begin(), quota.end(), 0);
+    std::vector<int> limit;
+    const std::size_t batch = 4096;
+    while (next < m && remaining > 0) {
+      const std::size_t begin = next, end = std::min(m, begin + batch);
+      limit.assign(end - begin, 0);
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, 16), [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t k = range.begin(); k < range.end(); ++k)
+          limit[k - begin] = covered && (*covered)[pool[k]] ? 0 : clear_classes(pool[k]);
+      });
+      for (std::size_t k = begin; k < end && remaining > 0; ++k, next = k) {
+        int j = limit[k - begin] - 1;
+        while (j >= 0 && quota[std::size_t(j)] == 0) --j;  // the largest valid class with quota left
+        if (j < 0) continue;                                 // supprimer(L_sites, S)
+        --quota[std::size_t(j)];
+        --remaining;
+        ++table.classes[std::size_t(n - 1 - j)].placed;
+        Site s;
+        s.col = int(pool[k] % std::uint32_t(cols));
+        s.row = int(pool[k] / std::uint32_t(cols));
+        const auto xy = density.georef().cell_centre(s.col, s.row);
+        s.x = xy[0];
+        s.y = xy[1];
+        s.radius_m = radius[std::size_t(j)];
+        s.radius_class = n - 1 - j;
+        s.population = std::llround(options.people_per_m * s.radius_m);
+        s.density = density[pool[k]];
+        rank_of[pool[k]] = k;
+        out.push_back(s);
+      }
+      step.update(double(next) / double(m));
+    }
+  };
+  // By radius, decreasing; equal radii keep the density order.
+  auto by_size = [&](const Site& a, const Site& b) {
+    if (a.radius_m != b.radius_m) return a.radius_m > b.radius_m;
+    return rank_of.at(std::uint32_t(a.row) * std::uint32_t(cols) + std::uint32_t(a.col)) <
+           rank_of.at(std::uint32_t(b.row) * std::uint32_t(cols) + std::uint32_t(b.col));
+  };
+
+  std::vector<Site> placed;
+  {
+    ProgressStep step(progress, "sites: growth");
+    grow(nullptr, placed, step);
+  }
+  {
+    ProgressStep step(progress, "sites: inclusions");
+    std::sort(placed.begin(), placed.end(), by_size);
+    result.sites = resolve_inclusions(placed, options.mode, distance, cols, rows);
+    step.update(1.0);
+  }
+  // Refill (Belhadj §4.3.1.2 names it as the remedy for the imbalance left by the inclusion
+  // removal): the quota of removed sites goes back to the growth, which resumes on the
+  // candidates not reached yet, skipping those whose centre lies in a kept disc.
+  for (int round = 0; round < options.refill_rounds && next < m; ++round) {
+    std::vector<int> kept(static_cast<std::size_t>(n), 0);
+    for (const Site& s : result.sites) ++kept[std::size_t(n - 1 - s.radius_class)];
+    for (int i = 0; i < n; ++i) quota[std::size_t(i)] = table.classes[std::size_t(n - 1 - i)].quota - kept[std::size_t(i)];
+    if (std::accumulate(quota.begin(), quota.end(), 0) == 0) break;
+    ProgressStep step(progress, "sites: refill " + std::to_string(round + 1));
+    const std::vector<std::uint8_t> covered = covered_cells(result.sites, distance, cols, rows);
+    std::vector<Site> merged = result.sites;
+    const std::size_t before = merged.size();
+    grow(&covered, merged, step);
+    if (merged.size() == before) break;
+    std::sort(merged.begin(), merged.end(), by_size);
+    result.sites = resolve_inclusions(merged, options.mode, distance, cols, rows);
+  }
+  for (const Site& s : result.sites) ++table.classes[std::size_t(s.radius_class)].kept;
+  result.quotas = table.classes;
+  return result;
+}
+
+}  // namespace terrapolis::sites

@@ -1,0 +1,76 @@
+// Quotas of sites per radius class (Belhadj 2007, §4.3.1.1, eq. 4.1-4.2, Algorithm 13).
+// SPDX-License-Identifier: MIT
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "core/error.hpp"
+#include "sites/sites.hpp"
+
+namespace terrapolis::sites {
+namespace {
+
+std::string metres(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%g m", v);
+  return buf;
+}
+
+void check_options(const SitesOptions& o) {
+  auto positive = [](double v, const char* name) {
+    if (!(std::isfinite(v) && v > 0)) throw bad_input(std::string("sites: ") + name + " must be a positive number");
+  };
+  positive(o.dr_min_m, "dr_min_m");
+  positive(o.x_max, "x_max");
+  positive(o.p, "p");
+  positive(o.people_per_m, "people_per_m");
+  if (!(std::isfinite(o.u_min) && o.u_min >= 0)) throw bad_input("sites: u_min must be >= 0");
+  if (!(std::isfinite(o.u_max) && o.u_max >= o.u_min)) throw bad_input("sites: u_max must be >= u_min");
+  if (!(std::isfinite(o.r_min_m) && o.r_min_m >= 0)) throw bad_input("sites: r_min must be >= 0 metres (0: automatic)");
+  if (!(std::isfinite(o.r_max_m) && o.r_max_m >= 0)) throw bad_input("sites: r_max must be >= 0 metres (0: automatic)");
+  if (o.candidates < 0) throw bad_input("sites: candidates must be >= 0 (0: automatic)");
+  if (o.refill_rounds < 0) throw bad_input("sites: refill rounds must be >= 0");
+}
+
+}  // namespace
+
+int QuotaTable::total() const {
+  int n = 0;
+  for (const auto& c : classes) n += c.quota;
+  return n;
+}
+
+double units_for_people(double people, const SitesOptions& o) {
+  const double base = std::max(0.0, (o.x_max - people) / o.x_max);
+  return o.u_min + (o.u_max - o.u_min) * std::pow(base, o.p);
+}
+
+double class_step_m(double cell_size_m, const SitesOptions& o) { return std::max(o.dr_min_m, std::floor(cell_size_m)); }
+
+QuotaTable compute_quotas(double cell_size_m, const SitesOptions& o) {
+  check_options(o);
+  QuotaTable table;
+  table.dr_m = class_step_m(cell_size_m, o);
+  table.r_min_m = o.r_min_m > 0 ? o.r_min_m : table.dr_m;
+  table.r_max_m = o.r_max_m > 0 ? o.r_max_m : o.x_max / o.people_per_m + table.dr_m;
+  // A tiny tolerance so that r_max - r_min an exact multiple of dr is not lost to rounding.
+  const double steps = (table.r_max_m - table.r_min_m) / table.dr_m;
+  const int n = int(std::floor(steps + 1e-9));
+  if (n < 1)
+    throw bad_input("sites: r_max (" + metres(table.r_max_m) + ") must exceed r_min (" + metres(table.r_min_m) +
+                    ") by at least one class step dr (" + metres(table.dr_m) + ")");
+  if (n > 100000) throw bad_input("sites: more than 100000 radius classes; raise dr_min or narrow r_min..r_max");
+  table.classes.resize(std::size_t(n));
+  double sum = 0;
+  for (int i = 0; i < n; ++i) {
+    const double r = table.r_min_m + i * table.dr_m;
+    const double units = units_for_people(o.people_per_m * r, o);
+    sum += std::floor(units);
+    if (sum > 5e7) throw bad_input("sites: the quotas add up to more than 5x10^7 sites; check u_max and the radius range");
+    // Class 0 is the largest radius; Algorithm 13's index i counts from r_min.
+    table.classes[std::size_t(n - 1 - i)] = QuotaClass{r, int(std::floor(units)), 0, 0};
+  }
+  return table;
+}
+
+}  // namespace terrapolis::sites

@@ -1,0 +1,122 @@
+// City sites: size quotas, placement on a density model and the inclusion hierarchy (Belhadj §4.3.1).
+// SPDX-License-Identifier: MIT
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "core/geodesy.hpp"
+#include "core/progress.hpp"
+#include "core/raster.hpp"
+
+namespace terrapolis::sites {
+
+/// One agglomeration site: a disc on the DEM grid (Belhadj 2007, §4.3.1: "a couple of coordinates
+/// associated with a radius").
+struct Site {
+  int id = 0;                    ///< index of the site in its list (sorted by radius, decreasing)
+  double x = 0, y = 0;           ///< centre in the DEM's CRS (centre of cell col,row)
+  int col = 0, row = 0;          ///< the cell holding the centre
+  double radius_m = 0;           ///< disc radius, metres (geodesic)
+  int radius_class = 0;          ///< 0 = the largest radius class
+  std::int64_t population = 0;   ///< people_per_m x radius_m (Belhadj eq. 4.2), rounded
+  double density = 0;            ///< density model value at the centre, in [0,1]
+  int parent = -1;               ///< index of the parent site, -1 for a root (Algorithm 15)
+  int depth = 0;                 ///< 0 for roots, parent's depth + 1 otherwise
+};
+
+struct SitesOptions {
+  std::uint64_t seed = 1;   ///< seed of the candidate draw (std::mt19937_64)
+  int candidates = 0;       ///< M, candidate positions drawn; 0: automatic (20 x N_sites, at most every buildable cell)
+  double r_min_m = 0;       ///< smallest radius, metres; 0: the class step dr
+  double r_max_m = 0;       ///< radii run r_min .. r_max - dr, metres; 0: x_max / people_per_m + dr
+  double dr_min_m = 50;     ///< smallest class step, metres: dr = max(dr_min, floor(cell size))
+  double u_min = 4;         ///< units in the largest class (over x_max people), eq. 4.1
+  double u_max = 1072;      ///< units in the smallest class, eq. 4.1
+  double x_max = 1e6;       ///< people at which f reaches u_min, eq. 4.1
+  double p = 4;             ///< decay exponent of f (> 1), eq. 4.1
+  double people_per_m = 400;  ///< g(r) = people_per_m x r, eq. 4.2
+  /// Inclusion removal (Belhadj §4.3.1.2): paris keeps partially included sites at most half the
+  /// size of their container as suburbs (radio-concentric cities); manhattan removes every
+  /// site whose centre lies in a larger one (regular tiling).
+  enum class Mode { paris, manhattan } mode = Mode::paris;
+  /// How a growing disc is tested against uninhabitable cells. exact: the whole disc, from a
+  /// distance transform in metres; perimeter: only the discrete circle of each radius, as the
+  /// thesis's intersecte_seuil does (obstacles between two radii slip inside, its Fig. 4.5).
+  enum class DiscTest { exact, perimeter } disc_test = DiscTest::exact;
+  /// Refill rounds after the inclusion removal: the quota of removed sites goes back to the
+  /// growth, which resumes on the candidates not reached yet whose centre is in no kept disc,
+  /// then inclusions are removed again. 0 is Algorithm 14 as printed (the imbalance stays).
+  int refill_rounds = 8;
+};
+
+/// One radius class of the quota table (Algorithm 13).
+struct QuotaClass {
+  double radius_m = 0;  ///< class radius, metres
+  int quota = 0;        ///< Q[i] = floor(f(g(radius)))
+  int placed = 0;       ///< sites given this class by the growth, all rounds (first round: never above quota)
+  int kept = 0;         ///< sites of this class in the result (never above quota)
+};
+
+/// The quota table: classes ordered from the largest radius (class 0) to the smallest.
+struct QuotaTable {
+  double dr_m = 0;      ///< class step, metres
+  double r_min_m = 0, r_max_m = 0;
+  std::vector<QuotaClass> classes;
+  int total() const;    ///< N_sites, the sum of quotas
+};
+
+struct SitesResult {
+  std::vector<Site> sites;          ///< sorted by radius, decreasing; id = index
+  std::vector<QuotaClass> quotas;   ///< class 0 (largest radius) first
+  double dr_m = 0;                  ///< class step used, metres
+  int candidates = 0;               ///< M, candidates drawn
+  std::uint64_t seed = 1;           ///< seed used
+};
+
+/// f(x) of Belhadj eq. 4.1: urban units of x people. For x >= x_max the base is clamped at 0
+/// (the thesis's formula grows again past x_max, and is undefined for non-integer p).
+double units_for_people(double people, const SitesOptions& options);
+
+/// The class step dr = max(dr_min, floor(cell_size_m)) (Algorithm 13).
+double class_step_m(double cell_size_m, const SitesOptions& options);
+
+/// Algorithm 13: quotas for classes r_min + i dr, i in 0..n-1, n = floor((r_max - r_min) / dr),
+/// for a grid whose cells are `cell_size_m` metres. Throws bad_input when the range is empty
+/// or a parameter is out of range.
+QuotaTable compute_quotas(double cell_size_m, const SitesOptions& options);
+
+/// Algorithms 13, 14 and 15: places sites on `density` (values in [0,1], NaN nodata) where
+/// `buildable` is 1; any other cell, and everything outside the grid, is uninhabitable.
+/// Candidates are drawn with options.seed; the result depends only on the inputs and options.
+SitesResult place_sites(const Raster<float>& density, const Raster<std::uint8_t>& buildable, const SitesOptions& options,
+                        Progress& progress);
+
+/// Distance in metres between the centres of two cells of a grid, by the mid-latitude formula
+/// with the exact meridian arc (geodesic to well under a millimetre within a few kilometres);
+/// Euclidean on projected grids.
+class GridDistance {
+ public:
+  GridDistance(const Georef& georef, int cols, int rows);
+  /// Metres from the centre of (c0,r0) to the centre of (c1,r1); rows may lie one outside the grid.
+  double operator()(int c0, int r0, int c1, int r1) const;
+  /// Northing of the centre of row r (r in -1..rows), metres from row 0.
+  double northing(int r) const { return y_[std::size_t(r + 1)]; }
+  /// East-west metres per column at the mid-latitude of rows r0 and r1.
+  double width_between(int r0, int r1) const;
+  const CellMetrics& metrics() const { return metrics_; }
+
+ private:
+  CellMetrics metrics_;
+  std::vector<double> y_;  // northing of rows -1..rows
+  int rows_;
+};
+
+/// Algorithms 14 (second part) and 15: with `sites` sorted by radius, decreasing, removes the
+/// included sites according to `mode` and links each kept partially included site to its
+/// parent (the first, hence largest, kept site containing its centre). Sites lie on a
+/// `cols` x `rows` grid; distances between centres come from `distance`. Returns the kept
+/// sites in the same order with ids, parents and depths renumbered.
+std::vector<Site> resolve_inclusions(const std::vector<Site>& sites, SitesOptions::Mode mode, const GridDistance& distance,
+                                     int cols, int rows);
+
+}  // namespace terrapolis::sites
