@@ -8,6 +8,8 @@ namespace terrapolis::cli {
 std::vector<std::unique_ptr<Command>> all_commands() {
   std::vector<std::unique_ptr<Command>> commands;
   commands.push_back(make_info_command());
+  commands.push_back(make_path_command());
+  commands.push_back(make_roads_command());
   return commands;
 }
 

@@ -8,5 +8,7 @@
 namespace terrapolis::cli {
 
 std::unique_ptr<Command> make_info_command();
+std::unique_ptr<Command> make_path_command();
+std::unique_ptr<Command> make_roads_command();
 
 }  // namespace terrapolis::cli

@@ -1,0 +1,455 @@
+// Dijkstra, A* and bidirectional A* on the oriented road graph (Galin et al. 2010).
+// SPDX-License-Identifier: MIT
+#include "roads/anisotropic_search.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <string>
+
+#include "core/error.hpp"
+
+namespace terrapolis::roads {
+namespace {
+
+constexpr double kDeg = 180.0 / std::numbers::pi;
+
+std::uint64_t splitmix64(std::uint64_t x) {
+  x += 0x9e3779b97f4a7c15ULL;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
+  return x ^ (x >> 31);
+}
+
+int sector_of(double angle_rad, int m) {
+  const double w = 2 * std::numbers::pi / m;
+  return int(std::floor(angle_rad / w + 0.5)) % m;
+}
+
+}  // namespace
+
+RoadGraph::RoadGraph(const TerrainField& terrain, const CostModel& model, const GraphOptions& options)
+    : terrain_(terrain), model_(model), options_(options) {
+  if (options.angles < 1 || options.angles > 64) throw bad_input("--angles: must be in 1..64, got " + std::to_string(options.angles));
+  const int m = options.angles;
+  step_m_ = model.sample_step_m > 0 ? model.sample_step_m : 0.5 * terrain.min_cell_m();
+  cheapest_ = model.cheapest_per_metre();
+  // Orientation layers: one block of m sectors per enabled structure, then the "start" orientation.
+  int block[3] = {0, -1, -1};
+  int blocks = 1;
+  if (model.bridge.enabled) block[1] = blocks++;
+  if (model.tunnel.enabled) block[2] = blocks++;
+  orientations_ = blocks * m + 1;
+  for (const MaskArc& a : segment_mask(options.k)) arcs_.push_back({a.dcol, a.drow, Structure::road, block[0] * m + sector_of(a.angle_rad, m), a.angle_rad});
+  surface_arcs_ = arcs_.size();
+  const double cell = terrain.typical_cell_m();
+  for (Structure s : {Structure::bridge, Structure::tunnel}) {
+    const StructureCosts& sc = s == Structure::bridge ? model.bridge : model.tunnel;
+    if (!sc.enabled) continue;
+    const double rmin = sc.min_length_m ? *sc.min_length_m / cell : sc.min_length_cells;
+    // Long arcs start beyond the surface mask: shorter crossings are surface arcs.
+    const double rmax = sc.max_length_m ? *sc.max_length_m / cell : sc.max_length_cells;
+    const auto ring = annulus_mask(std::max(rmin, 1.0), rmax);
+    const double keep = ring.empty() ? 0.0 : std::min(1.0, double(sc.samples) / double(ring.size()));
+    const std::uint64_t threshold = keep >= 1.0 ? ~std::uint64_t(0) : std::uint64_t(keep * 18446744073709551615.0);
+    (s == Structure::bridge ? bridge_keep_ : tunnel_keep_) = threshold;
+    if (keep <= 0) continue;
+    const int b = block[int(s)];
+    for (const MaskArc& a : ring) arcs_.push_back({a.dcol, a.drow, s, b * m + sector_of(a.angle_rad, m), a.angle_rad});
+  }
+  // Turn costs: the turn is the angle between the incoming sector and the new arc, less half a
+  // sector (the exact incoming direction is only known to within a sector), priced by the stricter
+  // of the two structures' curvature functions. m = 1 makes every turn free.
+  const StructureCosts* costs[3] = {&model.road, &model.bridge, &model.tunnel};
+  turn_.assign(std::size_t(orientations_) * arcs_.size(), 0.0);
+  into_.assign(std::size_t(orientations_), {});
+  for (std::size_t a = 0; a < arcs_.size(); ++a) into_[std::size_t(arcs_[a].orientation)].push_back(int(a));
+  for (int o = 0; o + 1 < orientations_; ++o) {
+    const int blk = o / m, sector = o % m;
+    Structure in = Structure::road;
+    for (int s = 0; s < 3; ++s)
+      if (block[s] == blk) in = Structure(s);
+    const double centre = sector * 2 * std::numbers::pi / m;
+    for (std::size_t a = 0; a < arcs_.size(); ++a) {
+      double d = std::fabs(arcs_[a].angle_rad - centre);
+      if (d > std::numbers::pi) d = 2 * std::numbers::pi - d;
+      const double turn = std::max(0.0, d - std::numbers::pi / m) * kDeg;
+      turn_[std::size_t(o) * arcs_.size() + a] =
+          std::max(costs[int(in)]->curvature_deg(turn), costs[int(arcs_[a].structure)]->curvature_deg(turn));
+    }
+  }
+}
+
+double RoadGraph::surface_cost_per_m(double slope_deg, double depth_m) const {
+  return model_.road.slope_deg(slope_deg) + model_.road.water_depth_m(depth_m);
+}
+
+bool RoadGraph::arc_sampled(Cell from, int arc) const {
+  const Arc& a = arcs_[std::size_t(arc)];
+  if (a.structure == Structure::road) return true;
+  const std::uint64_t p = terrain_.index(from.col, from.row), q = terrain_.index(from.col + a.dcol, from.row + a.drow);
+  const std::uint64_t lo = std::min(p, q), hi = std::max(p, q);
+  const std::uint64_t h = splitmix64(splitmix64(options_.seed * 3 + std::uint64_t(a.structure)) ^ (lo * 0x100000001b3ULL + hi));
+  return h <= (a.structure == Structure::bridge ? bridge_keep_ : tunnel_keep_);
+}
+
+double RoadGraph::arc_cost(Cell from, int arc) const {
+  const Arc& a = arcs_[std::size_t(arc)];
+  const int c1 = from.col + a.dcol, r1 = from.row + a.drow;
+  if (!terrain_.inside(c1, r1)) return kInfinity;
+  const GridPoint p0{double(from.col), double(from.row)}, p1{double(c1), double(r1)};
+  const double length = terrain_.length_m(p0, p1);
+  const int n = std::max(1, int(std::ceil(length / step_m_)));
+  const double dl = length / n;
+  const double dc = double(a.dcol) / n, dr = double(a.drow) / n;
+  double total = 0;
+  if (a.structure == Structure::road) {
+    const StructureCosts& sc = model_.road;
+    double z0 = terrain_.surface(from.col, from.row);
+    for (int i = 1; i <= n; ++i) {
+      const double z1 = i == n ? terrain_.surface(c1, r1) : terrain_.surface_at(from.col + dc * i, from.row + dr * i);
+      const double slope = std::atan(std::fabs(z1 - z0) / dl) * kDeg;
+      const double depth = terrain_.depth_at(from.col + dc * (i - 0.5), from.row + dr * (i - 0.5));
+      const double c = sc.slope_deg(slope) + sc.water_depth_m(depth);
+      if (c == kInfinity) return kInfinity;
+      total += c * dl;
+      z0 = z1;
+    }
+    return total;
+  }
+  // Bridges and tunnels join two land cells by a straight deck between their surfaces.
+  if (terrain_.water(from.col, from.row) || terrain_.water(c1, r1)) return kInfinity;
+  const bool bridge = a.structure == Structure::bridge;
+  const StructureCosts& sc = bridge ? model_.bridge : model_.tunnel;
+  const double za = terrain_.surface(from.col, from.row), zb = terrain_.surface(c1, r1);
+  const double per_m_slope = sc.slope_deg(std::atan(std::fabs(zb - za) / length) * kDeg);
+  if (per_m_slope == kInfinity) return kInfinity;
+  for (int i = 0; i < n; ++i) {
+    const double t = (i + 0.5) / n;
+    const double col = from.col + dc * (i + 0.5), row = from.row + dr * (i + 0.5);
+    const double deck = za + t * (zb - za);
+    const double depth = terrain_.depth_at(col, row);
+    double c;
+    if (bridge) {
+      const double h = deck - terrain_.surface_at(col, row);
+      if (h < 0) return kInfinity;  // the deck would cut the ground
+      c = sc.height_m(h) + sc.water_depth_m(depth);
+    } else {
+      const double d = terrain_.ground_at(col, row) - deck;
+      if (d < 0) return kInfinity;  // the tube would leave the ground (or the sea floor)
+      c = sc.depth_m(d) + sc.water_depth_m(depth);
+    }
+    if (c == kInfinity) return kInfinity;
+    total += (c + per_m_slope) * dl;
+  }
+  return total;
+}
+
+double RoadGraph::lower_bound(Cell a, Cell b) const {
+  // Any path between the two rows is at least |dcol| x the narrowest of their cell widths wide and
+  // |drow| x the shortest cell height (cell widths shrink monotonically polewards); 0.995 absorbs
+  // the small variation of cell heights with latitude.
+  const double w = std::min(terrain_.metres_x(a.row), terrain_.metres_x(b.row));
+  const double h = std::min(terrain_.metres_y(a.row), terrain_.metres_y(b.row));
+  return 0.995 * cheapest_ * std::hypot((b.col - a.col) * w, (b.row - a.row) * h);
+}
+
+namespace {
+
+/// Open-addressing hash map from node key to node index (linear probing, power-of-two size).
+class NodeMap {
+ public:
+  NodeMap() { resize(1 << 12); }
+  std::uint32_t find(std::uint64_t key) const {
+    for (std::size_t i = hash(key) & mask_;; i = (i + 1) & mask_) {
+      if (keys_[i] == kEmpty) return kNone;
+      if (keys_[i] == key) return values_[i];
+    }
+  }
+  /// Returns the index stored for `key`, inserting `value` when absent.
+  std::uint32_t insert(std::uint64_t key, std::uint32_t value, bool& inserted) {
+    if (2 * (count_ + 1) > keys_.size()) grow();
+    for (std::size_t i = hash(key) & mask_;; i = (i + 1) & mask_) {
+      if (keys_[i] == kEmpty) {
+        keys_[i] = key;
+        values_[i] = value;
+        ++count_;
+        inserted = true;
+        return value;
+      }
+      if (keys_[i] == key) {
+        inserted = false;
+        return values_[i];
+      }
+    }
+  }
+  static constexpr std::uint32_t kNone = 0xffffffffu;
+
+ private:
+  static constexpr std::uint64_t kEmpty = ~std::uint64_t(0);
+  static std::size_t hash(std::uint64_t k) { return std::size_t(splitmix64(k)); }
+  void resize(std::size_t n) {
+    keys_.assign(n, kEmpty);
+    values_.assign(n, 0);
+    mask_ = n - 1;
+    count_ = 0;
+  }
+  void grow() {
+    auto keys = std::move(keys_);
+    auto values = std::move(values_);
+    resize(keys.size() * 2);
+    bool dummy;
+    for (std::size_t i = 0; i < keys.size(); ++i)
+      if (keys[i] != kEmpty) insert(keys[i], values[i], dummy);
+  }
+  std::vector<std::uint64_t> keys_;
+  std::vector<std::uint32_t> values_;
+  std::size_t mask_ = 0, count_ = 0;
+};
+
+struct Node {
+  std::uint64_t key;
+  double g;
+  std::uint32_t parent;  ///< forward: predecessor; backward: successor towards the goal
+  std::int32_t arc;      ///< arc joining the node and its parent
+};
+
+struct QueueItem {
+  double f;
+  std::uint64_t key;
+  std::uint32_t node;
+  double g;
+  bool operator<(const QueueItem& o) const { return f != o.f ? f > o.f : key > o.key; }  // min-heap, ties by key
+};
+
+/// One direction of the search: its nodes, its map and its queue.
+struct Frontier {
+  std::vector<Node> nodes;
+  NodeMap map;
+  std::vector<QueueItem> heap;
+  double top() const { return heap.empty() ? kInfinity : heap.front().f; }
+  void push(const QueueItem& q) {
+    heap.push_back(q);
+    std::push_heap(heap.begin(), heap.end());
+  }
+  QueueItem pop() {
+    std::pop_heap(heap.begin(), heap.end());
+    QueueItem q = heap.back();
+    heap.pop_back();
+    return q;
+  }
+  /// Relaxes `key` to cost g through `parent`/`arc`; returns the node index when improved.
+  std::uint32_t relax(std::uint64_t key, double g, std::uint32_t parent, int arc, bool& improved) {
+    bool inserted;
+    const std::uint32_t idx = map.insert(key, std::uint32_t(nodes.size()), inserted);
+    if (inserted) {
+      nodes.push_back({key, g, parent, arc});
+      improved = true;
+    } else if (g < nodes[idx].g) {
+      nodes[idx].g = g;
+      nodes[idx].parent = parent;
+      nodes[idx].arc = arc;
+      improved = true;
+    } else {
+      improved = false;
+    }
+    return idx;
+  }
+};
+
+}  // namespace
+
+SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMethod method, std::size_t max_nodes,
+                           Progress* progress) {
+  const TerrainField& t = graph.terrain();
+  if (!t.inside(from.col, from.row) || !t.inside(to.col, to.row)) throw bad_input("path: an end point lies outside the DEM");
+  SearchResult result;
+  const std::uint64_t O = std::uint64_t(graph.orientations());
+  auto key_of = [&](Cell c, int o) { return std::uint64_t(t.index(c.col, c.row)) * O + std::uint64_t(o); };
+  auto cell_of = [&](std::uint64_t key) {
+    const std::uint64_t i = key / O;
+    return Cell{int(i % std::uint64_t(t.cols())), int(i / std::uint64_t(t.cols()))};
+  };
+  auto orient_of = [&](std::uint64_t key) { return int(key % O); };
+  const bool use_h = method != SearchMethod::dijkstra;
+  const std::size_t goal_index = t.index(to.col, to.row);
+  if (from == to) {
+    result.found = true;
+    result.cost = 0;
+    result.cells = {from};
+    return result;
+  }
+  std::optional<ProgressStep> step;
+  if (progress) step.emplace(*progress, "route");
+  const double h0 = graph.lower_bound(from, to);
+  double best_h = h0;
+  auto report = [&](double h) {
+    if (!step || h0 <= 0) return;
+    best_h = std::min(best_h, h);
+    if ((result.expanded & 4095) == 0) step->update(std::clamp(1.0 - best_h / h0, 0.0, 1.0));
+  };
+  const std::vector<RoadGraph::Arc>& arcs = graph.arcs();
+  const int na = int(arcs.size());
+
+  Frontier fw, bw;
+  auto check_memory = [&]() {
+    if (fw.nodes.size() + bw.nodes.size() > max_nodes)
+      throw processing_error("path: the search stored more than " + std::to_string(max_nodes) +
+                             " nodes; use a smaller --k or --angles, or closer end points");
+  };
+  {
+    bool imp;
+    const std::uint32_t s = fw.relax(key_of(from, graph.start_orientation()), 0.0, NodeMap::kNone, -1, imp);
+    fw.push({use_h ? h0 : 0.0, fw.nodes[s].key, s, 0.0});
+  }
+
+  if (method != SearchMethod::bidirectional) {
+    std::uint32_t goal_node = NodeMap::kNone;
+    while (!fw.heap.empty()) {
+      const QueueItem q = fw.pop();
+      if (q.g > fw.nodes[q.node].g) continue;  // stale entry
+      const std::uint64_t key = q.key;
+      const Cell c = cell_of(key);
+      if (t.index(c.col, c.row) == goal_index) {
+        goal_node = q.node;
+        break;
+      }
+      ++result.expanded;
+      report(graph.lower_bound(c, to));
+      const int o = orient_of(key);
+      for (int a = 0; a < na; ++a) {
+        const RoadGraph::Arc& arc = arcs[std::size_t(a)];
+        if (!t.inside(c.col + arc.dcol, c.row + arc.drow) || !graph.arc_sampled(c, a)) continue;
+        const double turn = graph.turn_cost(o, a);
+        if (turn == kInfinity) continue;
+        const double e = graph.arc_cost(c, a);
+        if (e == kInfinity) continue;
+        const Cell n{c.col + arc.dcol, c.row + arc.drow};
+        const double g = q.g + turn + e;
+        bool improved;
+        const std::uint32_t idx = fw.relax(key_of(n, arc.orientation), g, q.node, a, improved);
+        if (improved) fw.push({g + (use_h ? graph.lower_bound(n, to) : 0.0), fw.nodes[idx].key, idx, g});
+      }
+      check_memory();
+    }
+    result.nodes = fw.nodes.size();
+    if (goal_node == NodeMap::kNone) return result;
+    result.found = true;
+    result.cost = fw.nodes[goal_node].g;
+    for (std::uint32_t n = goal_node; n != NodeMap::kNone; n = fw.nodes[n].parent) {
+      result.cells.push_back(cell_of(fw.nodes[n].key));
+      if (fw.nodes[n].arc >= 0) result.structures.push_back(arcs[std::size_t(fw.nodes[n].arc)].structure);
+    }
+    std::reverse(result.cells.begin(), result.cells.end());
+    std::reverse(result.structures.begin(), result.structures.end());
+    return result;
+  }
+
+  // Bidirectional A*: the backward search runs on reversed arcs from every orientation at the goal.
+  // It stops when the best meeting cost mu <= max(top_f, top_b) (Pohl 1971): any cheaper path would
+  // cross both open lists below mu.
+  for (int o = 0; o < graph.start_orientation(); ++o) {
+    bool imp;
+    const std::uint32_t s = bw.relax(key_of(to, o), 0.0, NodeMap::kNone, -1, imp);
+    bw.push({use_h ? h0 : 0.0, bw.nodes[s].key, s, 0.0});
+  }
+  double mu = kInfinity;
+  std::uint64_t meet = 0;
+  auto try_meet = [&](std::uint64_t key, double g, const Frontier& other) {
+    const std::uint32_t j = other.map.find(key);
+    if (j == NodeMap::kNone) return;
+    const double total = g + other.nodes[j].g;
+    if (total < mu || (total == mu && key < meet)) {
+      mu = total;
+      meet = key;
+    }
+  };
+  while (!fw.heap.empty() || !bw.heap.empty()) {
+    if (mu <= std::max(fw.top(), bw.top())) break;
+    const bool forward = !fw.heap.empty() && (bw.heap.empty() || fw.heap.size() <= bw.heap.size());
+    Frontier& me = forward ? fw : bw;
+    Frontier& other = forward ? bw : fw;
+    const QueueItem q = me.pop();
+    if (q.g > me.nodes[q.node].g) continue;
+    ++result.expanded;
+    const Cell c = cell_of(q.key);
+    const int o = orient_of(q.key);
+    report(forward ? graph.lower_bound(c, to) : graph.lower_bound(c, from));
+    if (forward) {
+      for (int a = 0; a < na; ++a) {
+        const RoadGraph::Arc& arc = arcs[std::size_t(a)];
+        if (!t.inside(c.col + arc.dcol, c.row + arc.drow) || !graph.arc_sampled(c, a)) continue;
+        const double turn = graph.turn_cost(o, a);
+        if (turn == kInfinity) continue;
+        const double e = graph.arc_cost(c, a);
+        if (e == kInfinity) continue;
+        const Cell n{c.col + arc.dcol, c.row + arc.drow};
+        const double g = q.g + turn + e;
+        bool improved;
+        const std::uint32_t idx = me.relax(key_of(n, arc.orientation), g, q.node, a, improved);
+        if (improved) {
+          me.push({g + (use_h ? graph.lower_bound(n, to) : 0.0), me.nodes[idx].key, idx, g});
+          try_meet(me.nodes[idx].key, g, other);
+        }
+      }
+    } else {
+      // Node (c, o) was reached by an arc of orientation o: its predecessors are c - arc, with
+      // any orientation (the start orientation only at the start cell).
+      for (int a : graph.arcs_into(o)) {
+        const RoadGraph::Arc& arc = arcs[std::size_t(a)];
+        const Cell p{c.col - arc.dcol, c.row - arc.drow};
+        if (!t.inside(p.col, p.row) || !graph.arc_sampled(p, a)) continue;
+        const double e = graph.arc_cost(p, a);
+        if (e == kInfinity) continue;
+        const double hp = use_h ? graph.lower_bound(p, from) : 0.0;
+        for (int po = 0; po < graph.orientations(); ++po) {
+          if (po == graph.start_orientation() && !(p == from)) continue;
+          const double turn = graph.turn_cost(po, a);
+          if (turn == kInfinity) continue;
+          const double g = q.g + turn + e;
+          bool improved;
+          const std::uint32_t idx = me.relax(key_of(p, po), g, q.node, a, improved);
+          if (improved) {
+            me.push({g + hp, me.nodes[idx].key, idx, g});
+            try_meet(me.nodes[idx].key, g, other);
+          }
+        }
+      }
+    }
+    check_memory();
+  }
+  result.nodes = fw.nodes.size() + bw.nodes.size();
+  if (mu == kInfinity) return result;
+  result.found = true;
+  result.cost = mu;
+  for (std::uint32_t n = fw.map.find(meet); n != NodeMap::kNone; n = fw.nodes[n].parent) {
+    result.cells.push_back(cell_of(fw.nodes[n].key));
+    if (fw.nodes[n].arc >= 0) result.structures.push_back(arcs[std::size_t(fw.nodes[n].arc)].structure);
+  }
+  std::reverse(result.cells.begin(), result.cells.end());
+  std::reverse(result.structures.begin(), result.structures.end());
+  for (std::uint32_t n = bw.map.find(meet); n != NodeMap::kNone && bw.nodes[n].parent != NodeMap::kNone; n = bw.nodes[n].parent) {
+    const Node& nd = bw.nodes[n];
+    result.cells.push_back(cell_of(bw.nodes[nd.parent].key));
+    result.structures.push_back(arcs[std::size_t(nd.arc)].structure);
+  }
+  return result;
+}
+
+double chain_cost(const RoadGraph& graph, const std::vector<Cell>& cells) {
+  const auto& arcs = graph.arcs();
+  double total = 0;
+  int o = graph.start_orientation();
+  for (std::size_t i = 1; i < cells.size(); ++i) {
+    const int dc = cells[i].col - cells[i - 1].col, dr = cells[i].row - cells[i - 1].row;
+    int arc = -1;
+    for (std::size_t a = 0; a < graph.surface_arcs(); ++a)
+      if (arcs[a].dcol == dc && arcs[a].drow == dr) arc = int(a);
+    if (arc < 0) return kInfinity;
+    total += graph.turn_cost(o, arc) + graph.arc_cost(cells[i - 1], arc);
+    o = arcs[std::size_t(arc)].orientation;
+  }
+  return total;
+}
+
+}  // namespace terrapolis::roads
