@@ -31,13 +31,15 @@ class PathCommand final : public Command {
     app.add_option("--crs", crs_, "CRS of --from/--to: lonlat (WGS 84) or dem (the DEM's CRS)")->check(CLI::IsMember({"lonlat", "dem"}));
     app.add_option("--search", search_, "Search: astar, bidir (bidirectional A*), dijkstra")->check(CLI::IsMember({"astar", "bidir", "dijkstra"}));
     app.add_option("--sections", sections_, "Also write the road/bridge/tunnel sections to this file");
+    app.add_option("--evaluate", evaluate_, "Instead of routing, print the cost under the cost model of the first line of this file "
+                                            "(e.g. another tool's path), walked cell by cell; OUT is not written");
     options_.setup(app);
   }
 
   void run(Context& context) override {
     roads::RoutingOptions routing = options_.routing();
     routing.search = search_ == "bidir" ? roads::SearchMethod::bidirectional : search_ == "dijkstra" ? roads::SearchMethod::dijkstra : roads::SearchMethod::astar;
-    check_output_path(out_, options_.overwrite);
+    if (evaluate_.empty()) check_output_path(out_, options_.overwrite);
     if (!sections_.empty()) check_output_path(sections_, options_.overwrite);
     const roads::CostModel model = options_.cost_model();
     const Dem dem = read_dem(dem_);
@@ -50,6 +52,10 @@ class PathCommand final : public Command {
         throw bad_input(std::string(opt) + ": the point is in the sea (no land within " + std::to_string(routing.snap_cells) + " cells)");
     }
     const roads::RoadGraph graph(terrain, model, options_.graph());
+    if (!evaluate_.empty()) {
+      std::printf("cost %.3f\n", evaluate(graph, terrain, dem));
+      return;
+    }
     const auto t0 = std::chrono::steady_clock::now();
     const auto road = roads::route_road(terrain, graph, a, b, routing, &context.progress);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -85,6 +91,28 @@ class PathCommand final : public Command {
     return *cell;
   }
 
+  /// Cost of a polyline walked through 8-neighbour steps (a D8 path such as r.drain's).
+  double evaluate(const roads::RoadGraph& graph, const roads::TerrainField& terrain, const Dem& dem) const {
+    const VectorLayer layer = read_vector(evaluate_, dem.georef().crs);
+    if (layer.features.empty() || layer.features[0].parts.empty()) throw bad_input(evaluate_ + ": no line to evaluate");
+    std::vector<roads::Cell> chain;
+    for (const auto& f : layer.features)
+      for (const auto& part : f.parts)
+        for (const auto& v : part) {
+          const auto c = roads::cell_at(terrain, v[0], v[1]);
+          if (!c) throw bad_input(evaluate_ + ": a vertex lies outside the DEM");
+          while (!chain.empty() && !(chain.back() == *c)) {  // 8-neighbour steps towards the vertex
+            roads::Cell n = chain.back();
+            n.col += (c->col > n.col) - (c->col < n.col);
+            n.row += (c->row > n.row) - (c->row < n.row);
+            chain.push_back(n);
+          }
+          if (chain.empty()) chain.push_back(*c);
+        }
+    return roads::chain_cost(graph, chain);
+  }
+
+  std::string evaluate_;
   std::string dem_, from_, to_, out_, crs_ = "lonlat", search_ = "astar", sections_;
   RoadOptions options_;
 };

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <string>
 
@@ -257,6 +258,29 @@ struct Frontier {
   }
 };
 
+/// Surface arc costs of the cells met so far: a node is expanded once per orientation but its
+/// arcs cost the same from every orientation, so they are computed once (lazily, NaN = not yet).
+class ArcCache {
+ public:
+  ArcCache(const RoadGraph& graph) : graph_(graph), n_(graph.surface_arcs()) {}
+  double get(Cell c, std::size_t cell_index, int arc) {
+    if (std::size_t(arc) >= n_) return graph_.arc_cost(c, arc);
+    bool inserted;
+    const std::uint32_t slot = map_.insert(cell_index, std::uint32_t(costs_.size() / n_), inserted);
+    if (inserted) costs_.resize(costs_.size() + n_, std::numeric_limits<float>::quiet_NaN());
+    float& v = costs_[std::size_t(slot) * n_ + std::size_t(arc)];
+    if (std::isnan(v)) v = float(graph_.arc_cost(c, arc));
+    return v;
+  }
+  std::size_t cells() const { return costs_.size() / std::max<std::size_t>(1, n_); }
+
+ private:
+  const RoadGraph& graph_;
+  std::size_t n_;
+  NodeMap map_;
+  std::vector<float> costs_;
+};
+
 }  // namespace
 
 SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMethod method, std::size_t max_nodes,
@@ -292,8 +316,9 @@ SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMet
   const int na = int(arcs.size());
 
   Frontier fw, bw;
+  ArcCache cache(graph);
   auto check_memory = [&]() {
-    if (fw.nodes.size() + bw.nodes.size() > max_nodes)
+    if (fw.nodes.size() + bw.nodes.size() + cache.cells() * graph.surface_arcs() / 8 > max_nodes)
       throw processing_error("path: the search stored more than " + std::to_string(max_nodes) +
                              " nodes; use a smaller --k or --angles, or closer end points");
   };
@@ -322,7 +347,7 @@ SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMet
         if (!t.inside(c.col + arc.dcol, c.row + arc.drow) || !graph.arc_sampled(c, a)) continue;
         const double turn = graph.turn_cost(o, a);
         if (turn == kInfinity) continue;
-        const double e = graph.arc_cost(c, a);
+        const double e = cache.get(c, t.index(c.col, c.row), a);
         if (e == kInfinity) continue;
         const Cell n{c.col + arc.dcol, c.row + arc.drow};
         const double g = q.g + turn + e;
@@ -381,7 +406,7 @@ SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMet
         if (!t.inside(c.col + arc.dcol, c.row + arc.drow) || !graph.arc_sampled(c, a)) continue;
         const double turn = graph.turn_cost(o, a);
         if (turn == kInfinity) continue;
-        const double e = graph.arc_cost(c, a);
+        const double e = cache.get(c, t.index(c.col, c.row), a);
         if (e == kInfinity) continue;
         const Cell n{c.col + arc.dcol, c.row + arc.drow};
         const double g = q.g + turn + e;
@@ -399,7 +424,7 @@ SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMet
         const RoadGraph::Arc& arc = arcs[std::size_t(a)];
         const Cell p{c.col - arc.dcol, c.row - arc.drow};
         if (!t.inside(p.col, p.row) || !graph.arc_sampled(p, a)) continue;
-        const double e = graph.arc_cost(p, a);
+        const double e = cache.get(p, t.index(p.col, p.row), a);
         if (e == kInfinity) continue;
         const double hp = use_h ? graph.lower_bound(p, from) : 0.0;
         for (int po = 0; po < graph.orientations(); ++po) {
