@@ -3,6 +3,7 @@
 #include "roads/anisotropic_search.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -57,6 +58,42 @@ RoadGraph::RoadGraph(const TerrainField& terrain, const CostModel& model, const 
     if (keep <= 0) continue;
     const int b = block[int(s)];
     for (const MaskArc& a : ring) arcs_.push_back({a.dcol, a.drow, s, b * m + sector_of(a.angle_rad, m), a.angle_rad});
+  }
+  // Heuristic: per-metre cost against the grade t = tan(slope), the cheapest structure at each
+  // grade, sampled every 0.05 deg; its lower convex hull bounds every arc from below (an increasing
+  // piecewise-linear function of the slope is concave in the grade, so it lies above its chords).
+  {
+    std::vector<std::array<double, 2>> pts;
+    for (double sdeg = 0; sdeg <= 89.5; sdeg += 0.05) {
+      double c = model.road.slope_deg(sdeg) + model.road.water_depth_m.min_value();
+      if (model.bridge.enabled)
+        c = std::min(c, model.bridge.slope_deg(sdeg) + model.bridge.water_depth_m.min_value() + model.bridge.height_m.min_value());
+      if (model.tunnel.enabled)
+        c = std::min(c, model.tunnel.slope_deg(sdeg) + model.tunnel.water_depth_m.min_value() + model.tunnel.depth_m.min_value());
+      if (c == kInfinity) continue;
+      pts.push_back({std::tan(sdeg / kDeg), 0.99 * c});
+    }
+    std::vector<std::array<double, 2>> hull;
+    for (const auto& p : pts) {
+      while (hull.size() >= 2) {
+        const auto& a = hull[hull.size() - 2];
+        const auto& b = hull.back();
+        if ((b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0]) <= 0) hull.pop_back();
+        else break;
+      }
+      hull.push_back(p);
+    }
+    kappa_ = kInfinity;
+    for (const auto& h : hull) {
+      hull_t_.push_back(h[0]);
+      hull_c_.push_back(h[1]);
+      if (h[0] > 0 && h[1] / h[0] < kappa_) {
+        kappa_ = h[1] / h[0];
+        best_grade_ = h[0];
+      }
+    }
+    if (kappa_ == kInfinity) kappa_ = 0;
+    if (!hull_c_.empty()) cheapest_ = std::min(cheapest_, hull_c_.front());
   }
   // Turn costs: the turn is the angle between the incoming sector and the new arc, less half a
   // sector (the exact incoming direction is only known to within a sector), priced by the stricter
@@ -152,60 +189,49 @@ double RoadGraph::lower_bound(Cell a, Cell b) const {
   // the small variation of cell heights with latitude.
   const double w = std::min(terrain_.metres_x(a.row), terrain_.metres_x(b.row));
   const double h = std::min(terrain_.metres_y(a.row), terrain_.metres_y(b.row));
-  return 0.995 * cheapest_ * std::hypot((b.col - a.col) * w, (b.row - a.row) * h);
+  const double d = 0.995 * std::hypot((b.col - a.col) * w, (b.row - a.row) * h);
+  const double z = std::fabs(double(terrain_.surface(b.col, b.row)) - double(terrain_.surface(a.col, a.row)));
+  if (hull_t_.size() < 2 || kappa_ <= 0) return cheapest_ * d;
+  if (d <= 0 || z >= best_grade_ * d) return std::max(cheapest_ * d, kappa_ * z);
+  const double t = z / d;  // below the best grade: cover D at grade t along the envelope
+  const auto it = std::upper_bound(hull_t_.begin(), hull_t_.end(), t);
+  const std::size_t j = std::size_t(std::clamp<std::ptrdiff_t>(it - hull_t_.begin(), 1, std::ptrdiff_t(hull_t_.size()) - 1));
+  const double f = (t - hull_t_[j - 1]) / (hull_t_[j] - hull_t_[j - 1]);
+  return d * (hull_c_[j - 1] + f * (hull_c_[j] - hull_c_[j - 1]));
 }
 
 namespace {
 
-/// Open-addressing hash map from node key to node index (linear probing, power-of-two size).
+/// Node key -> node index, stored per cell: a dense array of 4 bytes per grid cell holds the
+/// block of a touched cell, and a block holds the indices of its `orientations` nodes. Lookups
+/// are two array reads (no hashing); memory is 4 bytes per cell plus 4 x orientations bytes per
+/// touched cell (a 3601 x 3601 SRTM tile: 52 MB for the cell array).
 class NodeMap {
  public:
-  NodeMap() { resize(1 << 12); }
+  NodeMap(std::size_t cells, std::uint64_t orientations) : orientations_(orientations), block_(cells, kNone) {}
   std::uint32_t find(std::uint64_t key) const {
-    for (std::size_t i = hash(key) & mask_;; i = (i + 1) & mask_) {
-      if (keys_[i] == kEmpty) return kNone;
-      if (keys_[i] == key) return values_[i];
-    }
+    const std::uint32_t b = block_[std::size_t(key / orientations_)];
+    return b == kNone ? kNone : slots_[std::size_t(b) * orientations_ + std::size_t(key % orientations_)];
   }
   /// Returns the index stored for `key`, inserting `value` when absent.
   std::uint32_t insert(std::uint64_t key, std::uint32_t value, bool& inserted) {
-    if (2 * (count_ + 1) > keys_.size()) grow();
-    for (std::size_t i = hash(key) & mask_;; i = (i + 1) & mask_) {
-      if (keys_[i] == kEmpty) {
-        keys_[i] = key;
-        values_[i] = value;
-        ++count_;
-        inserted = true;
-        return value;
-      }
-      if (keys_[i] == key) {
-        inserted = false;
-        return values_[i];
-      }
+    std::uint32_t& b = block_[std::size_t(key / orientations_)];
+    if (b == kNone) {
+      b = std::uint32_t(slots_.size() / orientations_);
+      slots_.resize(slots_.size() + orientations_, kNone);
     }
+    std::uint32_t& slot = slots_[std::size_t(b) * orientations_ + std::size_t(key % orientations_)];
+    inserted = slot == kNone;
+    if (inserted) slot = value;
+    return slot;
   }
+  std::size_t touched_cells() const { return slots_.size() / orientations_; }
   static constexpr std::uint32_t kNone = 0xffffffffu;
 
  private:
-  static constexpr std::uint64_t kEmpty = ~std::uint64_t(0);
-  static std::size_t hash(std::uint64_t k) { return std::size_t(splitmix64(k)); }
-  void resize(std::size_t n) {
-    keys_.assign(n, kEmpty);
-    values_.assign(n, 0);
-    mask_ = n - 1;
-    count_ = 0;
-  }
-  void grow() {
-    auto keys = std::move(keys_);
-    auto values = std::move(values_);
-    resize(keys.size() * 2);
-    bool dummy;
-    for (std::size_t i = 0; i < keys.size(); ++i)
-      if (keys[i] != kEmpty) insert(keys[i], values[i], dummy);
-  }
-  std::vector<std::uint64_t> keys_;
-  std::vector<std::uint32_t> values_;
-  std::size_t mask_ = 0, count_ = 0;
+  std::uint64_t orientations_;
+  std::vector<std::uint32_t> block_;
+  std::vector<std::uint32_t> slots_;
 };
 
 struct Node {
@@ -225,6 +251,7 @@ struct QueueItem {
 
 /// One direction of the search: its nodes, its map and its queue.
 struct Frontier {
+  Frontier(std::size_t cells, std::uint64_t orientations) : map(cells, orientations) {}
   std::vector<Node> nodes;
   NodeMap map;
   std::vector<QueueItem> heap;
@@ -262,22 +289,33 @@ struct Frontier {
 /// arcs cost the same from every orientation, so they are computed once (lazily, NaN = not yet).
 class ArcCache {
  public:
-  ArcCache(const RoadGraph& graph) : graph_(graph), n_(graph.surface_arcs()) {}
-  double get(Cell c, std::size_t cell_index, int arc) {
+  ArcCache(const RoadGraph& graph) : graph_(graph), n_(graph.surface_arcs()), slot_(graph.terrain().cols() * std::size_t(graph.terrain().rows()), kNone) {}
+  /// The cached costs of a cell's surface arcs (NaN = not computed yet); valid until the next call.
+  float* row(std::size_t cell_index) {
+    std::uint32_t& s = slot_[cell_index];
+    if (s == kNone) {
+      s = std::uint32_t(costs_.size() / n_);
+      costs_.resize(costs_.size() + n_, std::numeric_limits<float>::quiet_NaN());
+    }
+    return costs_.data() + std::size_t(s) * n_;
+  }
+  double get(Cell c, float* row, int arc) {
     if (std::size_t(arc) >= n_) return graph_.arc_cost(c, arc);
-    bool inserted;
-    const std::uint32_t slot = map_.insert(cell_index, std::uint32_t(costs_.size() / n_), inserted);
-    if (inserted) costs_.resize(costs_.size() + n_, std::numeric_limits<float>::quiet_NaN());
-    float& v = costs_[std::size_t(slot) * n_ + std::size_t(arc)];
+    float& v = row[arc];
     if (std::isnan(v)) v = float(graph_.arc_cost(c, arc));
     return v;
+  }
+  double get(Cell c, std::size_t cell_index, int arc) {
+    if (std::size_t(arc) >= n_) return graph_.arc_cost(c, arc);
+    return get(c, row(cell_index), arc);
   }
   std::size_t cells() const { return costs_.size() / std::max<std::size_t>(1, n_); }
 
  private:
+  static constexpr std::uint32_t kNone = 0xffffffffu;
   const RoadGraph& graph_;
   std::size_t n_;
-  NodeMap map_;
+  std::vector<std::uint32_t> slot_;
   std::vector<float> costs_;
 };
 
@@ -315,10 +353,11 @@ SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMet
   const std::vector<RoadGraph::Arc>& arcs = graph.arcs();
   const int na = int(arcs.size());
 
-  Frontier fw, bw;
+  Frontier fw(t.size(), O), bw(method == SearchMethod::bidirectional ? t.size() : 0, O);
   ArcCache cache(graph);
   auto check_memory = [&]() {
-    if (fw.nodes.size() + bw.nodes.size() + cache.cells() * graph.surface_arcs() / 8 > max_nodes)
+    if (fw.nodes.size() + bw.nodes.size() + (fw.map.touched_cells() + bw.map.touched_cells()) * O / 4 +
+            cache.cells() * graph.surface_arcs() / 4 > max_nodes)
       throw processing_error("path: the search stored more than " + std::to_string(max_nodes) +
                              " nodes; use a smaller --k or --angles, or closer end points");
   };
@@ -342,12 +381,13 @@ SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMet
       ++result.expanded;
       report(graph.lower_bound(c, to));
       const int o = orient_of(key);
+      float* costs = cache.row(t.index(c.col, c.row));
       for (int a = 0; a < na; ++a) {
         const RoadGraph::Arc& arc = arcs[std::size_t(a)];
         if (!t.inside(c.col + arc.dcol, c.row + arc.drow) || !graph.arc_sampled(c, a)) continue;
         const double turn = graph.turn_cost(o, a);
         if (turn == kInfinity) continue;
-        const double e = cache.get(c, t.index(c.col, c.row), a);
+        const double e = cache.get(c, costs, a);
         if (e == kInfinity) continue;
         const Cell n{c.col + arc.dcol, c.row + arc.drow};
         const double g = q.g + turn + e;
@@ -401,12 +441,13 @@ SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMet
     const int o = orient_of(q.key);
     report(forward ? graph.lower_bound(c, to) : graph.lower_bound(c, from));
     if (forward) {
+      float* costs = cache.row(t.index(c.col, c.row));
       for (int a = 0; a < na; ++a) {
         const RoadGraph::Arc& arc = arcs[std::size_t(a)];
         if (!t.inside(c.col + arc.dcol, c.row + arc.drow) || !graph.arc_sampled(c, a)) continue;
         const double turn = graph.turn_cost(o, a);
         if (turn == kInfinity) continue;
-        const double e = cache.get(c, t.index(c.col, c.row), a);
+        const double e = cache.get(c, costs, a);
         if (e == kInfinity) continue;
         const Cell n{c.col + arc.dcol, c.row + arc.drow};
         const double g = q.g + turn + e;

@@ -65,7 +65,9 @@ class RoadGraph {
   bool arc_sampled(Cell from, int arc) const;
   /// Arcs that reach a node of orientation `o`.
   const std::vector<int>& arcs_into(int orientation) const { return into_[std::size_t(orientation)]; }
-  /// A lower bound of the cost from a to b (straight line x cheapest cost per metre).
+  /// A lower bound of the cost from a to b: the cheapest way to cover the straight-line distance D
+  /// and the height difference Z, min over L >= D of L g(Z/L), where g is the lower convex envelope
+  /// of the per-metre cost against the grade (Z = 0 gives the paper's D x cheapest cost per metre).
   double lower_bound(Cell a, Cell b) const;
   /// Per-metre cost of a surface road at a point with a given slope (deg) (for reports).
   double surface_cost_per_m(double slope_deg, double depth_m) const;
@@ -80,6 +82,8 @@ class RoadGraph {
   double step_m_ = 1, cheapest_ = 1;
   std::uint64_t bridge_keep_ = 0, tunnel_keep_ = 0;  ///< hash thresholds of the sampling
   std::vector<double> turn_;
+  std::vector<double> hull_t_, hull_c_;  ///< lower convex envelope of cost per metre vs grade
+  double kappa_ = 0, best_grade_ = 0;    ///< cheapest cost per metre of climb, and its grade
   std::vector<std::vector<int>> into_;
 };
 

@@ -25,6 +25,7 @@ class TerrainField {
 
   int cols() const { return cols_; }
   int rows() const { return rows_; }
+  std::size_t size() const { return std::size_t(cols_) * std::size_t(rows_); }
   bool inside(int col, int row) const { return col >= 0 && row >= 0 && col < cols_ && row < rows_; }
   std::size_t index(int col, int row) const { return std::size_t(row) * std::size_t(cols_) + std::size_t(col); }
 

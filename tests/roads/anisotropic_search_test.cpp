@@ -67,6 +67,7 @@ TEST(AnisotropicSearch, AStarBidirectionalAndDijkstraAgreeOnRandomProblems) {
     EXPECT_NEAR(s.cost, d.cost, 1e-9 * (1 + d.cost)) << trial;
     EXPECT_NEAR(bi.cost, d.cost, 1e-9 * (1 + d.cost)) << trial;
     EXPECT_LE(s.expanded, d.expanded) << trial;
+    EXPECT_LE(graph.lower_bound(a, b), d.cost * (1 + 1e-12)) << trial;  // the heuristic is admissible
     // The returned paths cost what the searches say (every arc finite, turns included).
     for (const SearchResult* r : {&d, &s, &bi}) {
       ASSERT_EQ(r->cells.front(), a);
