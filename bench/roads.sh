@@ -12,9 +12,9 @@ out=$(mktemp -d); trap 'rm -rf "$out"' EXIT
 
 run() {  # label, extra arguments
   local label=$1; shift
-  /usr/bin/time -f "%e %M" -o "$out/time" "$bin" --progress none path "$dem" --from $from --to $to "$out/$label.geojson" "$@" 2>"$out/$label.log"
-  read -r secs kb <"$out/time"
-  echo "$label: $(grep -o 'galin:.*' "$out/$label.log") | wall ${secs} s, peak ${kb} kB"
+  /usr/bin/time -f "%e %U %M" -o "$out/time" "$bin" --progress none path "$dem" --from $from --to $to "$out/$label.geojson" "$@" 2>"$out/$label.log"
+  read -r secs user kb <"$out/time"
+  echo "$label: $(grep -o 'galin:.*' "$out/$label.log") | wall ${secs} s, CPU ${user} s, peak ${kb} kB"
 }
 run surface_astar --no-bridges --no-tunnels
 run surface_bidir --no-bridges --no-tunnels --search bidir
@@ -24,7 +24,7 @@ if command -v grass >/dev/null; then
   # GRASS: r.walk (anisotropic walking cost, Naismith/Langmuir) from the start, r.drain back from the end.
   gdal_translate -q -of GTiff "$dem" "$out/dem.tif"
   start=$(echo $from | tr , ' '); end=$(echo $to | tr , ' ')
-  t0=$(date +%s.%N)
+  t0=$(date +%s.%N); c0=$(awk "{print \$14+\$15+\$16+\$17}" /proc/$$/stat)
   grass -c "$out/dem.tif" "$out/loc" --exec bash -c "
     set -e
     r.in.gdal -q input=$out/dem.tif output=dem

@@ -62,19 +62,27 @@ std::optional<Road> route_road(const TerrainField& t, const RoadGraph& graph, Ce
   Road road;
   const auto a = snap_to_land(t, from, options.snap_cells), b = snap_to_land(t, to, options.snap_cells);
   const auto& land = t.land_components();
-  if (!a || !b || land[t.index(a->col, a->row)] != land[t.index(b->col, b->row)]) {
+  auto ferry = [&]() {
     // A maritime link (Belhadj §4.4.4): the two ends cannot be joined on the ground.
     road.ferry = true;
     road.router = "ferry";
+    road.cost.reset();
     road.ferry_line = {{double(from.col), double(from.row)}, {double(to.col), double(to.row)}};
+    road.stats = {};
     road.stats.length_m = t.length_m(road.ferry_line[0], road.ferry_line[1]);
     return road;
-  }
+  };
+  const bool apart = !a || !b || land[t.index(a->col, a->row)] != land[t.index(b->col, b->row)];
+  // Two land masses: only bridges can join them on the ground (an archipelago), else a ferry.
+  if (!a || !b || (apart && (options.router == Router::bezier || !graph.model().bridge.enabled))) return ferry();
   if (options.router == Router::galin) {
     const SearchResult s = shortest_path(graph, *a, *b, options.search, options.max_nodes, progress);
     road.expanded = s.expanded;
     road.nodes = s.nodes;
-    if (!s.found) return std::nullopt;
+    if (!s.found) {
+      if (apart) return ferry();
+      return std::nullopt;
+    }
     road.router = "galin";
     road.cost = s.cost;
     road.geometry = build_road_geometry(t, graph.model(), s);
