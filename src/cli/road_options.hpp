@@ -17,7 +17,8 @@ struct RoadOptions {
   std::uint64_t seed = 1;
   double sea_level = 0;
   std::string router = "galin";
-  int bezier_evaluations = 1000;
+  int bezier_evaluations = 1000, bezier_tries = 20;
+  double bezier_threshold = 0.1;
 
   void setup(CLI::App& app) {
     app.add_option("--router", router, "Router: galin (anisotropic shortest path) or bezier (Belhadj 2007 Alg. 16)")
@@ -29,7 +30,9 @@ struct RoadOptions {
     app.add_flag("--tunnels,!--no-tunnels", tunnels, "Allow tunnels (long arcs under ridges); default on");
     app.add_option("--seed", seed, "Seed of the stochastic bridge/tunnel arcs and of the Bézier router");
     app.add_option("--sea-level", sea_level, "Cells at or below this height (m) and nodata cells are water");
-    app.add_option("--bezier-evaluations", bezier_evaluations, "Bézier router budget: curve evaluations per road")->check(CLI::Range(1, 1000000));
+    app.add_option("--bezier-evaluations", bezier_evaluations, "Bézier router budget: curve evaluations per road (replaces the thesis' 1000 ms, for reproducible roads)")->check(CLI::Range(1, 1000000));
+    app.add_option("--bezier-threshold", bezier_threshold, "Bézier router: stop when the worst position costs less (0..1)")->check(CLI::Range(0.0, 1.0));
+    app.add_option("--bezier-tries", bezier_tries, "Bézier router: control points drawn per worst position")->check(CLI::Range(1, 100000));
     app.add_flag("--overwrite", overwrite, "Replace existing outputs");
   }
 
@@ -46,6 +49,8 @@ struct RoadOptions {
     r.graph = graph();
     r.bezier.seed = seed;
     r.bezier.max_evaluations = bezier_evaluations;
+    r.bezier.threshold = bezier_threshold;
+    r.bezier.tries = bezier_tries;
     return r;
   }
 };
