@@ -202,40 +202,7 @@ double RoadGraph::lower_bound(Cell a, Cell b) const {
 
 namespace {
 
-/// Node key -> node index, stored per cell: a dense array of 4 bytes per grid cell holds the
-/// block of a touched cell, and a block holds the indices of its `orientations` nodes. Lookups
-/// are two array reads (no hashing); memory is 4 bytes per cell plus 4 x orientations bytes per
-/// touched cell (a 3601 x 3601 SRTM tile: 52 MB for the cell array).
-class NodeMap {
- public:
-  NodeMap(std::size_t cells, std::uint64_t orientations) : orientations_(orientations), block_(cells, kNone) {}
-  std::uint32_t find(std::uint64_t key) const {
-    const std::uint32_t b = block_[std::size_t(key / orientations_)];
-    return b == kNone ? kNone : slots_[std::size_t(b) * orientations_ + std::size_t(key % orientations_)];
-  }
-  /// Returns the index stored for `key`, inserting `value` when absent.
-  std::uint32_t insert(std::uint64_t key, std::uint32_t value, bool& inserted) {
-    std::uint32_t& b = block_[std::size_t(key / orientations_)];
-    if (b == kNone) {
-      b = std::uint32_t(slots_.size() / orientations_);
-      slots_.resize(slots_.size() + orientations_, kNone);
-    }
-    std::uint32_t& slot = slots_[std::size_t(b) * orientations_ + std::size_t(key % orientations_)];
-    inserted = slot == kNone;
-    if (inserted) slot = value;
-    return slot;
-  }
-  std::size_t touched_cells() const { return slots_.size() / orientations_; }
-  static constexpr std::uint32_t kNone = 0xffffffffu;
-
- private:
-  std::uint64_t orientations_;
-  std::vector<std::uint32_t> block_;
-  std::vector<std::uint32_t> slots_;
-};
-
 struct Node {
-  std::uint64_t key;
   double g;
   std::uint32_t parent;  ///< forward: predecessor; backward: successor towards the goal
   std::int32_t arc;      ///< arc joining the node and its parent
@@ -249,11 +216,18 @@ struct QueueItem {
   bool operator<(const QueueItem& o) const { return f != o.f ? f > o.f : key > o.key; }  // min-heap, ties by key
 };
 
-/// One direction of the search: its nodes, its map and its queue.
+/// One direction of the search: its nodes and its queue. Nodes are stored per cell: a dense array
+/// of 4 bytes per grid cell points to the cell's block of `orientations` nodes, allocated on first
+/// touch, so a lookup is two array reads and memory follows the explored cells (a 3601 x 3601 SRTM
+/// tile needs 52 MB for the cell array; a node is 16 bytes).
 struct Frontier {
-  Frontier(std::size_t cells, std::uint64_t orientations) : map(cells, orientations) {}
-  std::vector<Node> nodes;
-  NodeMap map;
+  static constexpr std::uint32_t kNone = 0xffffffffu;
+  Frontier(std::size_t cells, std::uint64_t orientations) : orientations(orientations), block(cells, kNone) {}
+  std::uint64_t orientations;
+  std::vector<std::uint32_t> block;       ///< per grid cell: its block, or kNone
+  std::vector<std::uint32_t> block_cell;  ///< per block: its cell
+  std::vector<Node> nodes;                ///< block * orientations + orientation
+  std::size_t stored = 0;
   std::vector<QueueItem> heap;
   double top() const { return heap.empty() ? kInfinity : heap.front().f; }
   void push(const QueueItem& q) {
@@ -266,20 +240,30 @@ struct Frontier {
     heap.pop_back();
     return q;
   }
-  /// Relaxes `key` to cost g through `parent`/`arc`; returns the node index when improved.
-  std::uint32_t relax(std::uint64_t key, double g, std::uint32_t parent, int arc, bool& improved) {
-    bool inserted;
-    const std::uint32_t idx = map.insert(key, std::uint32_t(nodes.size()), inserted);
-    if (inserted) {
-      nodes.push_back({key, g, parent, arc});
-      improved = true;
-    } else if (g < nodes[idx].g) {
-      nodes[idx].g = g;
-      nodes[idx].parent = parent;
-      nodes[idx].arc = arc;
-      improved = true;
-    } else {
-      improved = false;
+  std::uint64_t key(std::uint32_t idx) const {
+    return std::uint64_t(block_cell[idx / orientations]) * orientations + idx % orientations;
+  }
+  /// Index of the node of `key`, or kNone when it was never reached.
+  std::uint32_t find(std::uint64_t k) const {
+    const std::uint32_t b = block[std::size_t(k / orientations)];
+    if (b == kNone) return kNone;
+    const std::uint32_t idx = std::uint32_t(std::uint64_t(b) * orientations + k % orientations);
+    return nodes[idx].g == kInfinity ? kNone : idx;
+  }
+  /// Relaxes `key` to cost g through `parent`/`arc`; returns the node index.
+  std::uint32_t relax(std::uint64_t k, double g, std::uint32_t parent, int arc, bool& improved) {
+    std::uint32_t& b = block[std::size_t(k / orientations)];
+    if (b == kNone) {
+      b = std::uint32_t(block_cell.size());
+      block_cell.push_back(std::uint32_t(k / orientations));
+      nodes.resize(nodes.size() + orientations, Node{kInfinity, kNone, -1});
+    }
+    const std::uint32_t idx = std::uint32_t(std::uint64_t(b) * orientations + k % orientations);
+    Node& n = nodes[idx];
+    improved = g < n.g;
+    if (improved) {
+      if (n.g == kInfinity) ++stored;
+      n = {g, parent, arc};
     }
     return idx;
   }
@@ -356,19 +340,18 @@ SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMet
   Frontier fw(t.size(), O), bw(method == SearchMethod::bidirectional ? t.size() : 0, O);
   ArcCache cache(graph);
   auto check_memory = [&]() {
-    if (fw.nodes.size() + bw.nodes.size() + (fw.map.touched_cells() + bw.map.touched_cells()) * O / 4 +
-            cache.cells() * graph.surface_arcs() / 4 > max_nodes)
+    if (fw.nodes.size() + bw.nodes.size() + cache.cells() * graph.surface_arcs() / 4 > max_nodes)
       throw processing_error("path: the search stored more than " + std::to_string(max_nodes) +
                              " nodes; use a smaller --k or --angles, or closer end points");
   };
   {
     bool imp;
-    const std::uint32_t s = fw.relax(key_of(from, graph.start_orientation()), 0.0, NodeMap::kNone, -1, imp);
-    fw.push({use_h ? h0 : 0.0, fw.nodes[s].key, s, 0.0});
+    const std::uint32_t s = fw.relax(key_of(from, graph.start_orientation()), 0.0, Frontier::kNone, -1, imp);
+    fw.push({use_h ? h0 : 0.0, fw.key(s), s, 0.0});
   }
 
   if (method != SearchMethod::bidirectional) {
-    std::uint32_t goal_node = NodeMap::kNone;
+    std::uint32_t goal_node = Frontier::kNone;
     while (!fw.heap.empty()) {
       const QueueItem q = fw.pop();
       if (q.g > fw.nodes[q.node].g) continue;  // stale entry
@@ -393,16 +376,16 @@ SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMet
         const double g = q.g + turn + e;
         bool improved;
         const std::uint32_t idx = fw.relax(key_of(n, arc.orientation), g, q.node, a, improved);
-        if (improved) fw.push({g + (use_h ? graph.lower_bound(n, to) : 0.0), fw.nodes[idx].key, idx, g});
+        if (improved) fw.push({g + (use_h ? graph.lower_bound(n, to) : 0.0), fw.key(idx), idx, g});
       }
       check_memory();
     }
-    result.nodes = fw.nodes.size();
-    if (goal_node == NodeMap::kNone) return result;
+    result.nodes = fw.stored;
+    if (goal_node == Frontier::kNone) return result;
     result.found = true;
     result.cost = fw.nodes[goal_node].g;
-    for (std::uint32_t n = goal_node; n != NodeMap::kNone; n = fw.nodes[n].parent) {
-      result.cells.push_back(cell_of(fw.nodes[n].key));
+    for (std::uint32_t n = goal_node; n != Frontier::kNone; n = fw.nodes[n].parent) {
+      result.cells.push_back(cell_of(fw.key(n)));
       if (fw.nodes[n].arc >= 0) result.structures.push_back(arcs[std::size_t(fw.nodes[n].arc)].structure);
     }
     std::reverse(result.cells.begin(), result.cells.end());
@@ -415,14 +398,14 @@ SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMet
   // cross both open lists below mu.
   for (int o = 0; o < graph.start_orientation(); ++o) {
     bool imp;
-    const std::uint32_t s = bw.relax(key_of(to, o), 0.0, NodeMap::kNone, -1, imp);
-    bw.push({use_h ? h0 : 0.0, bw.nodes[s].key, s, 0.0});
+    const std::uint32_t s = bw.relax(key_of(to, o), 0.0, Frontier::kNone, -1, imp);
+    bw.push({use_h ? h0 : 0.0, bw.key(s), s, 0.0});
   }
   double mu = kInfinity;
   std::uint64_t meet = 0;
   auto try_meet = [&](std::uint64_t key, double g, const Frontier& other) {
-    const std::uint32_t j = other.map.find(key);
-    if (j == NodeMap::kNone) return;
+    const std::uint32_t j = other.find(key);
+    if (j == Frontier::kNone) return;
     const double total = g + other.nodes[j].g;
     if (total < mu || (total == mu && key < meet)) {
       mu = total;
@@ -454,8 +437,8 @@ SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMet
         bool improved;
         const std::uint32_t idx = me.relax(key_of(n, arc.orientation), g, q.node, a, improved);
         if (improved) {
-          me.push({g + (use_h ? graph.lower_bound(n, to) : 0.0), me.nodes[idx].key, idx, g});
-          try_meet(me.nodes[idx].key, g, other);
+          me.push({g + (use_h ? graph.lower_bound(n, to) : 0.0), me.key(idx), idx, g});
+          try_meet(me.key(idx), g, other);
         }
       }
     } else {
@@ -476,27 +459,27 @@ SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMet
           bool improved;
           const std::uint32_t idx = me.relax(key_of(p, po), g, q.node, a, improved);
           if (improved) {
-            me.push({g + hp, me.nodes[idx].key, idx, g});
-            try_meet(me.nodes[idx].key, g, other);
+            me.push({g + hp, me.key(idx), idx, g});
+            try_meet(me.key(idx), g, other);
           }
         }
       }
     }
     check_memory();
   }
-  result.nodes = fw.nodes.size() + bw.nodes.size();
+  result.nodes = fw.stored + bw.stored;
   if (mu == kInfinity) return result;
   result.found = true;
   result.cost = mu;
-  for (std::uint32_t n = fw.map.find(meet); n != NodeMap::kNone; n = fw.nodes[n].parent) {
-    result.cells.push_back(cell_of(fw.nodes[n].key));
+  for (std::uint32_t n = fw.find(meet); n != Frontier::kNone; n = fw.nodes[n].parent) {
+    result.cells.push_back(cell_of(fw.key(n)));
     if (fw.nodes[n].arc >= 0) result.structures.push_back(arcs[std::size_t(fw.nodes[n].arc)].structure);
   }
   std::reverse(result.cells.begin(), result.cells.end());
   std::reverse(result.structures.begin(), result.structures.end());
-  for (std::uint32_t n = bw.map.find(meet); n != NodeMap::kNone && bw.nodes[n].parent != NodeMap::kNone; n = bw.nodes[n].parent) {
+  for (std::uint32_t n = bw.find(meet); n != Frontier::kNone && bw.nodes[n].parent != Frontier::kNone; n = bw.nodes[n].parent) {
     const Node& nd = bw.nodes[n];
-    result.cells.push_back(cell_of(bw.nodes[nd.parent].key));
+    result.cells.push_back(cell_of(bw.key(nd.parent)));
     result.structures.push_back(arcs[std::size_t(nd.arc)].structure);
   }
   return result;
