@@ -31,3 +31,10 @@ expect_fail "k" --from 9.30,42.68 --to 9.42,42.70 --k 0
 # Negative coordinates typed as is, in the DEM's CRS (UTM, southern hemisphere).
 "$bin" -q path "$samples/stars_olinda_dem_utm25s.tif" --crs dem --from 292000,9112000 --to 296000,9117000 "$out/olinda.geojson" --no-bridges --no-tunnels
 grep -q LineString "$out/olinda.geojson"
+# Pricing a given line (as the benchmark prices GRASS's path) prints a cost and writes nothing.
+cost=$("$bin" -q path "$dem" --from 9.30,42.68 --to 9.42,42.70 "$out/none.geojson" --evaluate "$out/road.geojson")
+[[ "$cost" == cost* ]] || { echo "evaluate printed '$cost'"; exit 1; }
+[[ ! -e "$out/none.geojson" ]]
+# The Bézier router answers the same question.
+"$bin" -q path "$dem" --from 9.30,42.68 --to 9.42,42.70 "$out/bezier.geojson" --router bezier --bezier-evaluations 200
+grep -q '"router": "bezier"' "$out/bezier.geojson"
