@@ -34,6 +34,7 @@ RoadGraph::RoadGraph(const TerrainField& terrain, const CostModel& model, const 
     : terrain_(terrain), model_(model), options_(options) {
   if (options.angles < 1 || options.angles > 64) throw bad_input("--angles: must be in 1..64, got " + std::to_string(options.angles));
   const int m = options.angles;
+  for (int s = 0; s < 3; ++s) salt_[s] = splitmix64(options.seed * 3 + std::uint64_t(s));
   step_m_ = model.sample_step_m > 0 ? model.sample_step_m : 0.5 * terrain.min_cell_m();
   cheapest_ = model.cheapest_per_metre();
   // Orientation layers: one block of m sectors per enabled structure, then the "start" orientation.
@@ -127,7 +128,7 @@ bool RoadGraph::arc_sampled(Cell from, int arc) const {
   if (a.structure == Structure::road) return true;
   const std::uint64_t p = terrain_.index(from.col, from.row), q = terrain_.index(from.col + a.dcol, from.row + a.drow);
   const std::uint64_t lo = std::min(p, q), hi = std::max(p, q);
-  const std::uint64_t h = splitmix64(splitmix64(options_.seed * 3 + std::uint64_t(a.structure)) ^ (lo * 0x100000001b3ULL + hi));
+  const std::uint64_t h = splitmix64(salt_[int(a.structure)] ^ (lo * 0x100000001b3ULL + hi));
   return h <= (a.structure == Structure::bridge ? bridge_keep_ : tunnel_keep_);
 }
 

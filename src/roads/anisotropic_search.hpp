@@ -81,6 +81,7 @@ class RoadGraph {
   int orientations_ = 1;
   double step_m_ = 1, cheapest_ = 1;
   std::uint64_t bridge_keep_ = 0, tunnel_keep_ = 0;  ///< hash thresholds of the sampling
+  std::uint64_t salt_[3] = {0, 0, 0};                ///< per-structure hash salt from the seed
   std::vector<double> turn_;
   std::vector<double> hull_t_, hull_c_;  ///< lower convex envelope of cost per metre vs grade
   double kappa_ = 0, best_grade_ = 0;    ///< cheapest cost per metre of climb, and its grade

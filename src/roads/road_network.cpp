@@ -5,7 +5,6 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include <atomic>
 #include <cmath>
 #include <map>
 
@@ -148,12 +147,9 @@ NetworkResult route_network(const TerrainField& t, const RoadGraph& graph, const
     edges.push_back({as_int(f.values[std::size_t(f_from)]).value_or(-1), as_int(f.values[std::size_t(f_to)]).value_or(-1), *a, *b});
   }
   std::vector<std::optional<Road>> out(edges.size());
-  std::atomic<std::size_t> done{0};
   ProgressStep step(progress, "roads");
-  std::atomic<bool> cancelled{false};
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, edges.size(), 1), [&](const tbb::blocked_range<std::size_t>& range) {
     for (std::size_t i = range.begin(); i != range.end(); ++i) {
-      if (cancelled) return;
       RoutingOptions o = options;
       o.bezier.seed = mix(options.bezier.seed ^ mix(i));
       const Edge& e = edges[i];
@@ -163,7 +159,6 @@ NetworkResult route_network(const TerrainField& t, const RoadGraph& graph, const
         out[i]->from = e.from;
         out[i]->to = e.to;
       }
-      done.fetch_add(1);
     }
   });
   step.update(1.0);
