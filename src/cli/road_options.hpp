@@ -6,13 +6,14 @@
 #include <cstdint>
 #include <string>
 
+#include "io/raster_io.hpp"
 #include "roads/road_network.hpp"
 
 namespace terrapolis::cli {
 
 struct RoadOptions {
   int k = 5, angles = 8;
-  std::string costs;
+  std::string costs, vegetation;
   bool bridges = true, tunnels = true, overwrite = false;
   std::uint64_t seed = 1;
   double sea_level = 0;
@@ -28,6 +29,7 @@ struct RoadOptions {
     app.add_option("--costs", costs, "JSON file overriding the default transfer functions");
     app.add_flag("--bridges,!--no-bridges", bridges, "Allow bridges (long arcs over valleys and water); default on");
     app.add_flag("--tunnels,!--no-tunnels", tunnels, "Allow tunnels (long arcs under ridges); default on");
+    app.add_option("--vegetation", vegetation, "Raster of vegetation / land-cover density (any GDAL raster, warped onto the DEM grid) priced by the 'vegetation' transfer functions");
     app.add_option("--seed", seed, "Seed of the stochastic bridge/tunnel arcs and of the Bézier router");
     app.add_option("--sea-level", sea_level, "Cells at or below this height (m) and nodata cells are water");
     app.add_option("--bezier-evaluations", bezier_evaluations, "Bézier router budget: curve evaluations per road (replaces the thesis' 1000 ms, for reproducible roads)")->check(CLI::Range(1, 1000000));
@@ -41,6 +43,11 @@ struct RoadOptions {
     if (!bridges) m.bridge.enabled = false;
     if (!tunnels) m.tunnel.enabled = false;
     return m;
+  }
+  /// Loads --vegetation onto the DEM's grid when given.
+  void load_layers(roads::TerrainField& terrain) const {
+    if (vegetation.empty()) return;
+    terrain.set_vegetation(read_resampled(vegetation, terrain.georef(), terrain.cols(), terrain.rows(), Resampling::bilinear));
   }
   roads::GraphOptions graph() const { return {k, angles, seed}; }
   roads::RoutingOptions routing() const {

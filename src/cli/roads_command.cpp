@@ -46,7 +46,8 @@ class RoadsCommand final : public Command {
 
     const roads::CostModel model = options_.cost_model();
     const Dem dem = read_dem(dem_);
-    const roads::TerrainField terrain(dem, options_.sea_level, model.unknown_water_depth_m, model.road_radius_m);
+    roads::TerrainField terrain(dem, options_.sea_level, model.unknown_water_depth_m, model.road_radius_m);
+    options_.load_layers(terrain);
     const VectorLayer network = read_vector(network_, dem.georef().crs);
     std::string cities_path = cities_;
     if (cities_path.empty()) {

@@ -66,11 +66,13 @@ RoadGraph::RoadGraph(const TerrainField& terrain, const CostModel& model, const 
   {
     std::vector<std::array<double, 2>> pts;
     for (double sdeg = 0; sdeg <= 89.5; sdeg += 0.05) {
-      double c = model.road.slope_deg(sdeg) + model.road.water_depth_m.min_value();
+      double c = model.road.slope_deg(sdeg) + model.road.water_depth_m.min_value() + model.road.vegetation.min_value();
       if (model.bridge.enabled)
-        c = std::min(c, model.bridge.slope_deg(sdeg) + model.bridge.water_depth_m.min_value() + model.bridge.height_m.min_value());
+        c = std::min(c, model.bridge.slope_deg(sdeg) + model.bridge.water_depth_m.min_value() + model.bridge.height_m.min_value() +
+                                model.bridge.vegetation.min_value());
       if (model.tunnel.enabled)
-        c = std::min(c, model.tunnel.slope_deg(sdeg) + model.tunnel.water_depth_m.min_value() + model.tunnel.depth_m.min_value());
+        c = std::min(c, model.tunnel.slope_deg(sdeg) + model.tunnel.water_depth_m.min_value() + model.tunnel.depth_m.min_value() +
+                                model.tunnel.vegetation.min_value());
       if (c == kInfinity) continue;
       pts.push_back({std::tan(sdeg / kDeg), 0.99 * c});
     }
@@ -144,12 +146,15 @@ double RoadGraph::arc_cost(Cell from, int arc) const {
   double total = 0;
   if (a.structure == Structure::road) {
     const StructureCosts& sc = model_.road;
+    const bool veg = terrain_.has_vegetation();
+    const double veg0 = veg ? 0.0 : sc.vegetation(0.0);  // without a layer the density is 0 everywhere
     double z0 = terrain_.surface(from.col, from.row);
     for (int i = 1; i <= n; ++i) {
       const double z1 = i == n ? terrain_.surface(c1, r1) : terrain_.surface_at(from.col + dc * i, from.row + dr * i);
       const double slope = std::atan(std::fabs(z1 - z0) / dl) * kDeg;
       const double depth = terrain_.depth_at(from.col + dc * (i - 0.5), from.row + dr * (i - 0.5));
-      const double c = sc.slope_deg(slope) + sc.water_depth_m(depth);
+      double c = sc.slope_deg(slope) + sc.water_depth_m(depth) + veg0;
+      if (veg) c += sc.vegetation(terrain_.vegetation_at(from.col + dc * (i - 0.5), from.row + dr * (i - 0.5)));
       if (c == kInfinity) return kInfinity;
       total += c * dl;
       z0 = z1;
@@ -173,10 +178,12 @@ double RoadGraph::arc_cost(Cell from, int arc) const {
       const double h = deck - terrain_.surface_at(col, row);
       if (h < 0) return kInfinity;  // the deck would cut the ground
       c = sc.height_m(h) + sc.water_depth_m(depth);
+      c += sc.vegetation(terrain_.vegetation_at(col, row));
     } else {
       const double d = terrain_.ground_at(col, row) - deck;
       if (d < 0) return kInfinity;  // the tube would leave the ground (or the sea floor)
       c = sc.depth_m(d) + sc.water_depth_m(depth);
+      c += sc.vegetation(terrain_.vegetation_at(col, row));
     }
     if (c == kInfinity) return kInfinity;
     total += (c + per_m_slope) * dl;

@@ -43,11 +43,13 @@ const char* structure_name(Structure s) {
 }
 
 double CostModel::cheapest_per_metre() const {
-  double best = road.slope_deg.min_value() + road.water_depth_m.min_value();
+  double best = road.slope_deg.min_value() + road.water_depth_m.min_value() + road.vegetation.min_value();
   if (bridge.enabled)
-    best = std::min(best, bridge.slope_deg.min_value() + bridge.water_depth_m.min_value() + bridge.height_m.min_value());
+    best = std::min(best, bridge.slope_deg.min_value() + bridge.water_depth_m.min_value() + bridge.height_m.min_value() +
+                              bridge.vegetation.min_value());
   if (tunnel.enabled)
-    best = std::min(best, tunnel.slope_deg.min_value() + tunnel.water_depth_m.min_value() + tunnel.depth_m.min_value());
+    best = std::min(best, tunnel.slope_deg.min_value() + tunnel.water_depth_m.min_value() + tunnel.depth_m.min_value() +
+                              tunnel.vegetation.min_value());
   return std::max(0.0, best);
 }
 
@@ -59,6 +61,10 @@ CostModel default_cost_model() {
   m.road.water_depth_m = {{{0, 0}, {0.5, 50}}, 0.5};
   // Per turn; convex so that a bend made of small turns costs less than one sharp turn.
   m.road.curvature_deg = {{{0, 0}, {20, 1}, {45, 6}, {90, 30}, {135, 80}, {170, 150}}, 170};
+  // Vegetation (only with --vegetation): dense cover doubles the cost of a road, no threshold;
+  // bridges pass over it at a tenth of that, tunnels under it for free (Peytavie §4.2.3).
+  m.road.vegetation = {{{0, 0}, {1, 1}}, kInfinity};
+  m.bridge.vegetation = {{{0, 0}, {1, 0.1}}, kInfinity};
   // Bridges: dearer per metre than roads, with a stricter slope and curvature; over water up to 50 m deep.
   m.bridge.slope_deg = {{{0, 1}, {4, 3}, {8, 10}}, 8};
   m.bridge.water_depth_m = {{{0, 0}, {50, 10}}, 50};
@@ -122,6 +128,7 @@ void read_structure(const json& j, StructureCosts& s, const std::string& origin,
     if (name == "slope_deg") read_transfer(*it, s.slope_deg, origin, k);
     else if (name == "water_depth_m") read_transfer(*it, s.water_depth_m, origin, k);
     else if (name == "curvature_deg") read_transfer(*it, s.curvature_deg, origin, k);
+    else if (name == "vegetation") read_transfer(*it, s.vegetation, origin, k);
     else if (name == "height_m" && key == "bridge") read_transfer(*it, s.height_m, origin, k);
     else if (name == "depth_m" && key == "tunnel") read_transfer(*it, s.depth_m, origin, k);
     else if (name == "enabled" && long_arcs) {
@@ -151,6 +158,7 @@ json structure_json(const StructureCosts& s, bool bridge, bool tunnel) {
   j["slope_deg"] = transfer_json(s.slope_deg);
   j["water_depth_m"] = transfer_json(s.water_depth_m);
   j["curvature_deg"] = transfer_json(s.curvature_deg);
+  j["vegetation"] = transfer_json(s.vegetation);
   if (bridge) j["height_m"] = transfer_json(s.height_m);
   if (tunnel) j["depth_m"] = transfer_json(s.depth_m);
   if (bridge || tunnel) {

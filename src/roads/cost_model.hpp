@@ -33,6 +33,7 @@ struct StructureCosts {
   TransferFunction slope_deg;       ///< per metre, slope of the road (degrees, >= 0)
   TransferFunction water_depth_m;   ///< per metre, water depth under the road (m, >= 0)
   TransferFunction curvature_deg;   ///< per turn, turn angle between arcs (degrees, 0..180)
+  TransferFunction vegetation;      ///< per metre, vegetation / land-cover density from --vegetation (raster units, e.g. 0..1)
   TransferFunction height_m;        ///< bridges: per metre, deck height above ground or water (m)
   TransferFunction depth_m;         ///< tunnels: per metre, depth below the ground (m)
   /// Bridges/tunnels: length range of the long arcs. Null = the paper's 50..300 m on its 10 m

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/error.hpp"
 #include "core/neighbours.hpp"
 
 namespace terrapolis::roads {
@@ -105,6 +106,18 @@ double TerrainField::ground_at(double col, double row) const { return bilinear(g
 float TerrainField::depth_at(double col, double row) const {
   const int c = std::clamp(int(std::lround(col)), 0, cols_ - 1), r = std::clamp(int(std::lround(row)), 0, rows_ - 1);
   return depth_[index(c, r)];
+}
+
+void TerrainField::set_vegetation(const Raster<float>& density) {
+  if (density.cols() != cols_ || density.rows() != rows_) throw bad_input("vegetation layer: not on the DEM's grid");
+  vegetation_.resize(density.size());
+  for (std::size_t i = 0; i < density.size(); ++i) vegetation_[i] = std::isnan(density[i]) ? 0.f : density[i];
+}
+
+float TerrainField::vegetation_at(double col, double row) const {
+  if (vegetation_.empty()) return 0.f;
+  const int c = std::clamp(int(std::lround(col)), 0, cols_ - 1), r = std::clamp(int(std::lround(row)), 0, rows_ - 1);
+  return vegetation_[index(c, r)];
 }
 
 double TerrainField::metres_x(double row) const {

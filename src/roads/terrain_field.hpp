@@ -39,6 +39,11 @@ class TerrainField {
   double ground_at(double col, double row) const;
   /// Water depth (m) at the nearest cell, the maximum within the road radius; 0 on land.
   float depth_at(double col, double row) const;
+  /// Sets the vegetation / land-cover density layer (same grid as the DEM; NaN counts as 0).
+  void set_vegetation(const Raster<float>& density);
+  /// Vegetation density at the nearest cell (0 without a layer).
+  float vegetation_at(double col, double row) const;
+  bool has_vegetation() const { return !vegetation_.empty(); }
   bool water(int col, int row) const { return water_[index(col, row)] != 0; }
   bool has_bathymetry() const { return bathymetry_; }
   double sea_level() const { return sea_level_; }
@@ -69,7 +74,7 @@ class TerrainField {
   double sea_level_ = 0;
   bool bathymetry_ = false;
   double min_cell_m_ = 1, typical_cell_m_ = 1;
-  std::vector<float> surface_, ground_, depth_;
+  std::vector<float> surface_, ground_, depth_, vegetation_;
   std::vector<std::uint8_t> water_;
   std::vector<std::int32_t> land_;
 };

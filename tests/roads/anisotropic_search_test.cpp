@@ -219,3 +219,25 @@ TEST(AnisotropicSearch, CurvatureLayersStraightenTheRoad) {
     EXPECT_LT(turn, 30.0);
   }
 }
+
+TEST(AnisotropicSearch, DenseVegetationIsWalkedAround) {
+  // A forest block (density 1) on the straight line; its transfer function makes it 9 times dearer.
+  const Dem dem = test::make_dem(40, 40, 10.0, [](int, int) { return 50.0; });
+  TerrainField terrain(dem, 0.0, 10.0, 0.0);
+  Raster<float> forest = dem.like<float>(0.f);
+  for (int r = 10; r < 30; ++r)
+    for (int c = 15; c < 25; ++c) forest(c, r) = 1.f;
+  CostModel m = default_cost_model();
+  m.bridge.enabled = m.tunnel.enabled = false;
+  m.road.vegetation = {{{0, 0}, {1, 8}}, kInfinity};
+  const RoadGraph plain(terrain, m, {4, 8, 1});
+  const SearchResult r0 = shortest_path(plain, {5, 20}, {35, 20}, SearchMethod::astar);
+  terrain.set_vegetation(forest);
+  const RoadGraph wooded(terrain, m, {4, 8, 1});
+  const SearchResult r1 = shortest_path(wooded, {5, 20}, {35, 20}, SearchMethod::astar);
+  const SearchResult r2 = shortest_path(wooded, {5, 20}, {35, 20}, SearchMethod::dijkstra);
+  ASSERT_TRUE(r0.found && r1.found && r2.found);
+  EXPECT_NEAR(r1.cost, r2.cost, 1e-9 * r2.cost);
+  EXPECT_GT(r1.cost, r0.cost);
+  for (const Cell& c : r1.cells) EXPECT_FALSE(c.col > 15 && c.col < 24 && c.row > 10 && c.row < 29) << c.col << "," << c.row;
+}
