@@ -2,6 +2,9 @@
 // SPDX-License-Identifier: MIT
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <sstream>
+
 #include "core/error.hpp"
 #include "roads/cost_model.hpp"
 
@@ -56,4 +59,21 @@ TEST(CostModel, BadFilesAreRefusedWithTheKey) {
   EXPECT_THROW(parse_cost_model("{not json", "costs.json"), terrapolis::Error);
   EXPECT_THROW(parse_cost_model(R"({"road": {"slope_deg": {"points": [[5, 1], [2, 1]]}}})", "c"), terrapolis::Error);
   EXPECT_THROW(load_cost_model("/nonexistent/costs.json"), terrapolis::Error);
+}
+
+TEST(CostModel, DocumentedDefaultsAreTheCodeDefaults) {
+  // docs/roads_costs.json is the default cost file shown to users; it must stay what the code uses.
+  std::ifstream in(std::string(TERRAPOLIS_SAMPLES) + "/../docs/roads_costs.json");
+  ASSERT_TRUE(in.good());
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const CostModel documented = parse_cost_model(ss.str(), "docs/roads_costs.json", CostModel{});
+  EXPECT_EQ(cost_model_json(documented), cost_model_json(default_cost_model()));
+}
+
+TEST(CostModel, TheDocumentedExampleParses) {
+  const CostModel m = parse_cost_model(
+      R"({"road": {"slope_deg": {"points": [[0,1],[5,2],[10,6]], "threshold": 10}}, "bridge": {"samples": 250}})", "example");
+  EXPECT_EQ(m.bridge.samples, 250);
+  EXPECT_DOUBLE_EQ(m.road.slope_deg(7.5), 4);
 }
