@@ -48,14 +48,18 @@ class RoadsCommand final : public Command {
     const Dem dem = read_dem(dem_);
     roads::TerrainField terrain(dem, options_.sea_level, model.unknown_water_depth_m, model.road_radius_m);
     options_.load_layers(terrain);
-    const VectorLayer network = read_vector(network_, dem.georef().crs);
+    VectorLayer network = read_vector(network_, dem.georef().crs);
+    network.name = network_;  // errors name the file
     std::string cities_path = cities_;
     if (cities_path.empty()) {
       const fs::path beside = fs::path(network_).parent_path() / "cities.geojson";
       if (fs::exists(beside)) cities_path = beside.string();
     }
     std::optional<VectorLayer> cities;
-    if (!cities_path.empty()) cities = read_vector(cities_path, dem.georef().crs);
+    if (!cities_path.empty()) {
+      cities = read_vector(cities_path, dem.georef().crs);
+      cities->name = cities_path;
+    }
     else context.log.warn("no cities.geojson beside the network: every road is departmental");
 
     const roads::RoadGraph graph(terrain, model, options_.graph());

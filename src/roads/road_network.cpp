@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <map>
+#include <mutex>
 
 #include "core/error.hpp"
 
@@ -148,6 +149,8 @@ NetworkResult route_network(const TerrainField& t, const RoadGraph& graph, const
   }
   std::vector<std::optional<Road>> out(edges.size());
   ProgressStep step(progress, "roads");
+  std::mutex progress_mutex;  // the sink is not thread-safe; a cancel throws out of parallel_for
+  std::size_t done = 0;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, edges.size(), 1), [&](const tbb::blocked_range<std::size_t>& range) {
     for (std::size_t i = range.begin(); i != range.end(); ++i) {
       RoutingOptions o = options;
@@ -159,6 +162,8 @@ NetworkResult route_network(const TerrainField& t, const RoadGraph& graph, const
         out[i]->from = e.from;
         out[i]->to = e.to;
       }
+      const std::lock_guard<std::mutex> lock(progress_mutex);
+      step.update(double(++done) / double(edges.size()));
     }
   });
   step.update(1.0);
