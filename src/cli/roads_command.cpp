@@ -33,16 +33,15 @@ class RoadsCommand final : public Command {
   void run(Context& context) override {
     namespace fs = std::filesystem;
     if (!fs::exists(network_)) throw bad_input(network_ + ": no such file");
-    std::error_code ec;
-    if (!fs::exists(outdir_)) {
-      fs::create_directories(outdir_, ec);
-      if (ec) throw bad_input(outdir_ + ": cannot create the output folder (" + ec.message() + ")");
-    }
-    if (!fs::is_directory(outdir_)) throw bad_input(outdir_ + ": not a folder");
+    // The folder is created only once the roads are computed: a failed run leaves nothing behind.
+    const bool create_folder = !fs::exists(outdir_);
+    if (!create_folder && !fs::is_directory(outdir_)) throw bad_input(outdir_ + ": not a folder");
     const std::string roads_path = (fs::path(outdir_) / "roads.geojson").string();
     const std::string sections_path = (fs::path(outdir_) / "road_sections.geojson").string();
-    check_output_path(roads_path, options_.overwrite);
-    check_output_path(sections_path, options_.overwrite);
+    if (!create_folder) {
+      check_output_path(roads_path, options_.overwrite);
+      check_output_path(sections_path, options_.overwrite);
+    }
 
     const roads::CostModel model = options_.cost_model();
     const Dem dem = read_dem(dem_);
@@ -68,6 +67,11 @@ class RoadsCommand final : public Command {
         roads::route_network(terrain, graph, network, cities ? &*cities : nullptr, options_.routing(), context.progress);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     for (const std::string& f : result.failed) context.log.warn("no road under the cost model for edge " + f + " (left out)");
+    if (create_folder) {
+      std::error_code ec;
+      fs::create_directories(outdir_, ec);
+      if (ec) throw bad_input(outdir_ + ": cannot create the output folder (" + ec.message() + ")");
+    }
     write_vector(roads_path, roads::roads_layer(terrain, result.roads), options_.overwrite);
     write_vector(sections_path, roads::sections_layer(terrain, result.roads), options_.overwrite);
     std::size_t ferries = 0;
