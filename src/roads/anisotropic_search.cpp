@@ -35,6 +35,17 @@ RoadGraph::RoadGraph(const TerrainField& terrain, const CostModel& model, const 
   if (options.angles < 1 || options.angles > 64) throw bad_input("--angles: must be in 1..64, got " + std::to_string(options.angles));
   const int m = options.angles;
   for (int s = 0; s < 3; ++s) salt_[s] = splitmix64(options.seed * 3 + std::uint64_t(s));
+  // The road slope cost as a table over the grade (no atan per sample): 4096 steps up to the
+  // threshold's grade; the threshold itself is tested exactly on the grade.
+  {
+    const double thr = model.road.slope_deg.threshold;
+    tan_slope_max_ = thr < 90 ? std::tan(thr / kDeg) : kInfinity;
+    const double gmax = thr < 90 ? tan_slope_max_ : std::tan(80 / kDeg);
+    lut_step_ = gmax / 4096;
+    slope_lut_.resize(4098);
+    for (std::size_t i = 0; i < slope_lut_.size(); ++i)
+      slope_lut_[i] = model.road.slope_deg(std::min(std::atan(double(i) * lut_step_) * kDeg, thr < 90 ? thr : 90.0));
+  }
   step_m_ = model.sample_step_m > 0 ? model.sample_step_m : 0.5 * terrain.min_cell_m();
   cheapest_ = model.cheapest_per_metre();
   // Orientation layers: one block of m sectors per enabled structure, then the "start" orientation.
@@ -121,6 +132,15 @@ RoadGraph::RoadGraph(const TerrainField& terrain, const CostModel& model, const 
   }
 }
 
+double RoadGraph::road_slope_cost(double grade) const {
+  if (grade > tan_slope_max_) return kInfinity;
+  const double x = grade / lut_step_;
+  const std::size_t i = std::size_t(x);
+  if (i + 1 >= slope_lut_.size()) return model_.road.slope_deg(std::atan(grade) * kDeg);
+  const double f = x - double(i);
+  return slope_lut_[i] + f * (slope_lut_[i + 1] - slope_lut_[i]);
+}
+
 double RoadGraph::surface_cost_per_m(double slope_deg, double depth_m) const {
   return model_.road.slope_deg(slope_deg) + model_.road.water_depth_m(depth_m);
 }
@@ -148,12 +168,12 @@ double RoadGraph::arc_cost(Cell from, int arc) const {
     const StructureCosts& sc = model_.road;
     const bool veg = terrain_.has_vegetation();
     const double veg0 = veg ? 0.0 : sc.vegetation(0.0);  // without a layer the density is 0 everywhere
+    const double water0 = sc.water_depth_m(0.0);
     double z0 = terrain_.surface(from.col, from.row);
     for (int i = 1; i <= n; ++i) {
       const double z1 = i == n ? terrain_.surface(c1, r1) : terrain_.surface_at(from.col + dc * i, from.row + dr * i);
-      const double slope = std::atan(std::fabs(z1 - z0) / dl) * kDeg;
       const double depth = terrain_.depth_at(from.col + dc * (i - 0.5), from.row + dr * (i - 0.5));
-      double c = sc.slope_deg(slope) + sc.water_depth_m(depth) + veg0;
+      double c = road_slope_cost(std::fabs(z1 - z0) / dl) + veg0 + (depth > 0 ? sc.water_depth_m(depth) : water0);
       if (veg) c += sc.vegetation(terrain_.vegetation_at(from.col + dc * (i - 0.5), from.row + dr * (i - 0.5)));
       if (c == kInfinity) return kInfinity;
       total += c * dl;

@@ -83,6 +83,9 @@ class RoadGraph {
   std::uint64_t bridge_keep_ = 0, tunnel_keep_ = 0;  ///< hash thresholds of the sampling
   std::uint64_t salt_[3] = {0, 0, 0};                ///< per-structure hash salt from the seed
   std::vector<double> turn_;
+  std::vector<double> slope_lut_;        ///< road slope cost against the grade |dz|/dl, for speed
+  double lut_step_ = 1, tan_slope_max_ = kInfinity;
+  double road_slope_cost(double grade) const;
   std::vector<double> hull_t_, hull_c_;  ///< lower convex envelope of cost per metre vs grade
   double kappa_ = 0, best_grade_ = 0;    ///< cheapest cost per metre of climb, and its grade
   std::vector<std::vector<int>> into_;
