@@ -28,9 +28,11 @@ expect_fail "in the sea" --from 9.0,43.15 --to 9.42,42.70
 expect_fail "latitude" --from 42.68,95 --to 9.42,42.70
 expect_fail "not a number" --from 9.3,abc --to 9.42,42.70
 expect_fail "k" --from 9.30,42.68 --to 9.42,42.70 --k 0
-# Negative coordinates typed as is, in the DEM's CRS (UTM, southern hemisphere).
+# Coordinates in the DEM's CRS (UTM 25S, no nodata tag) and negative lon/lat typed as is.
 "$bin" -q path "$samples/stars_olinda_dem_utm25s.tif" --crs dem --from 292000,9112000 --to 296000,9117000 "$out/olinda.geojson" --no-bridges --no-tunnels
 grep -q LineString "$out/olinda.geojson"
+"$bin" -q path "$samples/stars_olinda_dem_utm25s.tif" --from -34.9,-7.99 --to -34.88,-8.0 "$out/olinda2.geojson"
+grep -q LineString "$out/olinda2.geojson"
 # Pricing a given line (as the benchmark prices GRASS's path) prints a cost and writes nothing.
 cost=$("$bin" -q path "$dem" --from 9.30,42.68 --to 9.42,42.70 "$out/none.geojson" --evaluate "$out/road.geojson")
 [[ "$cost" == cost* ]] || { echo "evaluate printed '$cost'"; exit 1; }
