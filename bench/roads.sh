@@ -51,7 +51,7 @@ fi
 island=sample_dems/gebco2022_15s_north_corsica_capcorse.asc
 mkdir -p "$out/net"
 gdal_translate -q -of XYZ "$island" "$out/island.xyz"
-awk '$3 > 20 && (NR % 27) == 0 {print $1, $2}' "$out/island.xyz" | head -200 > "$out/sites.txt"
+awk '$3 > 20 && (NR % 27) == 0 && n++ < 200 {print $1, $2}' "$out/island.xyz" > "$out/sites.txt"
 awk '{x[NR]=$1; y[NR]=$2} END {
   printf "{\"type\": \"FeatureCollection\", \"features\": ["; sep = "";
   for (i = 1; i <= NR; i++) {
