@@ -16,5 +16,7 @@ std::unique_ptr<Command> make_hydro_command();
 std::unique_ptr<Command> make_catchment_command();
 std::unique_ptr<Command> make_sites_command();
 std::unique_ptr<Command> make_network_command();
+std::unique_ptr<Command> make_path_command();
+std::unique_ptr<Command> make_roads_command();
 
 }  // namespace terrapolis::cli

@@ -1,0 +1,69 @@
+#!/usr/bin/env bash
+# Roads benchmark: one long road on the SRTM3 Alps tile (k = 5, m = 8), surface only and with
+# bridges and tunnels, against GRASS r.walk + r.drain between the same points; prints time, nodes
+# expanded, peak memory and each path's cost under the Terrapolis cost model.
+# Usage: bench/roads.sh [BUILD_DIR]   (run from the repository root)
+set -euo pipefail
+build=${1:-build}
+bin=$build/src/cli/terrapolis
+dem=../shared/dems/N47E009.hgt
+from=9.2,47.5; to=9.6,47.3          # Toggenburg (Thur valley) to the Rhine valley near Feldkirch
+out=$(mktemp -d); trap 'rm -rf "$out"' EXIT
+
+run() {  # label, extra arguments
+  local label=$1; shift
+  /usr/bin/time -f "%e %U %M" -o "$out/time" "$bin" --progress none path "$dem" --from $from --to $to "$out/$label.geojson" "$@" 2>"$out/$label.log"
+  read -r secs user kb <"$out/time"
+  echo "$label: $(grep -o 'galin:.*' "$out/$label.log") | wall ${secs} s, CPU ${user} s, peak ${kb} kB"
+}
+run surface_astar --no-bridges --no-tunnels
+run surface_bidir --no-bridges --no-tunnels --search bidir
+run structures_astar
+
+if command -v grass >/dev/null; then
+  # GRASS: r.walk (anisotropic walking cost, Naismith/Langmuir) from the start, r.drain back from the end.
+  gdal_translate -q -of GTiff "$dem" "$out/dem.tif"
+  /usr/bin/time -f "%e %U %M" -o "$out/time" grass -c "$out/dem.tif" "$out/loc" --exec bash -c "
+    set -e
+    r.in.gdal --quiet input=$out/dem.tif output=dem
+    g.region raster=dem
+    r.mapcalc --quiet 'friction = 0'
+    r.walk -k --quiet elevation=dem friction=friction output=cost outdir=dir start_coordinates=$from stop_coordinates=$to
+    r.drain -d --quiet input=cost direction=dir output=drain drain=drain_line start_coordinates=$to
+    v.out.ogr --quiet input=drain_line output=$out/grass.geojson format=GeoJSON
+  " >"$out/grass.log" 2>&1 || { echo "GRASS failed:"; grep -i error "$out/grass.log" | head -5; exit 1; }
+  read -r secs user kb <"$out/time"
+  echo "grass r.walk+r.drain: wall ${secs} s, CPU ${user} s (GRASS session included), peak ${kb} kB"
+  # Both paths priced by our model, walked cell by cell (8-neighbour steps, curvature with m = 8);
+  # then without the slope and water thresholds, so that a path breaking them still gets a number.
+  echo '{"road": {"slope_deg": {"threshold": null}, "water_depth_m": {"threshold": null}}}' >"$out/open.json"
+  for label in grass surface_astar; do
+    strict=$("$bin" -q path "$dem" --from $from --to $to "$out/unused.geojson" --no-bridges --no-tunnels --evaluate "$out/$label.geojson")
+    open=$("$bin" -q path "$dem" --from $from --to $to "$out/unused.geojson" --no-bridges --no-tunnels --costs "$out/open.json" --evaluate "$out/$label.geojson")
+    echo "$label path under our model: $strict; without thresholds: $open"
+  done
+else
+  echo "GRASS not installed (apt-get install -y grass-core): peer skipped"
+fi
+
+# A whole network on an island: Corsica (GEBCO 15", bundled sample), 200 land sites every few
+# cells, each joined to its two nearest neighbours (about 200 roads), both routers.
+island=sample_dems/gebco2022_15s_north_corsica_capcorse.asc
+mkdir -p "$out/net"
+gdal_translate -q -of XYZ "$island" "$out/island.xyz"
+awk '$3 > 20 && (NR % 27) == 0 && n++ < 200 {print $1, $2}' "$out/island.xyz" > "$out/sites.txt"
+awk '{x[NR]=$1; y[NR]=$2} END {
+  printf "{\"type\": \"FeatureCollection\", \"features\": ["; sep = "";
+  for (i = 1; i <= NR; i++) {
+    b1 = 0; b2 = 0; d1 = 1e9; d2 = 1e9;
+    for (j = 1; j <= NR; j++) { if (j == i) continue; d = (x[i]-x[j])^2 + (y[i]-y[j])^2;
+      if (d < d1) { d2 = d1; b2 = b1; d1 = d; b1 = j } else if (d < d2) { d2 = d; b2 = j } }
+    for (k = 1; k <= 2; k++) { j = (k == 1 ? b1 : b2); if (j < i && (j == 0 || seen[j "," i])) continue; seen[i "," j] = 1;
+      printf "%s{\"type\": \"Feature\", \"properties\": {\"from\": %d, \"to\": %d, \"kept\": 1}, \"geometry\": {\"type\": \"LineString\", \"coordinates\": [[%s, %s], [%s, %s]]}}", sep, i, j, x[i], y[i], x[j], y[j]; sep = ", " } }
+  print "]}" }' "$out/sites.txt" > "$out/net/network.geojson"
+edges=$(grep -o '"from"' "$out/net/network.geojson" | wc -l)
+for router in galin bezier; do
+  /usr/bin/time -f "%e %U %M" -o "$out/time" "$bin" --progress none roads "$island" "$out/net/network.geojson" "$out/net_$router" --router $router 2>"$out/net_$router.log"
+  read -r secs user kb <"$out/time"
+  echo "network of $edges edges on Corsica, router $router: $(grep -o '[0-9]* roads.*' "$out/net_$router.log") | wall ${secs} s, CPU ${user} s, peak ${kb} kB"
+done

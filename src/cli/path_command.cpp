@@ -1,0 +1,125 @@
+// `terrapolis path DEM --from LON,LAT --to LON,LAT OUT.geojson`: one road between two points.
+// SPDX-License-Identifier: MIT
+#include <CLI/CLI.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+#include "cli/command.hpp"
+#include "cli/commands_list.hpp"
+#include "cli/road_options.hpp"
+#include "core/error.hpp"
+#include "io/crs.hpp"
+#include "io/raster_io.hpp"
+#include "io/vector_io.hpp"
+#include "roads/road_network.hpp"
+
+namespace terrapolis::cli {
+namespace {
+
+class PathCommand final : public Command {
+ public:
+  std::string name() const override { return "path"; }
+  std::string summary() const override { return "Lay one road between two points: anisotropic shortest path with bridges and tunnels (Galin et al. 2010)"; }
+
+  void setup(CLI::App& app) override {
+    app.add_option("DEM", dem_, "Elevation model")->required();
+    app.add_option("--from", from_, "Start point LON,LAT (or X,Y with --crs dem)")->required();
+    app.add_option("--to", to_, "End point LON,LAT (or X,Y with --crs dem)")->required();
+    app.add_option("OUT", out_, "Output road (.geojson or .gpkg)")->required();
+    app.add_option("--crs", crs_, "CRS of --from/--to: lonlat (WGS 84) or dem (the DEM's CRS)")->check(CLI::IsMember({"lonlat", "dem"}));
+    app.add_option("--search", search_, "Search: astar, bidir (bidirectional A*), dijkstra")->check(CLI::IsMember({"astar", "bidir", "dijkstra"}));
+    app.add_option("--sections", sections_, "Also write the road/bridge/tunnel sections to this file");
+    app.add_option("--evaluate", evaluate_, "Instead of routing, print the cost under the cost model of the first line of this file "
+                                            "(e.g. another tool's path), walked cell by cell; OUT is not written");
+    options_.setup(app);
+  }
+
+  void run(Context& context) override {
+    roads::RoutingOptions routing = options_.routing();
+    routing.search = search_ == "bidir" ? roads::SearchMethod::bidirectional : search_ == "dijkstra" ? roads::SearchMethod::dijkstra : roads::SearchMethod::astar;
+    if (evaluate_.empty()) check_output_path(out_, options_.overwrite);
+    if (!sections_.empty()) check_output_path(sections_, options_.overwrite);
+    const roads::CostModel model = options_.cost_model();
+    const Dem dem = read_dem(dem_);
+    roads::TerrainField terrain(dem, options_.sea_level, model.unknown_water_depth_m, model.road_radius_m);
+    options_.load_layers(terrain);
+    const auto a = locate("--from", from_, terrain), b = locate("--to", to_, terrain);
+    if (a == b) throw bad_input("--from/--to: both points fall in the same cell");
+    for (const auto& [opt, c] : {std::pair{"--from", a}, std::pair{"--to", b}}) {
+      if (dem.is_nodata(dem.index(c.col, c.row))) throw bad_input(std::string(opt) + ": the point is on a nodata cell of " + dem_);
+      if (!roads::snap_to_land(terrain, c, routing.snap_cells))
+        throw bad_input(std::string(opt) + ": the point is in the sea (no land within " + std::to_string(routing.snap_cells) + " cells)");
+    }
+    const roads::RoadGraph graph(terrain, model, options_.graph());
+    if (!evaluate_.empty()) {
+      std::printf("cost %.3f\n", evaluate(graph, terrain, dem));
+      return;
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    const auto road = roads::route_road(terrain, graph, a, b, routing, &context.progress);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (!road) throw processing_error("path: no road joins the two points under the cost model (slope or water thresholds)");
+    std::vector<roads::Road> roads{*road};
+    roads[0].from = 0;
+    roads[0].to = 1;
+    roads[0].road_class = "departmental";
+    const VectorLayer layer = roads::roads_layer(terrain, roads);
+    const VectorLayer sections = roads::sections_layer(terrain, roads);
+    write_vector(out_, layer, options_.overwrite);
+    if (!sections_.empty()) write_vector(sections_, sections, options_.overwrite);
+    const auto& s = road->stats;
+    char line[512];
+    std::snprintf(line, sizeof line,
+                  "%s: %.0f m, cost %.1f, max grade %.1f %%, mean grade %.1f %%, bridges %.0f m, tunnels %.0f m; %zu nodes expanded, %zu stored, %.2f s",
+                  road->router.c_str(), s.length_m, road->cost.value_or(NAN), s.max_grade_pct, s.mean_grade_pct, s.bridge_m, s.tunnel_m,
+                  road->expanded, road->nodes, seconds);
+    context.log.info(line);
+  }
+
+ private:
+  roads::Cell locate(const std::string& option, const std::string& text, const roads::TerrainField& terrain) const {
+    const auto v = parse_pair(option, text);
+    std::array<double, 2> xy = v;
+    if (crs_ == "lonlat") {
+      if (std::fabs(v[1]) > 90) throw bad_input(option + ": latitude " + std::to_string(v[1]) + " is outside -90..90 (give LON,LAT)");
+      const GridLocator locator(terrain.georef());
+      xy = locator.lonlat_to_crs(v[0], v[1]);
+    }
+    const auto cell = roads::cell_at(terrain, xy[0], xy[1]);
+    if (!cell) throw bad_input(option + ": the point " + text + " lies outside " + dem_);
+    return *cell;
+  }
+
+  /// Cost of a polyline walked through 8-neighbour steps (a D8 path such as r.drain's).
+  double evaluate(const roads::RoadGraph& graph, const roads::TerrainField& terrain, const Dem& dem) const {
+    const VectorLayer layer = read_vector(evaluate_, dem.georef().crs);
+    if (layer.features.empty() || layer.features[0].parts.empty()) throw bad_input(evaluate_ + ": no line to evaluate");
+    std::vector<roads::Cell> chain;
+    for (const auto& f : layer.features)
+      for (const auto& part : f.parts)
+        for (const auto& v : part) {
+          const auto c = roads::cell_at(terrain, v[0], v[1]);
+          if (!c) throw bad_input(evaluate_ + ": a vertex lies outside the DEM");
+          while (!chain.empty() && !(chain.back() == *c)) {  // 8-neighbour steps towards the vertex
+            roads::Cell n = chain.back();
+            n.col += (c->col > n.col) - (c->col < n.col);
+            n.row += (c->row > n.row) - (c->row < n.row);
+            chain.push_back(n);
+          }
+          if (chain.empty()) chain.push_back(*c);
+        }
+    return roads::chain_cost(graph, chain);
+  }
+
+  std::string evaluate_;
+  std::string dem_, from_, to_, out_, crs_ = "lonlat", search_ = "astar", sections_;
+  RoadOptions options_;
+};
+
+}  // namespace
+
+std::unique_ptr<Command> make_path_command() { return std::make_unique<PathCommand>(); }
+
+}  // namespace terrapolis::cli

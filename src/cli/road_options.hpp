@@ -1,0 +1,65 @@
+// Options shared by the `path` and `roads` commands (one declaration for both).
+// SPDX-License-Identifier: MIT
+#pragma once
+#include <CLI/CLI.hpp>
+
+#include <cstdint>
+#include <string>
+
+#include "io/raster_io.hpp"
+#include "roads/road_network.hpp"
+
+namespace terrapolis::cli {
+
+struct RoadOptions {
+  int k = 5, angles = 8;
+  std::string costs, vegetation;
+  bool bridges = true, tunnels = true, overwrite = false;
+  std::uint64_t seed = 1;
+  double sea_level = 0;
+  std::string router = "galin";
+  int bezier_evaluations = 1000, bezier_tries = 20;
+  double bezier_threshold = 0.1;
+
+  void setup(CLI::App& app) {
+    app.add_option("--router", router, "Router: galin (anisotropic shortest path) or bezier (Belhadj 2007 Alg. 16)")
+        ->check(CLI::IsMember({"galin", "bezier"}));
+    app.add_option("--k", k, "Segment mask M_k: arcs to (i,j) in [-k,k]^2 with gcd 1 (k = 5: 80 arcs, 11.3 deg)")->check(CLI::Range(1, 16));
+    app.add_option("--angles", angles, "Orientation sectors m pricing curvature (1 disables)")->check(CLI::Range(1, 64));
+    app.add_option("--costs", costs, "JSON file overriding the default transfer functions");
+    app.add_flag("--bridges,!--no-bridges", bridges, "Allow bridges (long arcs over valleys and water); default on");
+    app.add_flag("--tunnels,!--no-tunnels", tunnels, "Allow tunnels (long arcs under ridges); default on");
+    app.add_option("--vegetation", vegetation, "Raster of vegetation / land-cover density (any GDAL raster, warped onto the DEM grid) priced by the 'vegetation' transfer functions");
+    app.add_option("--seed", seed, "Seed of the stochastic bridge/tunnel arcs and of the Bézier router");
+    app.add_option("--sea-level", sea_level, "Cells at or below this height (m) and nodata cells are water");
+    app.add_option("--bezier-evaluations", bezier_evaluations, "Bézier router budget: curve evaluations per road (replaces the thesis' 1000 ms, for reproducible roads)")->check(CLI::Range(1, 1000000));
+    app.add_option("--bezier-threshold", bezier_threshold, "Bézier router: stop when the worst position costs less (0..1)")->check(CLI::Range(0.0, 1.0));
+    app.add_option("--bezier-tries", bezier_tries, "Bézier router: control points drawn per worst position")->check(CLI::Range(1, 100000));
+    app.add_flag("--overwrite", overwrite, "Replace existing outputs");
+  }
+
+  roads::CostModel cost_model() const {
+    roads::CostModel m = costs.empty() ? roads::default_cost_model() : roads::load_cost_model(costs);
+    if (!bridges) m.bridge.enabled = false;
+    if (!tunnels) m.tunnel.enabled = false;
+    return m;
+  }
+  /// Loads --vegetation onto the DEM's grid when given.
+  void load_layers(roads::TerrainField& terrain) const {
+    if (vegetation.empty()) return;
+    terrain.set_vegetation(read_resampled(vegetation, terrain.georef(), terrain.cols(), terrain.rows(), Resampling::bilinear));
+  }
+  roads::GraphOptions graph() const { return {k, angles, seed}; }
+  roads::RoutingOptions routing() const {
+    roads::RoutingOptions r;
+    r.router = router == "bezier" ? roads::Router::bezier : roads::Router::galin;
+    r.graph = graph();
+    r.bezier.seed = seed;
+    r.bezier.max_evaluations = bezier_evaluations;
+    r.bezier.threshold = bezier_threshold;
+    r.bezier.tries = bezier_tries;
+    return r;
+  }
+};
+
+}  // namespace terrapolis::cli

@@ -1,0 +1,98 @@
+// `terrapolis roads DEM NETWORK OUTDIR`: a road for every kept edge of a city network.
+// SPDX-License-Identifier: MIT
+#include <CLI/CLI.hpp>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+
+#include "cli/command.hpp"
+#include "cli/commands_list.hpp"
+#include "cli/road_options.hpp"
+#include "core/error.hpp"
+#include "io/raster_io.hpp"
+#include "io/vector_io.hpp"
+#include "roads/road_network.hpp"
+
+namespace terrapolis::cli {
+namespace {
+
+class RoadsCommand final : public Command {
+ public:
+  std::string name() const override { return "roads"; }
+  std::string summary() const override { return "Route a road for every kept edge of a city network (network.geojson; cities.geojson beside it)"; }
+
+  void setup(CLI::App& app) override {
+    app.add_option("DEM", dem_, "Elevation model")->required();
+    app.add_option("NETWORK", network_, "network.geojson from the network stage (LineStrings: from, to, kept)")->required();
+    app.add_option("OUTDIR", outdir_, "Folder for roads.geojson and road_sections.geojson (created if missing)")->required();
+    app.add_option("--cities", cities_, "Cities (Points: id, class); default: cities.geojson beside NETWORK when present");
+    options_.setup(app);
+  }
+
+  void run(Context& context) override {
+    namespace fs = std::filesystem;
+    if (!fs::exists(network_)) throw bad_input(network_ + ": no such file");
+    // The folder is created only once the roads are computed: a failed run leaves nothing behind.
+    const bool create_folder = !fs::exists(outdir_);
+    if (!create_folder && !fs::is_directory(outdir_)) throw bad_input(outdir_ + ": not a folder");
+    const std::string roads_path = (fs::path(outdir_) / "roads.geojson").string();
+    const std::string sections_path = (fs::path(outdir_) / "road_sections.geojson").string();
+    if (!create_folder) {
+      check_output_path(roads_path, options_.overwrite);
+      check_output_path(sections_path, options_.overwrite);
+    }
+
+    const roads::CostModel model = options_.cost_model();
+    const Dem dem = read_dem(dem_);
+    roads::TerrainField terrain(dem, options_.sea_level, model.unknown_water_depth_m, model.road_radius_m);
+    options_.load_layers(terrain);
+    VectorLayer network = read_vector(network_, dem.georef().crs);
+    network.name = network_;  // errors name the file
+    std::string cities_path = cities_;
+    if (cities_path.empty()) {
+      const fs::path beside = fs::path(network_).parent_path() / "cities.geojson";
+      if (fs::exists(beside)) cities_path = beside.string();
+    }
+    std::optional<VectorLayer> cities;
+    if (!cities_path.empty()) {
+      cities = read_vector(cities_path, dem.georef().crs);
+      cities->name = cities_path;
+    }
+    else context.log.warn("no cities.geojson beside the network: every road is departmental");
+
+    const roads::RoadGraph graph(terrain, model, options_.graph());
+    const auto t0 = std::chrono::steady_clock::now();
+    roads::NetworkResult result =
+        roads::route_network(terrain, graph, network, cities ? &*cities : nullptr, options_.routing(), context.progress);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    for (const std::string& f : result.failed) context.log.warn("no road under the cost model for edge " + f + " (left out)");
+    if (create_folder) {
+      std::error_code ec;
+      fs::create_directories(outdir_, ec);
+      if (ec) throw bad_input(outdir_ + ": cannot create the output folder (" + ec.message() + ")");
+    }
+    write_vector(roads_path, roads::roads_layer(terrain, result.roads), options_.overwrite);
+    write_vector(sections_path, roads::sections_layer(terrain, result.roads), options_.overwrite);
+    std::size_t ferries = 0;
+    double km = 0;
+    for (const auto& r : result.roads) {
+      ferries += r.ferry ? 1 : 0;
+      km += r.stats.length_m / 1000;
+    }
+    char line[256];
+    std::snprintf(line, sizeof line, "%zu roads (%zu maritime links, %zu failed), %.1f km, %.2f s", result.roads.size(), ferries,
+                  result.failed.size(), km, seconds);
+    context.log.info(line);
+  }
+
+ private:
+  std::string dem_, network_, outdir_, cities_;
+  RoadOptions options_;
+};
+
+}  // namespace
+
+std::unique_ptr<Command> make_roads_command() { return std::make_unique<RoadsCommand>(); }
+
+}  // namespace terrapolis::cli

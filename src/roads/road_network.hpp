@@ -1,0 +1,69 @@
+// Routing single roads and whole networks, and their GeoJSON layers (roads, sections).
+// SPDX-License-Identifier: MIT
+#pragma once
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/progress.hpp"
+#include "io/vector_io.hpp"
+#include "roads/anisotropic_search.hpp"
+#include "roads/bezier_router.hpp"
+#include "roads/road_geometry.hpp"
+
+namespace terrapolis::roads {
+
+enum class Router { galin, bezier };
+
+struct RoutingOptions {
+  Router router = Router::galin;
+  GraphOptions graph;
+  SearchMethod search = SearchMethod::astar;
+  BezierOptions bezier;
+  std::size_t max_nodes = 60'000'000;
+  int snap_cells = 3;  ///< an end on water moves to the nearest land cell within this many cells
+};
+
+/// One routed road with everything the outputs need.
+struct Road {
+  std::int64_t from = -1, to = -1;
+  std::string road_class;      ///< motorway, national, departmental
+  std::string router;          ///< galin, bezier, ferry
+  std::optional<double> cost;  ///< cost under the Galin model (null when infinite: Bézier roads may break it)
+  RoadGeometry geometry;
+  RoadStats stats;
+  std::size_t expanded = 0, nodes = 0;
+  bool ferry = false;
+  std::vector<GridPoint> ferry_line;  ///< for maritime links: the straight crossing
+};
+
+/// Routes one road between two cells. Ends on water are moved to land (snap_cells); ends on two
+/// different land masses give a maritime link. Returns nullopt when no road exists (e.g. the slope
+/// threshold closes every way) and no maritime link applies.
+std::optional<Road> route_road(const TerrainField& terrain, const RoadGraph& graph, Cell from, Cell to, const RoutingOptions& options,
+                               Progress* progress = nullptr);
+
+/// Roads of every kept edge of a network (LineStrings with from, to, kept; first and last vertices
+/// are the ends) whose cities give the class (class 0 = largest; mean class < 1 motorway, < 2
+/// national, else departmental; departmental when the cities are unknown). Roads are routed in
+/// parallel (oneTBB) into a vector indexed by edge, so the output does not depend on the threads.
+/// Edges with no road are reported in `failed` and left out.
+struct NetworkResult {
+  std::vector<Road> roads;
+  std::vector<std::string> failed;
+};
+NetworkResult route_network(const TerrainField& terrain, const RoadGraph& graph, const VectorLayer& network,
+                            const VectorLayer* cities, const RoutingOptions& options, Progress& progress);
+
+/// The roads layer (one LineString per road, in the DEM's CRS) and the sections layer.
+VectorLayer roads_layer(const TerrainField& terrain, const std::vector<Road>& roads);
+VectorLayer sections_layer(const TerrainField& terrain, const std::vector<Road>& roads);
+
+/// The nearest land cell within `radius` cells of `cell` (itself when on land), or nullopt.
+std::optional<Cell> snap_to_land(const TerrainField& terrain, Cell cell, int radius);
+
+/// Cell holding a point given in the DEM's CRS, or nullopt when outside the grid.
+std::optional<Cell> cell_at(const TerrainField& terrain, double x, double y);
+
+}  // namespace terrapolis::roads

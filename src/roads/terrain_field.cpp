@@ -1,0 +1,139 @@
+// Ground surface, water depth and land components of a DEM for the road search.
+// SPDX-License-Identifier: MIT
+#include "roads/terrain_field.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/error.hpp"
+#include "core/neighbours.hpp"
+
+namespace terrapolis::roads {
+
+TerrainField::TerrainField(const Dem& dem, double sea_level_m, double unknown_depth_m, double road_radius_m)
+    : cols_(dem.cols()), rows_(dem.rows()), georef_(dem.georef()), metrics_(cell_metrics(dem.georef(), dem.cols(), dem.rows())),
+      sea_level_(sea_level_m) {
+  const std::size_t n = dem.size();
+  surface_.resize(n);
+  ground_.resize(n);
+  depth_.assign(n, 0.f);
+  water_.assign(n, 0);
+  std::size_t water_cells = 0, deep_cells = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (dem.is_nodata(i)) continue;
+    if (dem[i] <= sea_level_m) {
+      ++water_cells;
+      if (dem[i] < sea_level_m - 1) ++deep_cells;
+    }
+  }
+  bathymetry_ = water_cells > 0 && 2 * deep_cells > water_cells;
+  std::vector<float> raw_depth(n, 0.f);
+  for (std::size_t i = 0; i < n; ++i) {
+    const bool nodata = dem.is_nodata(i);
+    if (nodata || dem[i] <= sea_level_m) {
+      water_[i] = 1;
+      const double d = (!nodata && bathymetry_) ? sea_level_m - dem[i] : std::max(unknown_depth_m, nodata ? 0.0 : sea_level_m - dem[i]);
+      raw_depth[i] = float(d);
+      surface_[i] = float(sea_level_m);
+      ground_[i] = float(sea_level_m - d);
+    } else {
+      surface_[i] = dem[i];
+      ground_[i] = dem[i];
+    }
+  }
+  double lo = 1e300;
+  for (int r = 0; r < rows_; ++r) lo = std::min({lo, metrics_.width_m[r], metrics_.height_m[r]});
+  min_cell_m_ = lo;
+  typical_cell_m_ = 0.5 * (metrics_.width_m[rows_ / 2] + metrics_.height_m[rows_ / 2]);
+  // Water within the road's radius (Peytavie §4.2.1: maximum depth over the disc Omega(p, r)).
+  const int rad = int(std::floor(road_radius_m / min_cell_m_));
+  if (rad <= 0) {
+    depth_ = raw_depth;
+  } else {
+    for (int r = 0; r < rows_; ++r)
+      for (int c = 0; c < cols_; ++c) {
+        float m = 0;
+        for (int dr = -rad; dr <= rad; ++dr)
+          for (int dc = -rad; dc <= rad; ++dc) {
+            if (!inside(c + dc, r + dr)) continue;
+            if (std::hypot(dc * metrics_.width_m[r], dr * metrics_.height_m[r]) > road_radius_m) continue;
+            m = std::max(m, raw_depth[index(c + dc, r + dr)]);
+          }
+        depth_[index(c, r)] = m;
+      }
+  }
+  // 8-connected land components, labelled in scan order (deterministic).
+  land_.assign(n, -1);
+  std::int32_t next = 0;
+  std::vector<std::size_t> stack;
+  for (std::size_t s = 0; s < n; ++s) {
+    if (water_[s] || land_[s] >= 0) continue;
+    land_[s] = next;
+    stack.push_back(s);
+    while (!stack.empty()) {
+      const std::size_t i = stack.back();
+      stack.pop_back();
+      const int c = int(i % std::size_t(cols_)), r = int(i / std::size_t(cols_));
+      for (int k = 0; k < 8; ++k) {
+        const int cc = c + dcol[k], rr = r + drow[k];
+        if (!inside(cc, rr)) continue;
+        const std::size_t j = index(cc, rr);
+        if (water_[j] || land_[j] >= 0) continue;
+        land_[j] = next;
+        stack.push_back(j);
+      }
+    }
+    ++next;
+  }
+}
+
+namespace {
+template <class V>
+double bilinear(const V& v, int cols, int rows, double col, double row) {
+  col = std::clamp(col, 0.0, double(cols - 1));
+  row = std::clamp(row, 0.0, double(rows - 1));
+  const int c0 = std::min(int(col), cols - 2 < 0 ? 0 : cols - 2), r0 = std::min(int(row), rows - 2 < 0 ? 0 : rows - 2);
+  const double fc = col - c0, fr = row - r0;
+  const std::size_t i = std::size_t(r0) * std::size_t(cols) + std::size_t(c0);
+  const double a = v[i], b = v[i + 1], c = v[i + cols], d = v[i + cols + 1];
+  return (a * (1 - fc) + b * fc) * (1 - fr) + (c * (1 - fc) + d * fc) * fr;
+}
+}  // namespace
+
+double TerrainField::surface_at(double col, double row) const { return bilinear(surface_, cols_, rows_, col, row); }
+double TerrainField::ground_at(double col, double row) const { return bilinear(ground_, cols_, rows_, col, row); }
+
+float TerrainField::depth_at(double col, double row) const {
+  const int c = std::clamp(int(std::lround(col)), 0, cols_ - 1), r = std::clamp(int(std::lround(row)), 0, rows_ - 1);
+  return depth_[index(c, r)];
+}
+
+void TerrainField::set_vegetation(const Raster<float>& density) {
+  if (density.cols() != cols_ || density.rows() != rows_) throw bad_input("vegetation layer: not on the DEM's grid");
+  vegetation_.resize(density.size());
+  for (std::size_t i = 0; i < density.size(); ++i) vegetation_[i] = std::isnan(density[i]) ? 0.f : density[i];
+}
+
+float TerrainField::vegetation_at(double col, double row) const {
+  if (vegetation_.empty()) return 0.f;
+  const int c = std::clamp(int(std::lround(col)), 0, cols_ - 1), r = std::clamp(int(std::lround(row)), 0, rows_ - 1);
+  return vegetation_[index(c, r)];
+}
+
+double TerrainField::metres_x(double row) const {
+  const int r = std::clamp(int(std::lround(row)), 0, rows_ - 1);
+  return metrics_.width_m[r];
+}
+
+double TerrainField::metres_y(double row) const {
+  // height_m[r] spans rows r-1..r; take the boundary nearest to the position.
+  const int r = std::clamp(int(std::lround(row + 0.5)), 0, rows_);
+  return metrics_.height_m[r];
+}
+
+double TerrainField::length_m(GridPoint a, GridPoint b) const {
+  const double mid = 0.5 * (a.row + b.row);
+  return std::hypot((b.col - a.col) * metres_x(mid), (b.row - a.row) * metres_y(mid));
+}
+
+}  // namespace terrapolis::roads

@@ -1,0 +1,82 @@
+// The terrain as the road search sees it: ground surface, water depth, metric cell sizes.
+// SPDX-License-Identifier: MIT
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "core/geodesy.hpp"
+#include "core/raster.hpp"
+
+namespace terrapolis::roads {
+
+/// Positions are in cell units, (col, row) with integers at cell centres (row 0 north).
+struct GridPoint {
+  double col = 0, row = 0;
+};
+
+/// Ground and water of a DEM for the road search. Water cells are cells at or below the sea level
+/// and nodata cells. Their depth is sea_level - elevation when the DEM carries bathymetry (more
+/// than half of its water cells lie over 1 m below sea level, as in GEBCO), otherwise
+/// `unknown_depth_m` (SRTM stores the sea as 0 m). Nodata cells get `unknown_depth_m`.
+class TerrainField {
+ public:
+  /// `road_radius_m`: water depth is the maximum over the cells within that distance.
+  TerrainField(const Dem& dem, double sea_level_m, double unknown_depth_m, double road_radius_m);
+
+  int cols() const { return cols_; }
+  int rows() const { return rows_; }
+  std::size_t size() const { return std::size_t(cols_) * std::size_t(rows_); }
+  bool inside(int col, int row) const { return col >= 0 && row >= 0 && col < cols_ && row < rows_; }
+  std::size_t index(int col, int row) const { return std::size_t(row) * std::size_t(cols_) + std::size_t(col); }
+
+  /// Ground or water surface height (m) at a cell: max(elevation, sea level); sea level on nodata.
+  float surface(int col, int row) const { return surface_[index(col, row)]; }
+  /// Terrain height (m) at a cell, the sea floor under water (for tunnels); sea level - depth on nodata.
+  float ground(int col, int row) const { return ground_[index(col, row)]; }
+  /// Bilinear surface height (m) at a fractional position, clamped to the grid.
+  double surface_at(double col, double row) const;
+  /// Bilinear terrain height (m) (sea floor under water).
+  double ground_at(double col, double row) const;
+  /// Water depth (m) at the nearest cell, the maximum within the road radius; 0 on land.
+  float depth_at(double col, double row) const;
+  /// Sets the vegetation / land-cover density layer (same grid as the DEM; NaN counts as 0).
+  void set_vegetation(const Raster<float>& density);
+  /// Vegetation density at the nearest cell (0 without a layer).
+  float vegetation_at(double col, double row) const;
+  bool has_vegetation() const { return !vegetation_.empty(); }
+  bool water(int col, int row) const { return water_[index(col, row)] != 0; }
+  bool has_bathymetry() const { return bathymetry_; }
+  double sea_level() const { return sea_level_; }
+
+  /// Metres per cell east-west and north-south at a (fractional) row (CellMetrics, geodesic on
+  /// geographic CRSs); arcs use them as a local plane, exact on projected grids and within
+  /// (length / Earth radius)^2 on geographic ones.
+  double metres_x(double row) const;
+  double metres_y(double row) const;
+  /// Length in metres of the straight segment a -> b.
+  double length_m(GridPoint a, GridPoint b) const;
+  /// Smallest cell side over the grid (m).
+  double min_cell_m() const { return min_cell_m_; }
+  /// Cell side at the centre row (m), the scale of "cells" in the cost model.
+  double typical_cell_m() const { return typical_cell_m_; }
+
+  /// Land component label (8-connected land cells), or -1 on water. Two points on different
+  /// labels cannot be joined by a road on the ground (maritime links).
+  const std::vector<std::int32_t>& land_components() const { return land_; }
+
+  const Georef& georef() const { return georef_; }
+  const CellMetrics& metrics() const { return metrics_; }
+
+ private:
+  int cols_ = 0, rows_ = 0;
+  Georef georef_;
+  CellMetrics metrics_;
+  double sea_level_ = 0;
+  bool bathymetry_ = false;
+  double min_cell_m_ = 1, typical_cell_m_ = 1;
+  std::vector<float> surface_, ground_, depth_, vegetation_;
+  std::vector<std::uint8_t> water_;
+  std::vector<std::int32_t> land_;
+};
+
+}  // namespace terrapolis::roads

@@ -1,0 +1,42 @@
+#!/usr/bin/env bash
+# `terrapolis path` on the Corsica sample: a road, and clean failures on bad points.
+set -euo pipefail
+bin=$1; samples=$2
+dem=$samples/gebco2022_15s_north_corsica_capcorse.asc
+out=$(mktemp -d); trap 'rm -rf "$out"' EXIT
+
+"$bin" -q path "$dem" --from 9.30,42.68 --to 9.42,42.70 "$out/road.geojson" --sections "$out/sections.geojson"
+grep -q '"router": "galin"' "$out/road.geojson"
+grep -q '"structure": "road"' "$out/sections.geojson"
+# Same again with bidirectional A*: the same cost.
+"$bin" -q path "$dem" --from 9.30,42.68 --to 9.42,42.70 "$out/road2.geojson" --search bidir
+c1=$(grep -o '"cost": [0-9.]*' "$out/road.geojson"); c2=$(grep -o '"cost": [0-9.]*' "$out/road2.geojson")
+[[ "$c1" == "$c2" ]] || { echo "astar $c1 != bidir $c2"; exit 1; }
+# Existing output without --overwrite is refused.
+if "$bin" -q path "$dem" --from 9.30,42.68 --to 9.42,42.70 "$out/road.geojson"; then exit 1; fi
+
+expect_fail() {  # expected message, then arguments; exit code 2 and no output left
+  local msg=$1; shift
+  set +e; err=$("$bin" -q path "$dem" "$@" "$out/bad.geojson" 2>&1); rc=$?; set -e
+  [[ $rc -eq 2 ]] || { echo "exit $rc for $*: $err"; exit 1; }
+  grep -q "$msg" <<<"$err" || { echo "message '$err' lacks '$msg'"; exit 1; }
+  [[ ! -e "$out/bad.geojson" ]] || { echo "output left behind"; exit 1; }
+}
+expect_fail "outside" --from 2.0,42.7 --to 9.42,42.70
+expect_fail "same cell" --from 9.30,42.68 --to 9.30,42.68
+expect_fail "in the sea" --from 9.0,43.15 --to 9.42,42.70
+expect_fail "latitude" --from 42.68,95 --to 9.42,42.70
+expect_fail "not a number" --from 9.3,abc --to 9.42,42.70
+expect_fail "k" --from 9.30,42.68 --to 9.42,42.70 --k 0
+# Coordinates in the DEM's CRS (UTM 25S, no nodata tag) and negative lon/lat typed as is.
+"$bin" -q path "$samples/stars_olinda_dem_utm25s.tif" --crs dem --from 292000,9112000 --to 296000,9117000 "$out/olinda.geojson" --no-bridges --no-tunnels
+grep -q LineString "$out/olinda.geojson"
+"$bin" -q path "$samples/stars_olinda_dem_utm25s.tif" --from -34.9,-7.99 --to -34.88,-8.0 "$out/olinda2.geojson"
+grep -q LineString "$out/olinda2.geojson"
+# Pricing a given line (as the benchmark prices GRASS's path) prints a cost and writes nothing.
+cost=$("$bin" -q path "$dem" --from 9.30,42.68 --to 9.42,42.70 "$out/none.geojson" --evaluate "$out/road.geojson")
+[[ "$cost" == cost* ]] || { echo "evaluate printed '$cost'"; exit 1; }
+[[ ! -e "$out/none.geojson" ]]
+# The Bézier router answers the same question.
+"$bin" -q path "$dem" --from 9.30,42.68 --to 9.42,42.70 "$out/bezier.geojson" --router bezier --bezier-evaluations 200
+grep -q '"router": "bezier"' "$out/bezier.geojson"

@@ -1,0 +1,130 @@
+// Network routing: deterministic whatever the threads, maritime links, classes; Bézier router.
+// SPDX-License-Identifier: MIT
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <cmath>
+
+#include "roads/road_network.hpp"
+#include "roads_fixtures.hpp"
+
+using namespace terrapolis;
+using namespace terrapolis::roads;
+
+namespace {
+
+/// Two hilly islands in a sea 30 m deep.
+Dem islands() {
+  return test::make_dem(60, 40, 10.0, [](int c, int r) {
+    const double a = 60 - 0.6 * ((c - 14) * (c - 14) + (r - 20) * (r - 20));
+    const double b = 40 - 0.8 * ((c - 47) * (c - 47) + (r - 20) * (r - 20));
+    return std::max({a, b, -30.0});
+  });
+}
+
+VectorLayer network(const Dem& dem, const std::vector<std::array<int, 4>>& edges) {
+  VectorLayer l;
+  l.name = "network.geojson";
+  l.geometry = GeometryType::line_string;
+  l.crs = dem.georef().crs;
+  l.fields = {{"from", FieldType::integer}, {"to", FieldType::integer}, {"kept", FieldType::integer}};
+  int id = 0;
+  for (const auto& e : edges) {
+    Feature f;
+    f.parts.push_back({dem.georef().cell_centre(e[0], e[1]), dem.georef().cell_centre(e[2], e[3])});
+    f.values = {std::int64_t(id), std::int64_t(id + 1), std::int64_t(1)};
+    ++id;
+    l.features.push_back(f);
+  }
+  return l;
+}
+
+std::string dump(const VectorLayer& l) {
+  std::string s;
+  char buf[64];
+  for (const auto& f : l.features) {
+    for (const auto& p : f.parts[0]) {
+      std::snprintf(buf, sizeof buf, "%.9f %.9f;", p[0], p[1]);
+      s += buf;
+    }
+    for (const auto& v : f.values) {
+      if (const auto* i = std::get_if<std::int64_t>(&v)) s += std::to_string(*i);
+      if (const auto* d = std::get_if<double>(&v)) s += std::to_string(*d);
+      if (const auto* t = std::get_if<std::string>(&v)) s += *t;
+      s += "|";
+    }
+    s += "\n";
+  }
+  return s;
+}
+
+}  // namespace
+
+TEST(RoadNetwork, SameOutputWithOneAndTwoThreadsAndFerriesBetweenIslands) {
+  const Dem dem = islands();
+  const TerrainField terrain(dem, 0.0, 10.0, 0.0);
+  CostModel model = default_cost_model();
+  model.bridge.max_length_cells = model.tunnel.max_length_cells = 8;
+  model.bridge.samples = model.tunnel.samples = 20;
+  const RoadGraph graph(terrain, model, {4, 8, 9});
+  const VectorLayer net = network(dem, {{6, 20, 22, 20}, {14, 12, 14, 28}, {10, 17, 47, 20}, {42, 20, 52, 20}});
+  SilentProgress silent;
+  std::string outputs[2];
+  for (int threads : {1, 2}) {
+    for (Router router : {Router::galin, Router::bezier}) {
+      tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
+      RoutingOptions o;
+      o.router = router;
+      o.graph = {4, 8, 9};
+      const NetworkResult r = route_network(terrain, graph, net, nullptr, o, silent);
+      ASSERT_EQ(r.roads.size(), 4u);
+      EXPECT_TRUE(r.roads[2].ferry);  // the two islands
+      EXPECT_EQ(r.roads[2].router, "ferry");
+      EXPECT_FALSE(r.roads[0].ferry);
+      EXPECT_EQ(r.roads[0].router, router == Router::galin ? "galin" : "bezier");
+      outputs[threads - 1] += dump(roads_layer(terrain, r.roads)) + dump(sections_layer(terrain, r.roads));
+    }
+  }
+  EXPECT_EQ(outputs[0], outputs[1]);
+}
+
+TEST(RoadNetwork, ClassFromTheMeanRankOfTheEndCities) {
+  const Dem dem = islands();
+  const TerrainField terrain(dem, 0.0, 10.0, 0.0);
+  CostModel model = default_cost_model();
+  model.bridge.enabled = model.tunnel.enabled = false;
+  const RoadGraph graph(terrain, model, {3, 1, 1});
+  const VectorLayer net = network(dem, {{6, 20, 22, 20}, {14, 12, 14, 28}});
+  VectorLayer cities;
+  cities.name = "cities.geojson";
+  cities.fields = {{"id", FieldType::integer}, {"class", FieldType::integer}};
+  for (int id = 0; id < 3; ++id) cities.features.push_back({{}, {std::int64_t(id), std::int64_t(id == 0 ? 0 : id == 1 ? 1 : 3)}});
+  SilentProgress silent;
+  const NetworkResult r = route_network(terrain, graph, net, &cities, RoutingOptions{}, silent);
+  ASSERT_EQ(r.roads.size(), 2u);
+  EXPECT_EQ(r.roads[0].road_class, "motorway");      // classes 0 and 1: mean 0.5
+  EXPECT_EQ(r.roads[1].road_class, "departmental");  // classes 1 and 3: mean 2
+}
+
+TEST(BezierRouter, DeterministicAndNeverWorseThanTheStraightCurve) {
+  const Dem dem = test::make_dem(50, 50, 30.0, [](int c, int r) {
+    return 100 + 400 * std::exp(-((c - 25) * (c - 25) + (r - 25) * (r - 25)) / 60.0);  // a hill on the way
+  });
+  const TerrainField terrain(dem, 0.0, 10.0, 0.0);
+  BezierOptions o;
+  o.seed = 5;
+  o.max_evaluations = 300;
+  const BezierResult a = bezier_route(terrain, {5, 25}, {45, 25}, o);
+  const BezierResult b = bezier_route(terrain, {5, 25}, {45, 25}, o);
+  o.max_evaluations = 1;
+  const BezierResult straight = bezier_route(terrain, {5, 25}, {45, 25}, o);
+  ASSERT_EQ(a.polyline.size(), b.polyline.size());
+  for (std::size_t i = 0; i < a.polyline.size(); ++i) {
+    EXPECT_EQ(a.polyline[i].col, b.polyline[i].col);
+    EXPECT_EQ(a.polyline[i].row, b.polyline[i].row);
+  }
+  EXPECT_LT(a.cost, straight.cost);
+  EXPECT_GT(a.control.size(), 2u);
+  EXPECT_EQ(a.polyline.front().col, 5);
+  EXPECT_EQ(a.polyline.back().col, 45);
+}
