@@ -8,6 +8,9 @@ namespace terrapolis::cli {
 std::vector<std::unique_ptr<Command>> all_commands() {
   std::vector<std::unique_ptr<Command>> commands;
   commands.push_back(make_info_command());
+  commands.push_back(make_fill_command());
+  commands.push_back(make_reconstruct_command());
+  commands.push_back(make_generate_command());
   return commands;
 }
 

@@ -8,5 +8,8 @@
 namespace terrapolis::cli {
 
 std::unique_ptr<Command> make_info_command();
+std::unique_ptr<Command> make_fill_command();
+std::unique_ptr<Command> make_reconstruct_command();
+std::unique_ptr<Command> make_generate_command();
 
 }  // namespace terrapolis::cli

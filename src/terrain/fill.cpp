@@ -37,6 +37,10 @@ void reconstruct(Raster<float>& raster, const FillParams& params, Progress* prog
     return;
   }
   SplineParams spline = params.spline;
+  // Rectangular cells (geographic grids): weigh the curvature along each axis by its true spacing.
+  const CellMetrics metrics = cell_metrics(raster.georef(), raster.cols(), raster.rows());
+  const int centre = raster.rows() / 2;
+  if (metrics.height_m[std::size_t(centre) + 1] > 0) spline.cell_aspect = metrics.width_m[std::size_t(centre)] / metrics.height_m[std::size_t(centre) + 1];
   spline.smoothness = params.method == FillMethod::harmonic ? Smoothness::harmonic : Smoothness::thin_plate;
   spline_fill(raster, spline, progress);
 }
@@ -159,10 +163,16 @@ void fill_voids(Dem& dem, const std::vector<std::uint8_t>& voids, const FillPara
       const int c0 = std::max(0, w.c0 - margin), r0 = std::max(0, w.r0 - margin);
       const int c1 = std::min(cols - 1, w.c1 + margin), r1 = std::min(rows - 1, w.r1 + margin);
       Georef georef = source.georef();
+      auto& gt = georef.transform;
+      gt[0] += c0 * gt[1] + r0 * gt[2];
+      gt[3] += c0 * gt[4] + r0 * gt[5];
       Raster<float> window(c1 - c0 + 1, r1 - r0 + 1, georef);
       for (int r = r0; r <= r1; ++r)
         for (int c = c0; c <= c1; ++c) window(c - c0, r - r0) = source(c, r);
-      reconstruct(window, params, nullptr);
+      // A void's window is small and its interior far from the samples: relaxing it longer is cheap.
+      FillParams local = params;
+      local.spline.max_sweeps = std::max(params.spline.max_sweeps, 300);
+      reconstruct(window, local, nullptr);
       for (const std::uint32_t i : w.cells) {
         const int c = int(i % std::uint32_t(cols)), r = int(i / std::uint32_t(cols));
         dem[i] = window(c - c0, r - r0);

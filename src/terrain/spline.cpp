@@ -71,40 +71,57 @@ inline int mirror(int i, int n) {
   return std::clamp(i, 0, n - 1);
 }
 
-/// Gauss-Seidel sweeps in 9 colours (col mod 3, row mod 3): no two cells of one colour are in each
+/// Successive over-relaxation (Gauss-Seidel) sweeps in 9 colours (col mod 3, row mod 3): no two cells of one colour are in each
 /// other's 13-point stencil, so a colour's rows run in parallel with a result independent of scheduling.
-void relax(Level& level, Smoothness smoothness, double tension, int max_sweeps, double tolerance) {
+void relax(Level& level, Smoothness smoothness, double tension, double aspect, int max_sweeps, double tolerance) {
+  // Over-relaxation: measured on the benchmark, 1.7 reaches a given error in about half the sweeps of 1.0.
+  constexpr double omega = 1.7;
   const int cols = level.cols, rows = level.rows;
-  double c0, cn, cd, cf;
-  if (smoothness == Smoothness::harmonic) { c0 = 4; cn = 1; cd = 0; cf = 0; }
-  else { c0 = 20 + 4 * tension; cn = 8 + tension; cd = -2; cf = -1; }
-  if (smoothness == Smoothness::thin_plate && (cols < 3 || rows < 3)) { c0 = 4; cn = 1; cd = 0; cf = 0; }
+  // Weights of the second differences: a east-west, b north-south, in units of 1/(cell width)^2.
+  const double a = 1.0, b = aspect * aspect;
+  // Coefficients of (lap^2 - tension lap) on the 13-point stencil; harmonic keeps only lap.
+  double c0, ce, cn, cd, cee, cnn;
+  const bool plate = smoothness == Smoothness::thin_plate && cols >= 3 && rows >= 3;
+  if (plate) {
+    c0 = 6 * a * a + 6 * b * b + 8 * a * b + 2 * tension * (a + b);
+    ce = 4 * a * a + 4 * a * b + tension * a;
+    cn = 4 * b * b + 4 * a * b + tension * b;
+    cd = -2 * a * b;
+    cee = -a * a;
+    cnn = -b * b;
+  } else {
+    c0 = 2 * (a + b); ce = a; cn = b; cd = 0; cee = 0; cnn = 0;
+  }
   float* z = level.z.data();
   const std::uint8_t* known = level.known.data();
   auto update = [&](int x, int y) -> double {
     const std::size_t i = std::size_t(y) * std::size_t(cols) + std::size_t(x);
     if (known[i]) return 0.0;
-    double sn, sd = 0, sf = 0;
+    double se, sn, sd = 0, see = 0, snn = 0;
     if (x >= 2 && y >= 2 && x < cols - 2 && y < rows - 2) {
       const std::size_t w = std::size_t(cols);
-      sn = double(z[i - 1]) + z[i + 1] + z[i - w] + z[i + w];
-      if (cd != 0) {
+      se = double(z[i - 1]) + z[i + 1];
+      sn = double(z[i - w]) + z[i + w];
+      if (plate) {
         sd = double(z[i - w - 1]) + z[i - w + 1] + z[i + w - 1] + z[i + w + 1];
-        sf = double(z[i - 2]) + z[i + 2] + z[i - 2 * w] + z[i + 2 * w];
+        see = double(z[i - 2]) + z[i + 2];
+        snn = double(z[i - 2 * w]) + z[i + 2 * w];
       }
     } else {
       auto at = [&](int dx, int dy) {
         return double(z[std::size_t(mirror(y + dy, rows)) * std::size_t(cols) + std::size_t(mirror(x + dx, cols))]);
       };
-      sn = at(-1, 0) + at(1, 0) + at(0, -1) + at(0, 1);
-      if (cd != 0) {
+      se = at(-1, 0) + at(1, 0);
+      sn = at(0, -1) + at(0, 1);
+      if (plate) {
         sd = at(-1, -1) + at(1, -1) + at(-1, 1) + at(1, 1);
-        sf = at(-2, 0) + at(2, 0) + at(0, -2) + at(0, 2);
+        see = at(-2, 0) + at(2, 0);
+        snn = at(0, -2) + at(0, 2);
       }
     }
-    const double v = (cn * sn + cd * sd + cf * sf) / c0;
+    const double v = (ce * se + cn * sn + cd * sd + cee * see + cnn * snn) / c0;
     const double change = std::abs(v - z[i]);
-    z[i] = float(v);
+    z[i] = float(z[i] + omega * (v - z[i]));
     return change;
   };
   for (int sweep = 0; sweep < max_sweeps; ++sweep) {
@@ -159,7 +176,7 @@ void spline_fill(Raster<float>& raster, const SplineParams& params, Progress* pr
     const double tension = params.tension * std::pow(4.0, l);
     // Coarse levels are cheap and carry the long wavelengths: relax them harder.
     const int sweeps = l + 1 == int(pyramid.size()) ? 4000 : params.max_sweeps * (1 + l);
-    if (level.unknown) relax(level, params.smoothness, tension, sweeps, params.tolerance_m);
+    if (level.unknown) relax(level, params.smoothness, tension, params.cell_aspect, sweeps, params.tolerance_m);
     if (step) step->update(double(pyramid.size() - std::size_t(l)) / double(pyramid.size()));
   }
   const Level& fine = pyramid[0];

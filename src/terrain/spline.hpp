@@ -15,17 +15,18 @@ enum class Smoothness {
 
 struct SplineParams {
   Smoothness smoothness = Smoothness::thin_plate;
-  double tension = 0.0;        ///< tension in 1/cell^2 at full resolution (>= 0); 0: pure thin plate
-  int max_sweeps = 400;        ///< cap on Gauss-Seidel sweeps per level
-  double tolerance_m = 1e-3;   ///< a level stops when no cell moves more than this, in metres
+  double tension = 0.0;        ///< tension in 1/(cell width)^2 at full resolution (>= 0); 0: pure thin plate
+  double cell_aspect = 1.0;    ///< cell width (east-west) / cell height (north-south), both in metres
+  int max_sweeps = 40;         ///< cap on relaxation sweeps at full resolution (level l: (1 + l) times more)
+  double tolerance_m = 1e-2;   ///< a level stops when no cell moves more than this, in metres
 };
 
 /// Computes every NaN cell of `raster` so that the surface satisfies the chosen equation there with
 /// the finite cells fixed exactly, by cascadic multigrid: the problem is restricted to a pyramid
 /// of grids halved in size, solved at the coarsest level, and each solution is interpolated up as the
 /// first guess of the next finer level, which 9-colour Gauss-Seidel (independent of the thread count)
-/// then relaxes. Grid edges are mirror boundaries. Distances are in cells, so on a geographic grid the
-/// east-west stretch of cells is ignored (at most a few percent of the curvature weights).
+/// then relaxes. Grid edges are mirror boundaries. Rectangular cells (geographic grids) are honoured
+/// through cell_aspect; its change with latitude inside one grid is ignored.
 /// A raster with no finite cell is left as it is.
 void spline_fill(Raster<float>& raster, const SplineParams& params, Progress* progress = nullptr);
 
