@@ -47,7 +47,18 @@ for name, limit in (("r", 25), ("p", 25), ("d", 35)):
     e = np.sqrt(np.mean((b[valid] - a[valid]) ** 2))
     assert e < limit, f"{name}: rmse {e}"
 PY
+# GeoJSON points with the height in a property.
+cat >"$T/pts.geojson" <<'JSON'
+{"type":"FeatureCollection","features":[
+{"type":"Feature","properties":{"h":100},"geometry":{"type":"Point","coordinates":[-72.9,44.1]}},
+{"type":"Feature","properties":{"h":300},"geometry":{"type":"Point","coordinates":[-72.8,44.15]}},
+{"type":"Feature","properties":{"h":200},"geometry":{"type":"Point","coordinates":[-72.85,44.05]}}]}
+JSON
+"$BIN" --quiet reconstruct "$T/pts.geojson" "$T/g.tif" --like "$DEM" --z-field h
+[ -s "$T/g.tif" ]
 set +e
+"$BIN" reconstruct "$T/pts.geojson" "$T/bad.tif" --like "$DEM" 2>"$T/err"; rc=$?
+[ $rc -eq 2 ] && grep -q "z-field" "$T/err" && [ ! -e "$T/bad.tif" ] || { echo "missing z field: rc=$rc"; cat "$T/err"; exit 1; }
 "$BIN" reconstruct "$T/points.csv" "$T/bad.tif" 2>"$T/err"; rc=$?
 [ $rc -eq 2 ] && grep -q -- "--like" "$T/err" && [ ! -e "$T/bad.tif" ] || { echo "points without grid: rc=$rc"; cat "$T/err"; exit 1; }
 printf 'lon,lat,z\n1,2,x\n' >"$T/broken.csv"
