@@ -4,14 +4,15 @@
 # bicubic, RST) on the same inputs. Prints RMSE and maximum error on the hidden cells, wall time and
 # peak memory (median of REPEAT runs).
 # Usage: bench/terrain.sh [DEM...]   (default: N47E009.hgt and topotoolbox_bigtujunga.tif)
-# Env: TERRAPOLIS_BIN (default build/src/cli/terrapolis), REPEAT (default 3), SKIP_RST=1 to skip RST,
-# GRASS_TIMEOUT (s, default 300) caps each r.fillnulls run (GRASS runs once: its time is r.fillnulls alone).
+# Env: TERRAPOLIS_BIN (default build/src/cli/terrapolis), REPEAT (default 3), SKIP_RST=1 to skip RST, GRASS_ONLY=1 to run GRASS alone,
+# GRASS_TIMEOUT (s, default 300; GRASS_SPARSE_TIMEOUT for the sparse case) caps each r.fillnulls run (GRASS runs once: its time is r.fillnulls alone).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BIN=$(realpath "${TERRAPOLIS_BIN:-build/src/cli/terrapolis}")
 DEMS_DIR=../shared/dems
 REPEAT=${REPEAT:-3}
 GRASS_TIMEOUT=${GRASS_TIMEOUT:-300}
+GRASS_SPARSE_TIMEOUT=${GRASS_SPARSE_TIMEOUT:-$GRASS_TIMEOUT}
 PY=/usr/bin/python3
 if [ $# -gt 0 ]; then DEMS=("$@"); else DEMS=("$DEMS_DIR/N47E009.hgt" "$DEMS_DIR/topotoolbox_bigtujunga.tif"); fi
 WORK=$(mktemp -d)
@@ -118,19 +119,19 @@ timed() {
   echo "$mt $((mm / 1024))"
 }
 
-grass_fill() {  # grass_fill METHOD IN OUT
+grass_fill() {  # grass_fill METHOD IN OUT TIMEOUT
   cat >"$WORK/grass.sh" <<EOF
 set -e
 r.in.gdal -o input="$2" output=a --quiet --overwrite
 g.region raster=a
 /usr/bin/time -f "%e %M" -o "$WORK/grass_time" r.fillnulls input=a output=b method=$1 --quiet --overwrite
-r.out.gdal input=b output="$3" format=GTiff type=Float32 nodata=-9999 --quiet --overwrite
+r.out.gdal -c -f input=b output="$3" format=GTiff type=Float32 nodata=-9999 --quiet --overwrite
 EOF
   rm -f "$3"
   # r.fillnulls can take very long on the sparse case: cap it, and report the cap as its time.
-  if ! timeout "$GRASS_TIMEOUT" grass --tmp-location "$2" --exec bash "$WORK/grass.sh" >/dev/null 2>"$WORK/grass_err"; then
-    echo "r.fillnulls $1 failed or exceeded ${GRASS_TIMEOUT}s" >&2
-    echo ">${GRASS_TIMEOUT} 0" >"$WORK/grass_time"
+  if ! timeout "$4" grass --tmp-location "$2" --exec bash "$WORK/grass.sh" >/dev/null 2>"$WORK/grass_err"; then
+    echo "r.fillnulls $1 on $2 failed or exceeded $4 s" >&2
+    echo ">$4 0" >"$WORK/grass_time"
   fi
 }
 
@@ -147,6 +148,7 @@ for dem in "${DEMS[@]}"; do
       printf '%-28s %-7s %-26s %9s %9s %7s %8s %7s\n' "$name" "$case" "$1" "$rmse" "$mx" "$filled" "$t" "$m"
     }
     if [ "$case" = sparse ]; then cmd=(reconstruct "$in"); else cmd=(fill "$in"); fi
+    if [ "${GRASS_ONLY:-0}" != 1 ]; then
     for m in thin-plate harmonic dmmc; do
       o="$d/${case}_tp_$m.tif"
       row "terrapolis $m" "$o" "$(timed "$BIN" --quiet "${cmd[@]}" "$o" --method "$m" --overwrite)"
@@ -156,11 +158,13 @@ for dem in "${DEMS[@]}"; do
     md=100; [ "$case" = voids ] && md=250
     o="$d/${case}_gdal.tif"
     row "gdal_fillnodata -md $md" "$o" "$(timed /usr/bin/python3 /usr/bin/gdal_fillnodata.py -q -md $md "$in" "$o")"
+    fi
     if command -v grass >/dev/null; then
       for gm in bilinear bicubic rst; do
         [ "$gm" = rst ] && [ "${SKIP_RST:-0}" = 1 ] && continue
         o="$d/${case}_grass_$gm.tif"
-        grass_fill "$gm" "$in" "$o"
+        limit=$GRASS_TIMEOUT; [ "$case" = sparse ] && limit=$GRASS_SPARSE_TIMEOUT
+        grass_fill "$gm" "$in" "$o" "$limit"
         read -r t m <"$WORK/grass_time" || true
         row "grass r.fillnulls $gm" "$o" "$t $((m / 1024))"
         rm -f "$WORK/grass_time"
