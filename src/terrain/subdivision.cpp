@@ -227,9 +227,9 @@ void midpoint_displacement(SubdivisionGrid& grid, const MidpointParams& params, 
 }
 
 std::size_t bottom_up(SubdivisionGrid& grid, Subdivision scheme, const BottomUpParams& params) {
-  const int cols = grid.cols, rows = grid.rows;
-  const SubdivisionTree tree(cols, rows);
-  const double d_max = std::hypot(double(cols), double(rows));
+  const int cols = grid.cols;
+  const SubdivisionTree tree(cols, grid.rows);
+  const double d_max = std::hypot(double(cols), double(grid.rows));
   std::vector<std::uint32_t> active;
   for (std::size_t i = 0; i < grid.z.size(); ++i)
     if (grid.state[i] != CellState::unknown) active.push_back(std::uint32_t(i));
@@ -269,7 +269,6 @@ std::size_t bottom_up(SubdivisionGrid& grid, Subdivision scheme, const BottomUpP
       g = h;
     }
   }
-  (void)rows;
   return set;
 }
 
