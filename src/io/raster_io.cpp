@@ -198,8 +198,8 @@ Raster<float> read_resampled(const std::string& path, const Georef& like, int co
   Raster<float> out(cols, rows, like, std::numeric_limits<float>::quiet_NaN());
   GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");
   DatasetPtr dst(mem->Create("", cols, rows, 0, GDT_Float32, nullptr));
-  char pointer[64] = {};  // CPLPrintPointer does not write a terminating NUL
-  CPLPrintPointer(pointer, out.data(), sizeof(pointer));
+  char pointer[64] = {};  // CPLPrintPointer does not null-terminate: keep a zero at the end
+  CPLPrintPointer(pointer, out.data(), sizeof(pointer) - 1);
   const std::string opt = std::string("DATAPOINTER=") + pointer;
   char* band_options[] = {const_cast<char*>(opt.c_str()), nullptr};
   dst->AddBand(GDT_Float32, band_options);
@@ -260,8 +260,8 @@ void write_raster(const std::string& path, const Raster<T>& raster, const WriteO
   detail::check_output(path, options.overwrite);
   GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");
   DatasetPtr src(mem->Create("", raster.cols(), raster.rows(), 0, gdal_type(T{}), nullptr));
-  char pointer[64] = {};  // CPLPrintPointer does not write a terminating NUL
-  CPLPrintPointer(pointer, const_cast<T*>(raster.data()), sizeof(pointer));
+  char pointer[64] = {};  // CPLPrintPointer does not null-terminate: keep a zero at the end
+  CPLPrintPointer(pointer, const_cast<T*>(raster.data()), sizeof(pointer) - 1);
   const std::string opt = std::string("DATAPOINTER=") + pointer;
   char* band_options[] = {const_cast<char*>(opt.c_str()), nullptr};
   src->AddBand(gdal_type(T{}), band_options);

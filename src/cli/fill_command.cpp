@@ -1,0 +1,68 @@
+// `terrapolis fill DEM OUT.tif`: fills the nodata voids of a DEM, keeping its grid and CRS.
+// SPDX-License-Identifier: MIT
+#include <CLI/CLI.hpp>
+
+#include <optional>
+
+#include "cli/command.hpp"
+#include "cli/commands_list.hpp"
+#include "cli/terrain_options.hpp"
+#include "core/error.hpp"
+#include "io/raster_io.hpp"
+#include "terrain/fill.hpp"
+
+namespace terrapolis::cli {
+namespace {
+
+class FillCommand final : public Command {
+ public:
+  std::string name() const override { return "fill"; }
+  std::string summary() const override { return "Fill the nodata voids of a DEM (thin-plate spline, harmonic or DMMC)"; }
+
+  void setup(CLI::App& app) override {
+    app.add_option("DEM", input_, "Elevation model with voids (any GDAL raster)")->required();
+    app.add_option("OUT", output_, "Output GeoTIFF (float32, same grid and CRS)")->required();
+    options_.add(app, true, 0.0);
+    app.add_option("--max-void-km2", max_void_km2_, "Voids larger than this (km2, geodesic) stay nodata")->check(CLI::PositiveNumber);
+    app.add_option("--sea-level", sea_level_m_, "Cells at or below this height (m) connected to the border are sea; voids touching the sea are not filled");
+    app.add_flag("--fill-border-voids", fill_border_, "Also fill nodata connected to the grid border (by default it is outside the DEM)");
+    app.add_option("--assume-crs", assume_crs_, "CRS for a DEM that carries none, e.g. EPSG:32611");
+    app.add_flag("--overwrite", overwrite_, "Replace OUT if it exists");
+  }
+
+  void run(Context& context) override {
+    const terrain::FillParams params = options_.params();
+    check_output_path(output_, overwrite_);
+    ReadOptions read;
+    if (!assume_crs_.empty()) read.assume_crs = assume_crs_;
+    Dem dem = read_dem(input_, read);
+    terrain::VoidOptions voids_options;
+    if (max_void_km2_ > 0) voids_options.max_area_km2 = max_void_km2_;
+    voids_options.sea_level_m = sea_level_m_;
+    voids_options.fill_border = fill_border_;
+    terrain::VoidReport report;
+    const auto voids = terrain::find_voids(dem, voids_options, &report);
+    context.log.info("fill: " + std::to_string(report.voids) + " voids, " + std::to_string(report.voids_filled) + " filled (" +
+                     std::to_string(report.cells_filled) + " cells), " + std::to_string(report.too_large) + " larger than the limit left as nodata");
+    terrain::fill_voids(dem, voids, params, &context.progress);
+    WriteOptions write;
+    write.overwrite = overwrite_;
+    write.description = "elevation with voids filled (m)";
+    write.metadata = options_.metadata(true);
+    write.metadata.emplace_back("TERRAPOLIS_VOIDS_FILLED", std::to_string(report.voids_filled));
+    write_raster(output_, dem, write);
+  }
+
+ private:
+  std::string input_, output_, assume_crs_;
+  TerrainOptions options_;
+  double max_void_km2_ = 0;
+  std::optional<double> sea_level_m_;
+  bool fill_border_ = false, overwrite_ = false;
+};
+
+}  // namespace
+
+std::unique_ptr<Command> make_fill_command() { return std::make_unique<FillCommand>(); }
+
+}  // namespace terrapolis::cli

@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# terrapolis generate: fractal terrain, seeded, constrained by a sketch; bad input fails cleanly.
+set -euo pipefail
+BIN=$1
+T=$(mktemp -d)
+trap 'rm -rf "$T"' EXIT
+"$BIN" --quiet generate "$T/a.tif" --size 129x97 --cell 30 --crs EPSG:32632 --origin 500000,5000000 --seed 4 --roughness 500
+"$BIN" --quiet --threads 1 generate "$T/b.tif" --size 129x97 --cell 30 --crs EPSG:32632 --origin 500000,5000000 --seed 4 --roughness 500
+cmp "$T/a.tif" "$T/b.tif"
+"$BIN" --quiet generate "$T/c.tif" --size 129x97 --cell 30 --crs EPSG:32632 --origin 500000,5000000 --seed 5 --roughness 500
+! cmp -s "$T/a.tif" "$T/c.tif"
+# A sketch: a ridge at 800 m across the grid; the generated terrain keeps it exactly.
+/usr/bin/python3 - "$T/sketch.tif" <<'PY'
+import sys
+import numpy as np
+from osgeo import gdal, osr
+ds = gdal.GetDriverByName("GTiff").Create(sys.argv[1], 129, 97, 1, gdal.GDT_Float32)
+ds.SetGeoTransform((500000, 30, 0, 5000000, 0, -30))
+s = osr.SpatialReference(); s.ImportFromEPSG(32632); ds.SetProjection(s.ExportToWkt())
+a = np.full((97, 129), -1, np.float32); a[48, 10:120] = 800
+b = ds.GetRasterBand(1); b.SetNoDataValue(-1); b.WriteArray(a); ds = None
+PY
+"$BIN" --quiet generate "$T/s.tif" --size 129x97 --cell 30 --crs EPSG:32632 --origin 500000,5000000 --constraints "$T/sketch.tif" --roughness 100
+/usr/bin/python3 -c "
+from osgeo import gdal; import numpy as np, sys
+ds = gdal.Open('$T/s.tif'); a = ds.GetRasterBand(1).ReadAsArray()
+sys.exit(0 if np.all(a[48, 10:120] == 800) and np.isfinite(a).all() else 1)"
+set +e
+"$BIN" generate "$T/bad.tif" --size 12 --cell 30 2>"$T/err"; rc=$?
+[ $rc -eq 2 ] && grep -q -- "--size" "$T/err" && [ ! -e "$T/bad.tif" ] || { echo "bad size: rc=$rc"; cat "$T/err"; exit 1; }
+"$BIN" generate "$T/bad.tif" --size 10x10 --cell 30 --crs EPSG:4326 2>"$T/err"; rc=$?
+[ $rc -eq 2 ] && grep -q "geographic" "$T/err" && [ ! -e "$T/bad.tif" ] || { echo "geographic crs: rc=$rc"; cat "$T/err"; exit 1; }
+"$BIN" generate "$T/bad.tif" --size 10x10 --cell 30 --hurst 3 2>"$T/err"; rc=$?
+[ $rc -ne 0 ] && [ ! -e "$T/bad.tif" ] || { echo "bad hurst: rc=$rc"; exit 1; }
+exit 0

@@ -1,0 +1,266 @@
+// Tests of constrained midpoint displacement, DMMC, multigrid splines and void detection.
+// SPDX-License-Identifier: MIT
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <limits>
+
+#include "terrain/fill.hpp"
+#include "terrain/spline.hpp"
+#include "terrain/subdivision.hpp"
+
+using namespace terrapolis;
+using namespace terrapolis::terrain;
+
+namespace {
+
+constexpr float nan_f = std::numeric_limits<float>::quiet_NaN();
+
+Georef unit_georef() {
+  Georef g;
+  g.transform = {500000, 30, 0, 4000000, 0, -30};
+  g.crs.wkt = "LOCAL_CS[\"test\"]";
+  return g;
+}
+
+/// Random sparse constraints: a share of the cells of `truth`, chosen by a hash.
+Raster<float> sample(const Raster<float>& truth, double share, std::uint64_t seed) {
+  Raster<float> r = truth;
+  for (int y = 0; y < r.rows(); ++y)
+    for (int x = 0; x < r.cols(); ++x)
+      if ((position_noise(seed, x, y) + 1) / 2 >= share) r(x, y) = nan_f;
+  return r;
+}
+
+/// The thesis's skeleton (Belhadj fig. 1.2, 3.3): two crossed diagonals at `ridge_m`, the
+/// counter-diagonal shifted one cell right, borders fixed at zero.
+Raster<float> cross_skeleton(int n, float ridge_m) {
+  Raster<float> r(n, n, unit_georef(), nan_f);
+  for (int i = 0; i < n; ++i) {
+    r(i, i) = ridge_m;
+    if (n - i < n) r(n - i, i) = ridge_m;  // counter-diagonal shifted by one
+  }
+  for (int i = 0; i < n; ++i) r(i, 0) = r(i, n - 1) = r(0, i) = r(n - 1, i) = 0.0f;
+  return r;
+}
+
+/// Largest height difference between a constrained cell and an 8-neighbour that was computed, away
+/// from the borders (where a ridge meets the zero border any neighbour jumps by half the ridge).
+double largest_jump_at_constraints(const Raster<float>& constraints, const Raster<float>& result) {
+  double worst = 0;
+  const int margin = result.cols() / 8;
+  for (int y = margin; y < result.rows() - margin; ++y)
+    for (int x = margin; x < result.cols() - margin; ++x) {
+      if (std::isnan(constraints(x, y))) continue;
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          if (!result.inside(x + dx, y + dy) || !std::isnan(constraints(x + dx, y + dy))) continue;
+          worst = std::max(worst, std::abs(double(result(x + dx, y + dy)) - result(x, y)));
+        }
+    }
+  return worst;
+}
+
+double rmse_hidden(const Raster<float>& truth, const Raster<float>& input, const Raster<float>& result) {
+  double s = 0;
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < truth.size(); ++i)
+    if (std::isnan(input[i])) { s += (double(result[i]) - truth[i]) * (double(result[i]) - truth[i]); ++n; }
+  return std::sqrt(s / double(n));
+}
+
+Raster<float> smooth_surface(int cols, int rows) {
+  Raster<float> r(cols, rows, unit_georef());
+  for (int y = 0; y < rows; ++y)
+    for (int x = 0; x < cols; ++x)
+      r(x, y) = float(300 + 120 * std::sin(x * 0.07) * std::cos(y * 0.05) + 40 * std::sin((x + 2 * y) * 0.03));
+  return r;
+}
+
+}  // namespace
+
+TEST(SubdivisionTree, EveryCellHasLevelAndParentsAtLowerLevels) {
+  for (const auto scheme : {Subdivision::triangle_edge, Subdivision::diamond_square})
+    for (const auto& [cols, rows] : {std::pair{9, 9}, {13, 7}, {2, 5}, {100, 37}}) {
+      const SubdivisionTree tree(cols, rows);
+      for (int y = 0; y < rows; ++y)
+        for (int x = 0; x < cols; ++x) {
+          int pc[4], pr[4];
+          double w[4];
+          const int n = tree.parents(scheme, x, y, pc, pr, w);
+          const bool corner = (x == 0 || x == cols - 1) && (y == 0 || y == rows - 1);
+          EXPECT_EQ(n == 0, corner) << x << "," << y;
+          double sum = 0;
+          for (int k = 0; k < n; ++k) {
+            sum += w[k];
+            const bool earlier = tree.level(pc[k], pr[k]) < tree.level(x, y);
+            // Diamond-Square edge midpoints also read the centres made at the same level.
+            const bool same_level_centre = scheme == Subdivision::diamond_square && tree.level(pc[k], pr[k]) == tree.level(x, y) &&
+                                           tree.x().depth[std::size_t(pc[k])] == tree.y().depth[std::size_t(pr[k])];
+            EXPECT_TRUE(earlier || same_level_centre) << x << "," << y;
+          }
+          if (n) {
+            EXPECT_NEAR(sum, 1.0, 1e-12);
+          }
+        }
+    }
+}
+
+TEST(MidpointDisplacement, WithoutNoiseReproducesAPlaneOnAnyGridSize) {
+  for (const auto scheme : {Subdivision::triangle_edge, Subdivision::diamond_square})
+    for (const auto& [cols, rows] : {std::pair{9, 9}, {13, 7}, {31, 64}}) {
+      auto plane = [](int x, int y) { return 10.0 + 2.0 * x - 3.0 * y; };
+      Raster<float> r(cols, rows, unit_georef(), nan_f);
+      for (const int y : {0, rows - 1})
+        for (const int x : {0, cols - 1}) r(x, y) = float(plane(x, y));
+      SubdivisionGrid g = SubdivisionGrid::from_raster(r);
+      MidpointParams p;
+      p.subdivision = scheme;
+      midpoint_displacement(g, p);
+      for (int y = 0; y < rows; ++y)
+        for (int x = 0; x < cols; ++x) EXPECT_NEAR(g.z[std::size_t(y * cols + x)], plane(x, y), 1e-3) << x << "," << y;
+    }
+}
+
+TEST(MidpointDisplacement, TriangleEdgeIsBilinearBetweenTheCorners) {
+  // Hand-computed: corners 0, 8 (east), 16 (south), 0 (south-east) on a 5x5 grid; centre = mean = 6.
+  Raster<float> r(5, 5, unit_georef(), nan_f);
+  r(0, 0) = 0; r(4, 0) = 8; r(0, 4) = 16; r(4, 4) = 0;
+  SubdivisionGrid g = SubdivisionGrid::from_raster(r);
+  midpoint_displacement(g, MidpointParams{});
+  EXPECT_FLOAT_EQ(g.z[2 * 5 + 2], 6.0f);
+  EXPECT_FLOAT_EQ(g.z[0 * 5 + 2], 4.0f);
+  EXPECT_FLOAT_EQ(g.z[2 * 5 + 0], 8.0f);
+  EXPECT_FLOAT_EQ(g.z[1 * 5 + 1], 0.75f * 0.75f * 0 + 0.25f * 0.75f * 8 + 0.75f * 0.25f * 16);
+}
+
+TEST(MidpointDisplacement, ConstraintsAreKeptExactly) {
+  const Raster<float> truth = smooth_surface(70, 45);
+  const Raster<float> input = sample(truth, 0.05, 7);
+  for (const auto scheme : {Subdivision::triangle_edge, Subdivision::diamond_square}) {
+    SubdivisionGrid g = SubdivisionGrid::from_raster(input);
+    MidpointParams p;
+    p.subdivision = scheme;
+    p.scale_m = 200;
+    midpoint_displacement(g, p);
+    Raster<float> d = input;
+    DmmcParams dp;
+    dp.top_down = p;
+    dp.low_pass = true;
+    dmmc(d, dp);
+    for (std::size_t i = 0; i < input.size(); ++i) {
+      EXPECT_TRUE(std::isfinite(g.z[i]));
+      EXPECT_TRUE(std::isfinite(d[i]));
+      if (std::isnan(input[i])) continue;
+      EXPECT_EQ(g.z[i], input[i]);
+      EXPECT_EQ(d[i], input[i]);
+    }
+  }
+}
+
+TEST(MidpointDisplacement, SameSeedSameBytesWhateverTheThreads) {
+  const Raster<float> input = sample(smooth_surface(200, 130), 0.03, 3);
+  auto run = [&](int threads, std::uint64_t seed) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
+    Raster<float> d = input;
+    DmmcParams dp;
+    dp.top_down.subdivision = Subdivision::diamond_square;
+    dp.top_down.scale_m = 50;
+    dp.top_down.seed = seed;
+    dp.low_pass = true;
+    dmmc(d, dp);
+    Raster<float> s = input;
+    spline_fill(s, SplineParams{});
+    d.values().insert(d.values().end(), s.values().begin(), s.values().end());
+    return d.values();
+  };
+  const auto one = run(1, 5), two = run(2, 5), other = run(2, 6);
+  ASSERT_EQ(one.size(), two.size());
+  EXPECT_EQ(std::memcmp(one.data(), two.data(), one.size() * sizeof(float)), 0);
+  EXPECT_NE(std::memcmp(one.data(), other.data(), one.size() * sizeof(float)), 0);
+}
+
+TEST(Dmmc, BottomUpDownDoesNotTearAlongTheShiftedDiagonal) {
+  // Belhadj fig. 1.2 vs fig. 3.3: plain subdivision ignores the shifted counter-diagonal until the
+  // last level, so its neighbours sit far below it; bottom-up-down pushes it up the tree first.
+  const int n = 65;
+  const float ridge = 1000;
+  const Raster<float> skeleton = cross_skeleton(n, ridge);
+  for (const auto scheme : {Subdivision::triangle_edge, Subdivision::diamond_square}) {
+    SubdivisionGrid plain = SubdivisionGrid::from_raster(skeleton);
+    MidpointParams p;
+    p.subdivision = scheme;
+    midpoint_displacement(plain, p);
+    Raster<float> plain_r = skeleton;
+    plain_r.values() = plain.z;
+    Raster<float> bud = skeleton;
+    DmmcParams dp;
+    dp.top_down = p;
+    dmmc(bud, dp);
+    const double jump_plain = largest_jump_at_constraints(skeleton, plain_r);
+    const double jump_bud = largest_jump_at_constraints(skeleton, bud);
+    // The smooth slope from ridge to border is ridge / (n/2) per cell; a tear is many times that.
+    std::printf("scheme %d: largest jump plain %.1f m, bottom-up-down %.1f m\n", int(scheme), jump_plain, jump_bud);
+    EXPECT_GT(jump_plain, 0.4 * ridge) << int(scheme);
+    EXPECT_LT(jump_bud, 0.2 * ridge) << int(scheme);
+  }
+}
+
+TEST(Reconstruction, ErrorFallsAsSamplesGrowDenser) {
+  const Raster<float> truth = smooth_surface(161, 121);
+  for (const auto method : {FillMethod::dmmc, FillMethod::harmonic, FillMethod::thin_plate}) {
+    double previous = 1e30;
+    for (const double share : {0.01, 0.04, 0.16}) {
+      const Raster<float> input = sample(truth, share, 11);
+      Raster<float> out = input;
+      FillParams fp;
+      fp.method = method;
+      fp.dmmc.top_down.subdivision = Subdivision::diamond_square;
+      fp.dmmc.bottom_up.weight_by_distance = false;
+      fp.dmmc.low_pass = true;
+      reconstruct(out, fp);
+      const double e = rmse_hidden(truth, input, out);
+      EXPECT_LT(e, previous) << to_string(method) << " " << share;
+      previous = e;
+    }
+    // Relief amplitude is ~300 m; at 16% samples every method is within a few metres.
+    EXPECT_LT(previous, method == FillMethod::thin_plate ? 1.0 : 6.0) << to_string(method);
+  }
+}
+
+TEST(Voids, BorderNodataAndSeaAreNotVoidsAndLargeVoidsStay) {
+  // 8x8 grid, 30 m cells: nodata along the west border, a 2-cell hole and a 6-cell hole inside,
+  // and a cell at sea level touching the east border next to a 1-cell hole.
+  Raster<float> dem(8, 8, unit_georef(), 100.0f);
+  for (int y = 0; y < 8; ++y) dem(0, y) = nan_f;
+  dem(2, 2) = dem(3, 2) = nan_f;
+  for (int y = 4; y <= 5; ++y)
+    for (int x = 4; x <= 6; ++x) dem(x, y) = nan_f;
+  dem(7, 1) = 0.0f;
+  dem(6, 1) = nan_f;
+  VoidReport rep;
+  auto v = find_voids(dem, VoidOptions{}, &rep);
+  EXPECT_EQ(rep.voids, 3u);
+  EXPECT_EQ(v[dem.index(0, 3)], 0);
+  EXPECT_EQ(v[dem.index(2, 2)], 1);
+  EXPECT_EQ(v[dem.index(6, 1)], 1);
+  VoidOptions sea;
+  sea.sea_level_m = 0.0;
+  sea.max_area_km2 = 3 * 900e-6;  // the 6-cell hole (5400 m2) is too large
+  v = find_voids(dem, sea, &rep);
+  EXPECT_EQ(v[dem.index(6, 1)], 0);
+  EXPECT_EQ(v[dem.index(5, 4)], 0);
+  EXPECT_EQ(v[dem.index(3, 2)], 1);
+  EXPECT_EQ(rep.too_large, 1u);
+  VoidOptions all;
+  all.fill_border = true;
+  v = find_voids(dem, all, &rep);
+  EXPECT_EQ(v[dem.index(0, 0)], 1);
+  FillParams fp;
+  fill_voids(dem, v, fp);
+  for (std::size_t i = 0; i < dem.size(); ++i) EXPECT_TRUE(std::isfinite(dem[i]));
+  EXPECT_NEAR(dem(2, 2), 100.0f, 0.05);
+}
