@@ -94,13 +94,14 @@ PY
     loc=$(gdallocationinfo -wgs84 "$work/agree_$name/accumulation.tif" "$lon" "$lat" | sed -n 's/.*Location: (\([0-9]*\)P,\([0-9]*\)L).*/\1 \2/p')
     read -r px py <<<"$loc"
     ours=$(gdallocationinfo -valonly "$work/agree_$name/accumulation.tif" "$px" "$py")
+    [[ $ours =~ ^[0-9.eE+]+$ ]] || { echo "skipping outlet $lon,$lat: no accumulation value ($ours)"; continue; }
     # GRASS may leave the grid some cells away from Terrapolis's outlet (a flat lake is routed
     # differently: 165 cells on N47E009). Candidates are GRASS's outlet cells within 200 cells
     # (local maxima of |accumulation| over their 8 neighbours: a cell mid-river always has a larger
     # downstream neighbour); the one closest in size to Terrapolis's is its counterpart.
     gdal_translate -q -of XYZ -srcwin $((px - 200)) $((py - 200)) 401 401 "$work/grass_acc_$name.tif" "$work/win.xyz" 2>/dev/null
     theirs=$(awk -v ours="$ours" 'function abs(v) { return v < 0 ? -v : v }
-      { v[NR - 1] = ($3 == "" || $3 != $3) ? 0 : abs($3) }
+      { v[NR - 1] = ($3 ~ /^-?[0-9]/) ? abs($3 + 0) : 0 }  # nodata ("nan", "-9999"...) counts as 0
       END { w = 401; best = -1
         for (i = 0; i < NR; i++) { r = int(i / w); c = i % w; if (v[i] <= 0) continue; local = 1
           for (dr = -1; dr <= 1; dr++) for (dc = -1; dc <= 1; dc++) {
