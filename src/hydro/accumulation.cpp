@@ -38,7 +38,7 @@ Raster<double> accumulate(const Dem& filled, const FlowRouter& router,
           w = std::isnan(wt) ? 0.0 : own * double(wt);
         }
         acc[i] = w;
-        receivers[i] = router.inner_receivers(c, r);
+        receivers[i] = router.inner_receivers(c, r);  // D8: one bit, no split computed
       }
     }
   });

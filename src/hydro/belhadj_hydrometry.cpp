@@ -16,7 +16,7 @@ namespace terrapolis::hydro {
 namespace {
 // Order in which a sender feeds its neighbours (fixed, so sums are reproducible).
 constexpr int kGatherOrder[8] = {5, 6, 7, 4, 0, 3, 2, 1};
-constexpr int kSafetyCap = 300;
+constexpr int kSafetyCap = 160;  // |F| <= ~8^t: |F|^2 stays below DBL_MAX up to t ~ 170
 }  // namespace
 
 BelhadjModel::BelhadjModel(const Dem& dem, const CellMetrics& metrics, VerticalScale vertical,
@@ -106,7 +106,7 @@ struct State {
 
 /// One sender row of `n` cells starting at padded index i0: computes its 8 R_i, N_i = |R_i| and
 /// S_i = R_i . V_i, Σn, Acc += Q, then adds R_i and N_i Q / Σn to the fed receivers (scatter,
-/// as the thesis's loop). `scratch` holds 17 n doubles. Returns Σ Q over the row.
+/// as the thesis's loop). `scratch` holds 9 n doubles. Returns Σ Q over the row.
 TP_KERNEL double sender_row(const State& st, std::size_t i0, int n, const std::ptrdiff_t* off, const int* order,
                             const double* hx, const double* hy, bool all, double* __restrict scratch) {
   const double* __restrict z = st.z + i0;
@@ -115,15 +115,15 @@ TP_KERNEL double sender_row(const State& st, std::size_t i0, int n, const std::p
   const double* __restrict fz = st.fz + i0;
   const double* __restrict q = st.q + i0;
   double* __restrict sn = scratch;
-  double* __restrict norms = scratch + n;          // 8 rows of N_i
-  double* __restrict fed = scratch + 9 * std::size_t(n);  // 8 rows of 1 (fed, inside) or 0
+  // 8 rows of N_i for the fed inside neighbours, 0 for the others (a fed neighbour with N_i = 0
+  // has R_i = 0 and so receives nothing either way).
+  double* __restrict norms = scratch + n;
   const double keep = all ? 1.0 : 0.0;  // Σn over unfed neighbours too (Algorithm 12 as printed)
   for (int c = 0; c < n; ++c) sn[c] = 0.0;
   for (int k = 0; k < 8; ++k) {
     const double* __restrict zn = z + off[k];
     const double* __restrict vn = st.valid + i0 + off[k];
     double* __restrict nk = norms + std::size_t(k) * std::size_t(n);
-    double* __restrict mk = fed + std::size_t(k) * std::size_t(n);
     const double vx = hx[k], vy = hy[k];
     for (int c = 0; c < n; ++c) {
       const double dz = zn[c] - z[c];
@@ -131,8 +131,7 @@ TP_KERNEL double sender_row(const State& st, std::size_t i0, int n, const std::p
       const double s = rx * vx + ry * vy + rz * dz;
       const double norm = std::sqrt(rx * rx + ry * ry + rz * rz);
       const double inside = vn[c];  // loaded unconditionally so the loop has no branch
-      nk[c] = norm;
-      mk[c] = s > 0 ? inside : 0.0;
+      nk[c] = s > 0 ? inside * norm : 0.0;
       sn[c] += s > 0 ? norm : keep * norm;
     }
   }
@@ -146,14 +145,13 @@ TP_KERNEL double sender_row(const State& st, std::size_t i0, int n, const std::p
     const int k = order[g];
     const double* __restrict zn = z + off[k];
     const double* __restrict nk = norms + std::size_t(k) * std::size_t(n);
-    const double* __restrict mk = fed + std::size_t(k) * std::size_t(n);
     double* __restrict ox = st.fx2 + i0 + off[k];
     double* __restrict oy = st.fy2 + i0 + off[k];
     double* __restrict oz = st.fz2 + i0 + off[k];
     double* __restrict oq = st.q2 + i0 + off[k];
     const double vx = hx[k], vy = hy[k];
     for (int c = 0; c < n; ++c) {
-      const double m = mk[c];
+      const double m = nk[c] > 0 ? 1.0 : 0.0;
       ox[c] += m * (fx[c] + vx);
       oy[c] += m * (fy[c] + vy);
       oz[c] += m * (fz[c] + (zn[c] - z[c]));
@@ -181,7 +179,7 @@ double BelhadjModel::step() {
   for (int phase = 0; phase < 3; ++phase) {
     const int count = (rows_ - phase + 2) / 3;
     tbb::parallel_for(tbb::blocked_range<int>(0, count), [&](const tbb::blocked_range<int>& range) {
-      std::vector<double> scratch(17 * static_cast<std::size_t>(cols_));
+      std::vector<double> scratch(9 * static_cast<std::size_t>(cols_));
       for (int t = range.begin(); t < range.end(); ++t) {
         const int r = phase + 3 * t;
         const std::size_t pr = std::size_t(r + 1), i0 = pr * std::size_t(stride_) + 1;

@@ -75,7 +75,7 @@ class BelhadjModel {
 };
 
 struct BelhadjOptions {
-  int max_iterations = 0;                ///< 0: until convergence (with a safety cap of 300)
+  int max_iterations = 0;                ///< 0: until convergence (with a safety cap of 160)
   double threshold = 1.0 / 1048576;      ///< stop when the mean quantity is below this (2^-20)
   VerticalScale vertical = VerticalScale::metres;
   std::optional<double> sea_level;       ///< cells at or below are outside (outlets)
@@ -89,8 +89,8 @@ struct BelhadjRun {
 };
 
 /// Runs the diffusion until the mean quantity drops below `threshold` or `max_iterations`.
-/// The cap of 300 iterations keeps the flow vectors finite (|F| can grow 8-fold per iteration on a
-/// flat: 8^300 < 1e308); the thesis's cases converge in 20 to 51 iterations.
+/// The cap of 160 iterations keeps the flow vectors finite (|F| can grow 8-fold per iteration on a
+/// flat, and |F|^2 must stay below 1.8e308: 8^340 would not); the thesis's cases converge in 20 to 51 iterations.
 BelhadjRun belhadj_hydrometry(const Dem& dem, const CellMetrics& metrics, const BelhadjOptions& options,
                               Progress& progress);
 

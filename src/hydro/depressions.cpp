@@ -175,19 +175,27 @@ FlatGradient resolve_flats(const Dem& filled, const Raster<std::uint8_t>& d8) {
     ++next_label;
   }
   std::vector<std::int32_t> flat_height(std::size_t(next_label), 0);
-  // Breadth-first wave over undrained cells of the same flat, one ring per loop.
-  auto wave = [&](std::vector<std::uint32_t> front, auto&& set) {
-    std::vector<std::uint32_t> next;
-    for (std::int32_t loops = 1; !front.empty(); ++loops) {
+  // Breadth-first wave over undrained cells of the same flat, one ring per loop. A cell is
+  // marked (mask > 0 after `set`) when it is first reached, so each is queued once; its value
+  // depends only on its ring, as in Barnes's algorithm where duplicates are skipped when popped.
+  auto wave = [&](const std::vector<std::uint32_t>& seeds, auto&& set) {
+    std::vector<std::uint32_t> front, next;
+    for (std::uint32_t i : seeds)
+      if (mask[i] <= 0) {
+        set(i, 1);
+        front.push_back(i);
+      }
+    for (std::int32_t loops = 2; !front.empty(); ++loops) {
       next.clear();
       for (std::uint32_t i : front) {
-        if (!set(i, loops)) continue;
         const int c = int(i % std::uint32_t(cols)), r = int(i / std::uint32_t(cols));
         for (int k = 0; k < 8; ++k) {
           const int nc = c + dcol[k], nr = r + drow[k];
           if (!filled.inside(nc, nr)) continue;
           const std::size_t n = filled.index(nc, nr);
-          if (labels[n] == labels[i] && d8[n] == kNoFlow) next.push_back(std::uint32_t(n));
+          if (mask[n] > 0 || d8[n] != kNoFlow || labels[n] != labels[i]) continue;
+          set(n, loops);
+          next.push_back(std::uint32_t(n));
         }
       }
       std::swap(front, next);
@@ -197,19 +205,15 @@ FlatGradient resolve_flats(const Dem& filled, const Raster<std::uint8_t>& d8) {
   std::vector<std::uint32_t> high_labelled;
   for (std::uint32_t i : high)
     if (labels[i] != 0) high_labelled.push_back(i);
-  wave(high_labelled, [&](std::uint32_t i, std::int32_t loops) {
-    if (mask[i] > 0) return false;
+  wave(high_labelled, [&](std::size_t i, std::int32_t loops) {
     mask[i] = loops;
     flat_height[std::size_t(labels[i])] = loops;
-    return true;
   });
-  // Gradient towards lower terrain, combined: 2*towards + (height - away).
+  // Gradient towards lower terrain, combined: 2*towards + (height - away), always > 0.
   for (auto& m : mask.values()) m = -m;
-  wave(low, [&](std::uint32_t i, std::int32_t loops) {
-    if (mask[i] > 0) return false;
+  wave(low, [&](std::size_t i, std::int32_t loops) {
     if (mask[i] < 0) mask[i] = flat_height[std::size_t(labels[i])] + mask[i] + 2 * loops;
     else mask[i] = 2 * loops;
-    return true;
   });
   return out;
 }

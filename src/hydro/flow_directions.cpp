@@ -16,7 +16,7 @@ namespace {
 bool valid(const Dem& z, int c, int r) { return z.inside(c, r) && !std::isnan(z(c, r)); }
 
 /// First pass: steepest strictly-lower neighbour, outflow for outlets, kNoFlow otherwise.
-std::uint8_t steepest(const Dem& z, const CellMetrics& m, const std::optional<double>& sea_level, int c, int r) {
+std::uint8_t steepest(const Dem& z, const double* step, const std::optional<double>& sea_level, int c, int r) {
   const float zc = z(c, r);
   if (std::isnan(zc)) return kNoData;
   if (is_sea(zc, sea_level)) return kTerminal;
@@ -30,7 +30,7 @@ std::uint8_t steepest(const Dem& z, const CellMetrics& m, const std::optional<do
     }
     const double drop = double(zc) - double(z(nc, nr));
     if (drop <= 0) continue;
-    const double slope = drop / m.step_m(r, k);
+    const double slope = drop / step[k];
     if (slope > best_slope) {
       best_slope = slope;
       best = k;
@@ -50,8 +50,11 @@ Raster<std::uint8_t> d8_directions(const Dem& filled, const CellMetrics& metrics
   d8.nodata = kNoData;
   bool any_flat = false;
   tbb::parallel_for(tbb::blocked_range<int>(0, filled.rows()), [&](const tbb::blocked_range<int>& rows) {
-    for (int r = rows.begin(); r < rows.end(); ++r)
-      for (int c = 0; c < filled.cols(); ++c) d8(c, r) = steepest(filled, metrics, sea_level, c, r);
+    for (int r = rows.begin(); r < rows.end(); ++r) {
+      double step[8];
+      for (int k = 0; k < 8; ++k) step[k] = metrics.step_m(r, k);
+      for (int c = 0; c < filled.cols(); ++c) d8(c, r) = steepest(filled, step, sea_level, c, r);
+    }
   });
   for (auto v : d8.values())
     if (v == kNoFlow) {
@@ -213,6 +216,11 @@ void FlowRouter::split(int c, int r, FlowSplit& out) const {
 }
 
 std::uint8_t FlowRouter::inner_receivers(int c, int r) const {
+  if (method_ == FlowMethod::d8) {
+    const int k = d8_(c, r);
+    if (k >= 8 || !valid(z_, c + dcol[k], r + drow[k])) return 0;
+    return std::uint8_t(1u << k);
+  }
   FlowSplit s;
   split(c, r, s);
   std::uint8_t bits = 0;

@@ -16,7 +16,7 @@ enum class HydrometryMethod {
 
 struct HydrometryOptions {
   HydrometryMethod method = HydrometryMethod::belhadj;
-  int max_iterations = 0;            ///< belhadj: 0 until convergence (safety cap 300)
+  int max_iterations = 0;            ///< belhadj: 0 until convergence (safety cap 160)
   double threshold = 1.0 / 1048576;  ///< belhadj: mean quantity below which it stops (2^-20)
   VerticalScale vertical = VerticalScale::metres;
   std::optional<double> sea_level;   ///< cells at or below are outlets (coastal DEMs), metres
