@@ -16,6 +16,7 @@
 #include "cli/dem_input.hpp"
 #include "core/error.hpp"
 #include "density/density.hpp"
+#include "hydro/hydrometry.hpp"
 #include "io/raster_io.hpp"
 #include "terrapolis/version.hpp"
 
@@ -39,13 +40,13 @@ double parse_number(const std::string& option, const std::string& text) {
 /// The hydrometry the density model uses, on the DEM's grid, and whether it is worth writing.
 /// This is the ONE place that decides where hydrometry comes from: a file given with --hydrometry
 /// (resampled bilinearly to the DEM's grid), nothing when neither its weight nor a river-bed cap
-/// needs it (all zeros, not written), otherwise the hydrology stage.
+/// needs it (all zeros, not written), otherwise Belhadj's hydrometry computed from the DEM.
 struct Hydrometry {
   Raster<float> values;
   bool used = false;
 };
 
-Hydrometry obtain_hydrometry(const Dem& dem, const density::DensityOptions& options, const std::string& path) {
+Hydrometry obtain_hydrometry(const Dem& dem, const density::DensityOptions& options, const std::string& path, Progress& progress) {
   Hydrometry h;
   h.used = options.weights[1] != 0 || options.river_bed_cap.has_value();
   if (!path.empty()) {
@@ -61,7 +62,11 @@ Hydrometry obtain_hydrometry(const Dem& dem, const density::DensityOptions& opti
     h.values = dem.like<float>(0.0f);
     return h;
   }
-  throw bad_input("--hydrometry FILE is required when the hydrometry weight is not 0 or --river-bed-cap is set");
+  // Belhadj's hydrometry (thesis Alg. 12) with the sea as outlet, as `terrapolis hydro --sea-level` does.
+  hydro::HydrometryOptions hydrometry;
+  hydrometry.sea_level = options.sea_level_m;
+  h.values = hydro::compute_hydrometry(dem, hydrometry, progress);
+  return h;
 }
 
 class DensityCommand final : public Command {
@@ -114,7 +119,7 @@ class DensityCommand final : public Command {
     const auto seconds = [](clock::time_point a, clock::time_point b) { return format(std::chrono::duration<double>(b - a).count(), 3); };
     const auto t0 = clock::now();
     const Dem dem = dem_.read();
-    const Hydrometry hydrometry = obtain_hydrometry(dem, options, hydrometry_path_);
+    const Hydrometry hydrometry = obtain_hydrometry(dem, options, hydrometry_path_, context.progress);
     const auto t1 = clock::now();
     const std::clock_t cpu1 = std::clock();  // processor time of all threads
     const density::DensityResult result = density::compute_density(dem, hydrometry.values, options, context.progress);

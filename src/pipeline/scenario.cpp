@@ -88,13 +88,18 @@ void apply_set(json& doc, const std::string& set) {
 }  // namespace
 
 std::string Scenario::path(const std::string& field) const {
-  const std::filesystem::path p = resolved.at(field).get<std::string>();
-  if (p.is_absolute()) return p.string();
+  const json& value = field.starts_with('/') ? resolved.at(json::json_pointer(field)) : resolved.at(field);
+  return file(value.get<std::string>(), field == "dem");
+}
+
+std::string Scenario::file(const std::string& name, bool bundled_fallback) const {
+  const std::filesystem::path p = name;
+  if (name.empty() || p.is_absolute()) return name;
   if (!base_dir.empty()) return (base_dir / p).lexically_normal().string();
   // The default scenario names the bundled DEM relative to the source tree; find it from elsewhere too.
   std::error_code ec;
   const std::filesystem::path bundled = std::filesystem::path(TERRAPOLIS_SOURCE_DIR) / p;
-  if (field == "dem" && !std::filesystem::exists(p, ec) && std::filesystem::exists(bundled, ec)) return bundled.string();
+  if (bundled_fallback && !std::filesystem::exists(p, ec) && std::filesystem::exists(bundled, ec)) return bundled.string();
   return p.string();
 }
 
