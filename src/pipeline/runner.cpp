@@ -227,15 +227,15 @@ std::string format_summary(const json& manifest) {
   }
   if (sum.contains("density")) {
     const json& d = sum["density"];
-    line("  density  %.1f%% of the land buildable, mean density %.3f\n", 100 * d["buildable_share"].get<double>(),
-         d["mean_density"].get<double>());
+    line("  density  %.1f%% water, %.1f%% of the land buildable, mean density %.3f\n", 100 * d["water_share"].get<double>(),
+         100 * d["buildable_land_share"].get<double>(), d["mean_density"].get<double>());
   }
   if (sum.contains("sites")) {
     const json& c = sum["sites"];
     line("  sites    %d cities (%d roots, %d suburbs), %.0f people\n", c["cities"].get<int>(), c["roots"].get<int>(),
          c["suburbs"].get<int>(), c["population"].get<double>());
-    for (const auto& k : c["per_class"])
-      line("           class %d (radius %.0f m): %d\n", k["class"].get<int>(), k["radius_m"].get<double>(), k["cities"].get<int>());
+    for (const auto& [k, v] : c["per_class"].items())
+      line("           class %s (radius %.0f m): %d\n", k.c_str(), v["radius_m"].get<double>(), v["cities"].get<int>());
   }
   if (sum.contains("network")) {
     const json& n = sum["network"];

@@ -96,7 +96,8 @@ void density_run(RunState& s, Progress& progress, const Log&) {
   s.write("density", "buildable.tif", r.buildable, density::describe_output("buildable"), Style::mask);
   s.write("density", "density.tif", r.density, density::describe_output("density"), Style::density);
   const auto& st = r.stats;
-  s.summary["density"] = {{"buildable_share", st.known_cells ? round_to(double(st.buildable_cells) / double(st.known_cells), 1e-4) : 0.0},
+  const std::size_t land = st.known_cells - st.water_cells;
+  s.summary["density"] = {{"buildable_land_share", land ? round_to(double(st.buildable_cells) / double(land), 1e-4) : 0.0},
                           {"water_share", st.known_cells ? round_to(double(st.water_cells) / double(st.known_cells), 1e-4) : 0.0},
                           {"mean_density", round_to(st.mean_density, 1e-4)}};
   s.density = std::move(r.density);
@@ -128,10 +129,9 @@ void sites_run(RunState& s, Progress& progress, const Log&) {
     population += site.population;
     roots += site.parent < 0;
   }
-  json classes = json::array();
+  json classes = json::object();  // keyed by class so `compare` lines them up
   for (std::size_t k = 0; k < r.quotas.size(); ++k)
-    if (per_class.count(int(k)))
-      classes.push_back({{"class", k}, {"radius_m", r.quotas[k].radius_m}, {"cities", per_class[int(k)]}});
+    if (per_class.count(int(k))) classes[std::to_string(k)] = {{"radius_m", r.quotas[k].radius_m}, {"cities", per_class[int(k)]}};
   s.summary["sites"] = {{"cities", r.sites.size()}, {"roots", roots}, {"suburbs", int(r.sites.size()) - roots},
                         {"population", population}, {"per_class", classes}};
   s.sites = r.sites;

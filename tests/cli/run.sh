@@ -21,7 +21,7 @@ m = json.load(open(sys.argv[1]))
 assert [t["stage"] for t in m["timings"]] == ["terrain", "hydro", "density", "sites", "network", "roads"], m["timings"]
 s = m["summary"]
 assert s["hydro"]["stream_reaches"] > 0 and s["sites"]["cities"] > 0, s
-assert sum(c["cities"] for c in s["sites"]["per_class"]) == s["sites"]["cities"], s["sites"]
+assert sum(c["cities"] for c in s["sites"]["per_class"].values()) == s["sites"]["cities"], s["sites"]
 assert 0 < s["density"]["mean_density"] <= 1, s["density"]
 assert s["roads"]["roads"] + s["roads"]["failed"] == s["network"]["kept_edges"], (s["roads"], s["network"])
 assert sum(s["roads"]["length_km"].values()) > 0, s["roads"]
