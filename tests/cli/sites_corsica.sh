@@ -54,6 +54,12 @@ cmp "$T/a/cities.geojson" "$T/b/cities.geojson"
 "$BIN" --quiet sites "$T/in" "$T/a" --seed 9 --overwrite
 grep -q '"seed": 9' "$T/a/cities.geojson"
 
+# A DEM instead of a density folder: the same cities as `terrapolis density` then `terrapolis sites`.
+"$BIN" --quiet sites "$DEM" "$T/from_dem"
+"$BIN" --quiet density "$DEM" "$T/model"
+"$BIN" --quiet sites "$T/model" "$T/from_model"
+cmp "$T/from_dem/cities.geojson" "$T/from_model/cities.geojson"
+
 # Bad inputs: exit 2, one line naming the problem, no output folder left.
 refuse() { expect_refused "$1" "$2" "$BIN" --quiet sites "${@:3}" "$1"; }
 refuse "$T/x1" "no such folder" "$T/missing"
