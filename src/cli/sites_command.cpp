@@ -94,6 +94,10 @@ class SitesCommand final : public Command {
     app.add_option("--refill", options_.refill_rounds, "Rounds giving the quota of removed sites back to the growth (0: Algorithm 14 as printed)")
         ->check(CLI::NonNegativeNumber)
         ->capture_default_str();
+    app.add_option("--quota-scale", options_.quota_scale,
+                   "Multiplies every quota (region area / 543940 km2 of the census fit; 1: the thesis)")
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str();
     app.add_flag("--report", report_, "Print the quota table");
     app.add_flag("--overwrite", overwrite_, "Replace existing outputs");
   }

@@ -85,6 +85,7 @@ sites::SitesOptions sites_options(const Scenario& scenario) {
   o.x_max = s["x_max"].get<double>();
   o.p = s["p"].get<double>();
   o.people_per_m = s["people_per_m"].get<double>();
+  o.quota_scale = s["quota_scale"].get<double>();
   o.refill_rounds = s["refill_rounds"].get<int>();
   return o;
 }

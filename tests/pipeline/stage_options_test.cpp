@@ -56,6 +56,7 @@ TEST(StageOptions, SitesAndNetworkDefaultsEqualTheCode) {
   EXPECT_EQ(s.x_max, c.x_max);
   EXPECT_EQ(s.p, c.p);
   EXPECT_EQ(s.people_per_m, c.people_per_m);
+  EXPECT_EQ(s.quota_scale, c.quota_scale);
   EXPECT_EQ(s.mode, c.mode);
   EXPECT_EQ(s.disc_test, c.disc_test);
   EXPECT_EQ(s.refill_rounds, c.refill_rounds);
