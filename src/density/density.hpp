@@ -58,6 +58,18 @@ struct DensityOptions {
   std::vector<std::pair<std::string, double>> layers;
   /// User exclusion rasters (nearest resampling): non-zero cells are uninhabitable.
   std::vector<std::string> exclusions;
+
+  // ---- pre-computed factors (plugins) --------------------------------------------------------
+  /// A factor already on the DEM's grid, values in [0,1] (NaN reads as 0), with its weight: it
+  /// enters the combination exactly like a user layer.
+  struct Factor {
+    std::string name;
+    Raster<float> values;
+    double weight = 1;
+  };
+  std::vector<Factor> factors;
+  /// Exclusion masks already on the DEM's grid: non-zero cells are uninhabitable.
+  std::vector<Raster<std::uint8_t>> exclusion_masks;
 };
 
 /// Figures for the calibration report.
