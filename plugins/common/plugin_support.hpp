@@ -34,6 +34,14 @@ int guarded(char* error, std::size_t size, F&& work) {
   }
 }
 
+/// Keeps GDAL's own messages off stderr while alive: the plugin reports errors through the ABI.
+struct QuietGdal {
+  QuietGdal() { CPLPushErrorHandler(CPLQuietErrorHandler); }
+  ~QuietGdal() { CPLPopErrorHandler(); }
+  QuietGdal(const QuietGdal&) = delete;
+  QuietGdal& operator=(const QuietGdal&) = delete;
+};
+
 inline std::size_t cells(const TerrapolisGrid& g) { return std::size_t(g.cols) * std::size_t(g.rows); }
 
 /// A piecewise-linear curve through (x, y) points with increasing x, constant beyond its ends.
@@ -73,6 +81,7 @@ inline json identity_transfer() { return {{"points", json::array({json::array({0
 /// codes must not be blended); NaN where the source has no data or does not cover the cell.
 inline std::vector<double> read_on_grid(const TerrapolisGrid& g, const std::string& path, int band) {
   GDALAllRegister();
+  const QuietGdal quiet;
   GDALDatasetH src = GDALOpen(path.c_str(), GA_ReadOnly);
   if (!src) throw std::runtime_error(path + ": cannot open the raster");
   struct Closer {

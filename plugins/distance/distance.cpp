@@ -50,6 +50,7 @@ const char* const kSchema = R"json({
 /// Distance (m) from every cell centre to the features, via a mask of the cells they touch.
 std::vector<double> distances(const TerrapolisGrid& g, const json& p) {
   GDALAllRegister();
+  const QuietGdal quiet;
   const std::string path = p["vector"].get<std::string>();
   GDALDatasetH ds = GDALOpenEx(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY, nullptr, nullptr, nullptr);
   if (!ds) throw std::runtime_error(path + ": cannot open the vector file");

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cctype>
 #include <regex>
+#include <sstream>
 
 namespace terrapolis::cli {
 namespace {
@@ -20,30 +21,28 @@ std::string lower(std::string s) {
 
 bool contains(const std::string& text, const std::string& word) { return lower(text).find(lower(word)) != std::string::npos; }
 
-/// What a file-valued option holds, for GUIs (QGIS parameter types), from its name and help text:
-/// raster_in, vector_in, file_in, raster_out, vector_out, file_out, folder_out, folder_in, or none.
-std::string kind_of(const CLI::Option& o, const std::string& type) {
-  if (type != "string") return "";
-  const std::string name = o.get_name(), help = o.get_description();
-  if (name == "--plugin" || name == "--set" || name == "--from" || name == "--to") return "";
-  if (name == "DEM" || name == "--dem") return "raster_in";
-  const bool out = name == "OUT" || name == "OUTDIR" || name == "--output" || name == "-o" || name == "--sections" ||
-                   contains(help, "write") || contains(help, "output");
-  if (contains(help, "folder") || name == "OUTDIR" || name == "RUN" || name == "RUN1" || name == "RUN2") {
-    if (name == "OUTDIR" || contains(help, "folder for") || name == "--output" || name == "-o") return "folder_out";
-    if (contains(help, "run folder") || name.rfind("RUN", 0) == 0) return "folder_in";
+/// What a path-valued option holds, for GUIs (QGIS parameter types): raster_in, vector_in,
+/// file_in, folder_in, raster_out, vector_out, file_out, folder_out; "" for other text (CRS
+/// codes, coordinates, lists). Read from the option's name and help text, the only place the
+/// command line states it; docs/plugins.md lists the wording rules.
+std::string kind_of(const CLI::Option& o) {
+  const std::string name = o.nonpositional() ? o.get_name() : o.get_name(true), help = o.get_description();
+  // FILE:WEIGHT pairs, plugin specs and CRS codes are text.
+  if (contains(help, "FILE:") || name == "--plugin" || help.rfind("CRS", 0) == 0) return "";
+  if (name == "DEM" || help.rfind("DEM ", 0) == 0) return "raster_in";
+  if (name == "OUTDIR" || name == "--output") return "folder_out";
+  if (name == "OUT" || help.rfind("Also write", 0) == 0) {
+    if (contains(help, ".geojson") || contains(help, "polygon") || contains(help, "road") || contains(help, "sections")) return "vector_out";
+    if (contains(help, "GeoTIFF")) return "raster_out";
+    return "file_out";
   }
-  if (out) {
-    if (contains(help, ".geojson") || contains(help, "road") || contains(help, "vector")) return "vector_out";
-    if (contains(help, ".tif") || contains(help, "raster")) return "raster_out";
-    if (name == "OUT" || name == "--sections") return "file_out";
-  }
-  if (contains(help, "json file") || contains(help, "scenario")) return "file_in";
-  if (contains(help, "raster") || contains(help, "hydrometry") || contains(help, "density")) return "raster_in";
-  if (contains(help, "network") || contains(help, "cities") || contains(help, "line") || contains(help, "vector") ||
-      contains(help, ".geojson"))
+  if (contains(help, "folder")) return "folder_in";
+  if (contains(help, ".csv")) return "file_in";  // several formats: let the user pick any file
+  if (contains(help, "raster")) return "raster_in";
+  if (contains(help, ".geojson") || contains(help, "(Points") || contains(help, "line of this file") || contains(help, "City points"))
     return "vector_in";
-  return "file_in";
+  if (contains(help, "file")) return "file_in";
+  return "";
 }
 
 ordered_json describe_option(CLI::Option& o) {
@@ -62,15 +61,18 @@ ordered_json describe_option(CLI::Option& o) {
   o.capture_default_str();
   const std::string full = o.get_type_name();
   const std::string base = full.substr(0, full.find(':'));
-  const bool flag = o.get_type_size_max() == 0;
+  const bool flag = full.empty();  // flags have no type name
   std::string type = flag ? "boolean" : base == "INT" || base == "UINT" ? "integer" : base == "FLOAT" ? "number" : "string";
   j["type"] = type;
   j["cli_type"] = full;
   const std::string def = o.get_default_str();
-  if (def.empty()) {
-    j["default"] = flag ? ordered_json(false) : ordered_json(nullptr);
-  } else if (flag) {
-    j["default"] = def == "true" || def == "1";
+  if (flag) {
+    // A flag with a negated alias (--bridges,!--no-bridges) is on unless negated.
+    bool on = false;
+    for (const auto& n : o.get_lnames()) on = on || (n.rfind("no-", 0) == 0 && j["name"] != "--" + n);
+    j["default"] = on;
+  } else if (def.empty()) {
+    j["default"] = nullptr;
   } else if (type == "integer" || type == "number") {
     try {
       j["default"] = type == "integer" ? ordered_json(std::stoll(def)) : ordered_json(std::stod(def));
@@ -82,6 +84,15 @@ ordered_json describe_option(CLI::Option& o) {
   }
   j["required"] = o.get_required();
   j["repeatable"] = !flag && (o.get_expected_max() > 1 || o.get_items_expected_max() > 1);
+  if (j["repeatable"] && j["default"].is_string()) {  // CLI11 prints vectors as "[a,b]"
+    std::string list = j["default"].get<std::string>();
+    if (list.size() >= 2 && list.front() == '[' && list.back() == ']') list = list.substr(1, list.size() - 2);
+    ordered_json items = ordered_json::array();
+    std::stringstream ss(list);
+    std::string item;
+    while (std::getline(ss, item, ',')) items.push_back(item);
+    j["default"] = items;
+  }
   // Validators print as "{a,b}" (IsMember), "INT in [1 - 16]" (Range), "NONNEGATIVE", "POSITIVE".
   static const std::regex set_re(R"(\{([^}]*)\})"), range_re(R"(\[\s*([-+0-9.eE]+)\s*-\s*([-+0-9.eE]+)\s*\])");
   std::smatch m;
@@ -101,7 +112,7 @@ ordered_json describe_option(CLI::Option& o) {
   } else if (contains(validators, "POSITIVE")) {
     j["exclusive_minimum"] = 0.0;
   }
-  const std::string kind = kind_of(o, type);
+  const std::string kind = type == "string" && !j.contains("choices") ? kind_of(o) : "";
   j["kind"] = kind.empty() ? ordered_json(nullptr) : ordered_json(kind);
   return j;
 }

@@ -265,7 +265,8 @@ void validate_params(const LoadedPlugin& plugin, const json& params) {
   valijson::ValidationResults::Error best;
   for (const auto& e : results)
     if (e.context.size() > best.context.size()) best = e;
-  throw bad_input(where(plugin) + ": params" + pointer_of(best.context) + ": " + best.description);
+  const std::string pointer = pointer_of(best.context);
+  throw bad_input(where(plugin) + ": params" + (pointer == "/" ? "" : pointer) + ": " + best.description);
 }
 
 PluginSet load_plugins(const std::vector<PluginSpec>& specs, const Log& log) {

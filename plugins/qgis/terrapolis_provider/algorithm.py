@@ -6,6 +6,7 @@ import re
 from qgis.core import (QgsProcessing, QgsProcessingAlgorithm, QgsProcessingContext, QgsProcessingException,
                        QgsProcessingParameterBoolean, QgsProcessingParameterEnum, QgsProcessingParameterFile,
                        QgsProcessingParameterFileDestination, QgsProcessingParameterFolderDestination,
+                       QgsProcessingParameterMultipleLayers,
                        QgsProcessingParameterNumber, QgsProcessingParameterRasterDestination,
                        QgsProcessingParameterRasterLayer, QgsProcessingParameterString,
                        QgsProcessingParameterVectorLayer, QgsProcessingOutputMultipleLayers,
@@ -42,6 +43,8 @@ def make_parameter(option):
         if "maximum" in option:
             p.setMaximum(option["maximum"])
         return p
+    if kind == "raster_in" and option.get("repeatable"):
+        return QgsProcessingParameterMultipleLayers(name, help_text, QgsProcessing.TypeRaster, optional=optional)
     if kind == "raster_in":
         return QgsProcessingParameterRasterLayer(name, help_text, optional=optional)
     if kind == "vector_in":
@@ -59,8 +62,9 @@ def make_parameter(option):
     if kind == "file_out":
         return QgsProcessingParameterFileDestination(name, help_text, optional=optional)
     # Free text; repeatable options take one value per line.
-    return QgsProcessingParameterString(name, help_text, defaultValue=default, multiLine=option.get("repeatable", False),
-                                        optional=optional or default is not None)
+    if option.get("repeatable"):
+        return QgsProcessingParameterString(name, help_text, multiLine=True, optional=True)
+    return QgsProcessingParameterString(name, help_text, defaultValue=default, optional=optional or default is not None)
 
 
 class TerrapolisAlgorithm(QgsProcessingAlgorithm):
@@ -110,6 +114,9 @@ class TerrapolisAlgorithm(QgsProcessingAlgorithm):
                 value = str(self.parameterAsInt(parameters, name, context))
             elif option["type"] == "number":
                 value = repr(self.parameterAsDouble(parameters, name, context))
+            elif kind == "raster_in" and option.get("repeatable"):
+                layers = self.parameterAsLayerList(parameters, name, context)
+                value = "\n".join(l.source() for l in layers)
             elif kind == "raster_in":
                 layer = self.parameterAsRasterLayer(parameters, name, context)
                 value = layer.source() if layer else None
@@ -120,10 +127,10 @@ class TerrapolisAlgorithm(QgsProcessingAlgorithm):
                 value = self.parameterAsFile(parameters, name, context)
             elif kind == "folder_out":
                 value = self.parameterAsString(parameters, name, context)
-                outputs.append(("folder", value))
+                outputs.append((name, "folder", value))
             elif kind in ("raster_out", "vector_out", "file_out"):
                 value = self.parameterAsFileOutput(parameters, name, context)
-                outputs.append(("file", value))
+                outputs.append((name, "file", value))
             else:
                 value = self.parameterAsString(parameters, name, context)
             if value is None or value == "":
@@ -150,7 +157,9 @@ class TerrapolisAlgorithm(QgsProcessingAlgorithm):
         if code != 0:
             raise QgsProcessingException("terrapolis %s failed (exit code %d); see the log" % (self.command["name"], code))
         layers = []
-        for what, path in outputs:
+        result = {}
+        for name, what, path in outputs:
+            result[name] = path
             files = [path] if what == "file" else [os.path.join(path, f) for f in sorted(os.listdir(path))] if os.path.isdir(path) else []
             for f in files:
                 if f.endswith((".tif", ".geojson", ".gpkg")) and os.path.exists(f):
@@ -158,10 +167,7 @@ class TerrapolisAlgorithm(QgsProcessingAlgorithm):
                     # Loaded by QGIS with their default style (the .qml beside the file, when present).
                     details = QgsProcessingContext.LayerDetails(os.path.splitext(os.path.basename(f))[0], context.project(), "")
                     context.addLayerToLoadOnCompletion(f, details)
-        result = {OUTPUT_LAYERS: layers}
-        for option in self.command["options"]:
-            if option.get("kind") in ("folder_out", "raster_out", "vector_out", "file_out"):
-                result[parameter_name(option)] = parameters.get(parameter_name(option))
+        result[OUTPUT_LAYERS] = layers
         return result
 
 
