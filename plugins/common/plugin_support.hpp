@@ -42,6 +42,11 @@ struct QuietGdal {
   QuietGdal& operator=(const QuietGdal&) = delete;
 };
 
+/// Reports progress to the host; throws when the user cancelled (guarded() turns it into a failure).
+inline void report(const TerrapolisGrid& g, double fraction) {
+  if (g.progress && !g.progress(g.progress_context, fraction)) throw std::runtime_error("cancelled");
+}
+
 inline std::size_t cells(const TerrapolisGrid& g) { return std::size_t(g.cols) * std::size_t(g.rows); }
 
 /// A piecewise-linear curve through (x, y) points with increasing x, constant beyond its ends.

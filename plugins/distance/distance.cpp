@@ -80,7 +80,9 @@ std::vector<double> distances(const TerrapolisGrid& g, const json& p) {
   char* options[] = {const_cast<char*>("ALL_TOUCHED=TRUE"), nullptr};
   if (GDALRasterizeLayers(mem, 1, &band, 1, &layer, nullptr, nullptr, &burn, options, nullptr, nullptr) != CE_None)
     throw std::runtime_error(path + ": cannot rasterize the features on the DEM grid (" + CPLGetLastErrorMsg() + ")");
-  std::vector<double> d = distance_transform_m(mask.data(), g.cols, g.rows, g.cell_width_m, g.cell_height_m);
+  report(g, 0.2);
+  std::vector<double> d = distance_transform_m(mask.data(), g.cols, g.rows, g.cell_width_m, g.cell_height_m,
+                                               [&](double f) { report(g, 0.2 + 0.75 * f); });
   // No feature on the grid: every cell is "far" (a finite value, so no cell reads as forbidden).
   for (double& v : d)
     if (std::isinf(v)) v = 1e20;
@@ -92,11 +94,12 @@ int density(const TerrapolisGrid* g, const char* params, float* factor, uint8_t*
     const json p = json::parse(params);
     if (!p.contains("density")) throw std::runtime_error("params has no \"density\" object: this plugin cannot be a density factor");
     const json& dp = p["density"];
-    const Curve curve = dp.contains("points") ? Curve::from(dp["points"]) : Curve{};
+    const bool curve_given = dp.contains("points");
+    const Curve curve = curve_given ? Curve::from(dp["points"]) : Curve{};
     const double exclude = dp.value("exclude_within_m", -1.0);
     const std::vector<double> d = distances(*g, p);
     for (std::size_t i = 0; i < d.size(); ++i) {
-      factor[i] = float(std::clamp(curve(d[i]), 0.0, 1.0));
+      if (curve_given) factor[i] = float(std::clamp(curve(d[i]), 0.0, 1.0));  // else NaN: exclusions only
       if (d[i] <= exclude) excluded[i] = 1;
     }
   });

@@ -3,6 +3,7 @@
 #pragma once
 #include <cmath>
 #include <cstddef>
+#include <functional>
 #include <limits>
 #include <vector>
 
@@ -53,8 +54,9 @@ inline void squared_distance_1d(const double* f, const double* pos, std::size_t 
 /// steps). On geographic grids each row's pass uses that row's own width, so the east-west part is
 /// measured at the latitude of the feature's row: relative error about |dlat| tan(lat) on the
 /// east-west component (under 0.2 % at 10 km and 45 degrees).
+/// `progress(fraction)` is called now and then (it may throw to stop the work).
 inline std::vector<double> distance_transform_m(const unsigned char* feature, int cols, int rows, const double* width_m,
-                                                const double* height_m) {
+                                                const double* height_m, const std::function<void(double)>& progress = {}) {
   constexpr double inf = std::numeric_limits<double>::infinity();
   const std::size_t nc = std::size_t(cols), nr = std::size_t(rows);
   std::vector<double> g(nc * nr);
@@ -63,6 +65,7 @@ inline std::vector<double> distance_transform_m(const unsigned char* feature, in
   for (std::size_t r = 0; r < nr; ++r) {  // along rows
     for (std::size_t c = 0; c < nc; ++c) f[c] = feature[r * nc + c] ? 0.0 : inf, pos[c] = double(c) * width_m[r];
     squared_distance_1d(f.data(), pos.data(), nc, &g[r * nc], v, z);
+    if (progress && r % 256 == 255) progress(0.5 * double(r) / double(nr));
   }
   pos[0] = 0;
   for (std::size_t r = 1; r < nr; ++r) pos[r] = pos[r - 1] + height_m[r - 1];
@@ -70,6 +73,7 @@ inline std::vector<double> distance_transform_m(const unsigned char* feature, in
     for (std::size_t r = 0; r < nr; ++r) f[r] = g[r * nc + c];
     squared_distance_1d(f.data(), pos.data(), nr, d.data(), v, z);
     for (std::size_t r = 0; r < nr; ++r) g[r * nc + c] = std::sqrt(d[r]);
+    if (progress && c % 256 == 255) progress(0.5 + 0.5 * double(c) / double(nc));
   }
   return g;
 }

@@ -3,7 +3,6 @@
 // SPDX-License-Identifier: MIT
 #include <cmath>
 #include <map>
-#include <optional>
 
 #include "plugin_support.hpp"
 
@@ -41,23 +40,24 @@ const char* const kSchema = R"json({
       }
     },
     "default": {"type": "object", "additionalProperties": false,
-                "description": "effect of codes not in the table and of no-data cells (default: density 0, road cost 0)",
+                "description": "effect of codes not in the table and of no-data cells (default: no density opinion, road cost 0)",
                 "properties": {"density": {"$ref": "#/definitions/density"}, "road_cost": {"$ref": "#/definitions/road_cost"}}},
     "structures": {"type": "array", "items": {"enum": ["road", "bridge", "tunnel"]}, "uniqueItems": true,
                    "default": ["road"], "description": "structures that pay the road cost (by default bridges pass over land cover, tunnels under it)"}
   }
 })json";
 
-/// What one class does: attractiveness (nullopt = excluded) and cost per metre (infinity = forbidden).
+/// What one class does: attractiveness (NaN = no opinion), exclusion, cost per metre (infinity = forbidden).
 struct Effect {
-  std::optional<double> density = 0.0;
+  double density = NAN;
+  bool excluded = false;
   double road_cost = 0.0;
 };
 
 Effect effect_of(const json& j, Effect e) {
   if (j.contains("density")) {
-    if (j["density"].is_string()) e.density.reset();
-    else e.density = j["density"].get<double>();
+    e.excluded = j["density"].is_string();
+    e.density = e.excluded ? NAN : j["density"].get<double>();
   }
   if (j.contains("road_cost")) e.road_cost = j["road_cost"].is_string() ? INFINITY : j["road_cost"].get<double>();
   return e;
@@ -81,7 +81,9 @@ struct Table {
 };
 
 std::vector<double> codes_on_grid(const TerrapolisGrid& g, const json& p) {
-  return read_on_grid(g, p["raster"].get<std::string>(), p.value("band", 1));
+  std::vector<double> codes = read_on_grid(g, p["raster"].get<std::string>(), p.value("band", 1));
+  report(g, 0.9);
+  return codes;
 }
 
 int density(const TerrapolisGrid* g, const char* params, float* factor, uint8_t* excluded, char* error, size_t size) {
@@ -91,8 +93,8 @@ int density(const TerrapolisGrid* g, const char* params, float* factor, uint8_t*
     const std::vector<double> codes = codes_on_grid(*g, p);
     for (std::size_t i = 0; i < codes.size(); ++i) {
       const Effect& e = table(codes[i]);
-      factor[i] = e.density ? float(*e.density) : 0.0f;
-      if (!e.density) excluded[i] = 1;
+      factor[i] = float(e.density);
+      if (e.excluded) excluded[i] = 1;
     }
   });
 }

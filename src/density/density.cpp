@@ -377,7 +377,7 @@ DensityResult compute_density(const Dem& dem, const Raster<float>& hydrometry, c
     for (const auto& f : options.factors) weights.push_back(f.weight);
     const std::size_t first_factor = 4 + layers.size();
     for_rows(rows, step, [&](int r0, int r1) {
-      std::vector<double> values(weights.size());
+      std::vector<double> values(weights.size()), cell_weights(weights);
       for (int r = r0; r < r1; ++r)
         for (int x = 0; x < cols; ++x) {
           const std::size_t i = dem.index(x, r);
@@ -391,11 +391,15 @@ DensityResult compute_density(const Dem& dem, const Raster<float>& hydrometry, c
           values[2] = result.plateau[i];
           values[3] = result.plain[i];
           for (std::size_t l = 0; l < layers.size(); ++l) values[4 + l] = layers[l][i];
+          // A factor with no value here (NaN) takes no part in this cell's combination.
+          bool any = false;
           for (std::size_t f = 0; f < options.factors.size(); ++f) {
             const float v = options.factors[f].values[i];
             values[first_factor + f] = std::isnan(v) ? 0.0 : std::clamp(double(v), 0.0, 1.0);
+            cell_weights[first_factor + f] = std::isnan(v) ? 0.0 : weights[first_factor + f];
           }
-          result.density[i] = float(combine(weights.data(), values.data(), weights.size()));
+          for (std::size_t k = 0; k < cell_weights.size() && !any; ++k) any = cell_weights[k] != 0;
+          result.density[i] = any ? float(combine(cell_weights.data(), values.data(), cell_weights.size())) : 0.0f;
         }
     });
   }

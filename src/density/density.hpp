@@ -60,8 +60,9 @@ struct DensityOptions {
   std::vector<std::string> exclusions;
 
   // ---- pre-computed factors (plugins) --------------------------------------------------------
-  /// A factor already on the DEM's grid, values in [0,1] (NaN reads as 0), with its weight: it
-  /// enters the combination exactly like a user layer.
+  /// A factor already on the DEM's grid, values in [0,1], with its weight: it enters the
+  /// combination exactly like a user layer, except that a NaN cell takes no part in that cell's
+  /// combination (the factor has no opinion there; a cell where every weight is then 0 gets 0).
   struct Factor {
     std::string name;
     Raster<float> values;

@@ -115,6 +115,29 @@ struct GridView {
 
 std::string where(const LoadedPlugin& p) { return "plugin " + p.spec.id + " (" + p.file + ")"; }
 
+/// Forwards a plugin's progress to a Progress sink; remembers a cancel (exceptions must not cross the C ABI).
+struct ProgressBridge {
+  Progress& progress;
+  bool cancelled = false;
+  static int report(void* context, double fraction) {
+    auto* self = static_cast<ProgressBridge*>(context);
+    if (!self->progress.update(fraction)) self->cancelled = true;
+    return self->cancelled ? 0 : 1;
+  }
+  /// Runs one plugin call with the bridge installed in `grid`; throws on cancel or failure.
+  template <class F>
+  void call(TerrapolisGrid& grid, const LoadedPlugin& p, const char* what, F&& fn) {
+    grid.progress = &ProgressBridge::report;
+    grid.progress_context = this;
+    std::vector<char> error(1024, '\0');
+    const int status = fn(error.data(), error.size());
+    grid.progress = nullptr;
+    grid.progress_context = nullptr;
+    if (cancelled) throw Error(ErrorKind::cancelled, "cancelled");
+    if (status != 0) throw bad_input(where(p) + ": " + (error[0] ? std::string(error.data()) : std::string(what) + " failed"));
+  }
+};
+
 }  // namespace
 
 std::string LoadedPlugin::description() const { return api && api->description ? api->description : ""; }
@@ -286,7 +309,7 @@ PluginSet load_plugins(const json& list, const Log& log) { return load_plugins(p
 
 std::vector<DensityFactor> density_factors(const PluginSet& set, const Dem& dem, Progress& progress, const Log& log) {
   std::vector<DensityFactor> out;
-  const GridView view(dem);
+  GridView view(dem);
   for (const LoadedPlugin& p : set) {
     if (!p.has_density_factor()) {
       log.detail("plugin " + p.spec.id + ": no density factor");
@@ -298,10 +321,11 @@ std::vector<DensityFactor> density_factors(const PluginSet& set, const Dem& dem,
     f.weight = p.spec.weight;
     f.factor = dem.like<float>(std::numeric_limits<float>::quiet_NaN());
     Raster<std::uint8_t> excluded = dem.like<std::uint8_t>(0);
-    std::vector<char> error(1024, '\0');
     const std::string params = p.spec.params.dump();
-    if (p.api->density_factor(&view.grid, params.c_str(), f.factor.values().data(), excluded.values().data(), error.data(), error.size()) != 0)
-      throw bad_input(where(p) + ": " + (error[0] ? std::string(error.data()) : std::string("density factor failed")));
+    ProgressBridge bridge{progress};
+    bridge.call(view.grid, p, "density factor", [&](char* error, std::size_t size) {
+      return p.api->density_factor(&view.grid, params.c_str(), f.factor.values().data(), excluded.values().data(), error, size);
+    });
     for (float& v : f.factor.values())
       if (!std::isnan(v)) v = std::clamp(v, 0.0f, 1.0f);
     bool any = false;
@@ -325,7 +349,7 @@ void add_to_density(std::vector<DensityFactor> factors, density::DensityOptions&
 
 std::vector<RoadTerm> road_terms(const PluginSet& set, const Dem& dem, Progress& progress, const Log& log) {
   std::vector<RoadTerm> out;
-  const GridView view(dem);
+  GridView view(dem);
   for (const LoadedPlugin& p : set) {
     if (!p.has_road_cost()) {
       log.detail("plugin " + p.spec.id + ": no road cost term");
@@ -335,11 +359,12 @@ std::vector<RoadTerm> road_terms(const PluginSet& set, const Dem& dem, Progress&
     RoadTerm t;
     t.id = p.spec.id;
     t.characteristic = dem.like<float>(std::numeric_limits<float>::quiet_NaN());
-    std::vector<char> error(1024, '\0'), transfer(1 << 16, '\0');
+    std::vector<char> transfer(1 << 16, '\0');
     const std::string params = p.spec.params.dump();
-    if (p.api->road_cost(&view.grid, params.c_str(), t.characteristic.values().data(), transfer.data(), transfer.size(), error.data(),
-                         error.size()) != 0)
-      throw bad_input(where(p) + ": " + (error[0] ? std::string(error.data()) : std::string("road cost failed")));
+    ProgressBridge bridge{progress};
+    bridge.call(view.grid, p, "road cost", [&](char* error, std::size_t size) {
+      return p.api->road_cost(&view.grid, params.c_str(), t.characteristic.values().data(), transfer.data(), transfer.size(), error, size);
+    });
     transfer.back() = '\0';
     const std::string origin = where(p) + ": transfer functions";
     json j;

@@ -69,7 +69,7 @@ PluginSet load_plugins(const nlohmann::json& list, const Log& log);
 /// A plugin's density factor on the DEM's grid.
 struct DensityFactor {
   std::string id;
-  Raster<float> factor;                        ///< [0,1], NaN read as 0
+  Raster<float> factor;                        ///< [0,1], NaN = no opinion at that cell
   double weight = 1;
   std::optional<Raster<std::uint8_t>> excluded; ///< 1 = uninhabitable; absent when the plugin excluded nothing
 };

@@ -30,10 +30,15 @@ typedef struct TerrapolisGrid {
   const float* elevation;      /**< cols*rows elevations in metres, NaN = no data */
   const double* cell_width_m;  /**< rows entries: east-west distance between cell centres of row r, metres (geodesic) */
   const double* cell_height_m; /**< rows entries: north-south distance between centres of rows r and r+1, metres (last row: r-1..r) */
+  /** Reports the fraction (0..1) of the call done, from the calling thread only. Returns 0 when
+   *  the user cancelled: the plugin should then return non-zero soon (its message is ignored). */
+  int (*progress)(void* progress_context, double fraction);
+  void* progress_context;
 } TerrapolisGrid;
 
 /** Computes a density factor. Writes cols*rows values in [0,1] to `factor` (1 = most attractive;
- *  NaN reads as 0) and may set cells of `excluded` (cols*rows, all 0 on entry) to 1 to make them
+ *  NaN, the value on entry, = no opinion: the factor takes no part in that cell's weighted
+ *  combination) and may set cells of `excluded` (cols*rows, all 0 on entry) to 1 to make them
  *  uninhabitable. `params_json` is the plugin's parameter object, validated against its schema,
  *  printed compactly (no whitespace, keys sorted; defaults are not filled in). On failure returns
  *  non-zero and writes a one-line message (no trailing newline) to `error` (size `error_size`). */

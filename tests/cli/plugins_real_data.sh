@@ -57,6 +57,11 @@ col, row = int((9.37 - gt[0]) / gt[1]), int((42.69 - gt[3]) / gt[5])
 assert a[row, col] == 0, "a cell inside the reserve is buildable"
 base = gdal.Open("base/buildable.tif").ReadAsArray()
 assert base[row, col] == 1 and (a == 1).sum() < (base == 1).sum()
+# Without a curve the plugin only excludes: elsewhere the density hardly moves (the characteristics
+# are divided by their maximum over habitable land, which the reserve may have held).
+dens, base_dens = gdal.Open("protected/density.tif").ReadAsArray(), gdal.Open("base/density.tif").ReadAsArray()
+both = (a == 1) & (base == 1)
+assert abs(dens[both] - base_dens[both]).max() < 0.05, abs(dens[both] - base_dens[both]).max()
 PY
 
 # ---- land cover: a raster in another CRS, classes mapped to attractiveness and road cost -------

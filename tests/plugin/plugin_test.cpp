@@ -9,7 +9,9 @@
 #include "../../plugins/distance/distance_transform.hpp"
 #include "core/error.hpp"
 #include "density/density.hpp"
+#include "io/crs.hpp"
 #include "io/raster_io.hpp"
+#include "core/geodesy.hpp"
 #include "plugin/plugin.hpp"
 #include "support/temp_dir.hpp"
 
@@ -135,6 +137,24 @@ TEST(Plugin, DensityFactorMovesDensityAsItsWeightSays) {
   }
 }
 
+TEST(Plugin, NanFactorCellsTakeNoPartInTheCombination) {
+  const Dem dem = read_dem(test::sample("gebco2022_15s_north_corsica_capcorse.asc"));
+  SilentProgress progress;
+  const auto base = density::compute_density(dem, dem.like<float>(0.0f), density::DensityOptions{}, progress);
+  density::DensityOptions o;
+  Raster<float> factor = dem.like<float>(std::numeric_limits<float>::quiet_NaN());
+  for (int r = 0; r < dem.rows(); ++r)
+    for (int c = 0; c < dem.cols() / 2; ++c) factor(c, r) = 0.9f;  // an opinion on the west half only
+  o.factors.push_back({"half", factor, 2.0});
+  const auto with = density::compute_density(dem, dem.like<float>(0.0f), o, progress);
+  for (int r = 0; r < dem.rows(); ++r)
+    for (int c = 0; c < dem.cols(); ++c) {
+      if (base.buildable(c, r) != 1) continue;
+      const double expected = c < dem.cols() / 2 ? (3.5 * base.density(c, r) + 2 * 0.9) / 5.5 : base.density(c, r);
+      ASSERT_NEAR(with.density(c, r), expected, 1e-5) << c << "," << r;
+    }
+}
+
 TEST(Plugin, DensityExclusionsMakeCellsUninhabitable) {
   const Dem dem = read_dem(test::sample("gebco2022_15s_north_corsica_capcorse.asc"));
   const auto r = corsica_density(dem, 1, 0.5, 300.0);
@@ -179,6 +199,45 @@ TEST(Plugin, CostLayersSumTheirTransferFunctions) {
   EXPECT_EQ(terrain.extra_cost_at(roads::Structure::road, 1, 0), 6.0f);  // 3 + 3
   EXPECT_EQ(terrain.extra_cost_at(roads::Structure::road, 2, 0), 0.0f);  // NaN costs nothing
   EXPECT_EQ(terrain.extra_cost_at(roads::Structure::bridge, 1, 0), 0.0f);
+}
+
+/// Cancels at the first update.
+class CancellingProgress final : public Progress {
+ public:
+  void begin(std::string_view) override {}
+  bool update(double) override { return false; }
+  void end() override {}
+};
+
+TEST(Plugin, DistancePluginOnCorsicaAndCancel) {
+  const Dem dem = read_dem(test::sample("gebco2022_15s_north_corsica_capcorse.asc"));
+  test::TempDir dir;
+  {
+    std::ofstream(dir.file("point.geojson"))
+        << R"({"type":"FeatureCollection","features":[{"type":"Feature","properties":{},"geometry":{"type":"Point","coordinates":[9.2,42.8]}}]})";
+  }
+  const json list = json::array({{{"id", "distance"},
+                                  {"params", {{"vector", dir.file("point.geojson")}, {"density", {{"points", {{0, 1}, {10000, 0}}}}}}}}});
+  const auto set = plugin::load_plugins(list, Log(LogLevel::quiet));
+  SilentProgress progress;
+  const auto factors = plugin::density_factors(set, dem, progress, Log(LogLevel::quiet));
+  ASSERT_EQ(factors.size(), 1u);
+  // The point's cell has factor 1; the factor falls by 1 per 10 km: check against geodesic distances.
+  const GridLocator locator(dem.georef());
+  for (int r = 0; r < dem.rows(); r += 7)
+    for (int c = 0; c < dem.cols(); c += 7) {
+      const auto ll = locator.cell_lonlat(c, r);
+      const double d = geodesic_distance_m(dem.georef().crs.ellipsoid, ll[0], ll[1], 9.2, 42.8);
+      // Raster distance between cell centres: within one cell diagonal (~600 m) plus 0.2 %.
+      ASSERT_NEAR(factors[0].factor(c, r), std::clamp(1 - d / 10000, 0.0, 1.0), (600 + 0.002 * d) / 10000) << c << "," << r;
+    }
+  CancellingProgress cancel;
+  try {
+    plugin::density_factors(set, dem, cancel, Log(LogLevel::quiet));
+    FAIL() << "not cancelled";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::cancelled);
+  }
 }
 
 /// Brute-force distance under the same metric model as the transform.
