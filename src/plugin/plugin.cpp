@@ -10,7 +10,9 @@
 #include <valijson/validator.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <limits>
 #include <fstream>
@@ -126,7 +128,8 @@ struct ProgressBridge {
   }
   /// Runs one plugin call with the bridge installed in `grid`; throws on cancel or failure.
   template <class F>
-  void call(TerrapolisGrid& grid, const LoadedPlugin& p, const char* what, F&& fn) {
+  void call(TerrapolisGrid& grid, const LoadedPlugin& p, const char* what, const Log& log, F&& fn) {
+    const auto t0 = std::chrono::steady_clock::now();
     grid.progress = &ProgressBridge::report;
     grid.progress_context = this;
     std::vector<char> error(1024, '\0');
@@ -135,6 +138,9 @@ struct ProgressBridge {
     grid.progress_context = nullptr;
     if (cancelled) throw Error(ErrorKind::cancelled, "cancelled");
     if (status != 0) throw bad_input(where(p) + ": " + (error[0] ? std::string(error.data()) : std::string(what) + " failed"));
+    char line[128];
+    std::snprintf(line, sizeof line, ": %s in %.3f s", what, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    log.detail("plugin " + p.spec.id + line);
   }
 };
 
@@ -323,7 +329,7 @@ std::vector<DensityFactor> density_factors(const PluginSet& set, const Dem& dem,
     Raster<std::uint8_t> excluded = dem.like<std::uint8_t>(0);
     const std::string params = p.spec.params.dump();
     ProgressBridge bridge{progress};
-    bridge.call(view.grid, p, "density factor", [&](char* error, std::size_t size) {
+    bridge.call(view.grid, p, "density factor", log, [&](char* error, std::size_t size) {
       return p.api->density_factor(&view.grid, params.c_str(), f.factor.values().data(), excluded.values().data(), error, size);
     });
     for (float& v : f.factor.values())
@@ -362,7 +368,7 @@ std::vector<RoadTerm> road_terms(const PluginSet& set, const Dem& dem, Progress&
     std::vector<char> transfer(1 << 16, '\0');
     const std::string params = p.spec.params.dump();
     ProgressBridge bridge{progress};
-    bridge.call(view.grid, p, "road cost", [&](char* error, std::size_t size) {
+    bridge.call(view.grid, p, "road cost", log, [&](char* error, std::size_t size) {
       return p.api->road_cost(&view.grid, params.c_str(), t.characteristic.values().data(), transfer.data(), transfer.size(), error, size);
     });
     transfer.back() = '\0';
