@@ -25,7 +25,7 @@ const char* const kSchema = R"json({
               "items": {"type": "array", "minItems": 2, "maxItems": 2, "items": {"type": "number"}}}
   },
   "properties": {
-    "vector": {"type": "string", "description": "vector file (any OGR format with a CRS): roads, stations, protected-area polygons..."},
+    "vector": {"type": "string", "format": "path", "description": "vector file (any OGR format with a CRS): roads, stations, protected-area polygons..."},
     "layer": {"type": "string", "description": "layer name (default: the first layer)"},
     "where": {"type": "string", "description": "OGR SQL attribute filter, e.g. \"class = 'motorway'\""},
     "density": {

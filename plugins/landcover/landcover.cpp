@@ -23,7 +23,7 @@ const char* const kSchema = R"json({
                   "oneOf": [{"type": "number", "minimum": 0}, {"enum": ["forbidden"]}]}
   },
   "properties": {
-    "raster": {"type": "string", "description": "land-cover raster (any GDAL raster with a CRS), resampled nearest onto the DEM grid"},
+    "raster": {"type": "string", "format": "path", "description": "land-cover raster (any GDAL raster with a CRS), resampled nearest onto the DEM grid"},
     "band": {"type": "integer", "minimum": 1, "default": 1},
     "classes": {
       "type": "array", "minItems": 1,

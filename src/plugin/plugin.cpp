@@ -150,7 +150,7 @@ std::string LoadedPlugin::description() const { return api && api->description ?
 bool LoadedPlugin::has_density_factor() const { return api && api->density_factor; }
 bool LoadedPlugin::has_road_cost() const { return api && api->road_cost; }
 
-std::vector<PluginSpec> parse_plugin_list(const json& list, const std::string& origin) {
+std::vector<PluginSpec> parse_plugin_list(const json& list, const std::string& origin, const std::string& base_dir) {
   if (!list.is_array()) throw bad_input(origin + ": expected an array of {\"id\", \"weight\", \"params\"} objects");
   std::vector<PluginSpec> specs;
   for (std::size_t k = 0; k < list.size(); ++k) {
@@ -158,6 +158,7 @@ std::vector<PluginSpec> parse_plugin_list(const json& list, const std::string& o
     const std::string at = origin + "/" + std::to_string(k);
     if (!e.is_object()) throw bad_input(at + ": expected an object {\"id\", \"weight\", \"params\"}");
     PluginSpec s;
+    s.base_dir = base_dir;
     for (auto it = e.begin(); it != e.end(); ++it) {
       if (it.key() == "id") {
         if (!it->is_string()) throw bad_input(at + "/id: expected a string");
@@ -204,6 +205,7 @@ PluginSpec parse_plugin_option(const std::string& text) {
     ss << in.rdbuf();
     body = ss.str();
     origin = rest;
+    s.base_dir = fs::path(rest).parent_path().string();
   }
   try {
     s.params = json::parse(body);
@@ -304,6 +306,15 @@ PluginSet load_plugins(const std::vector<PluginSpec>& specs, const Log& log) {
     LoadedPlugin p = open_plugin(find_plugin(spec.id));
     if (p.spec.id != spec.id) throw bad_input(p.file + ": declares id '" + p.spec.id + "', expected '" + spec.id + "'");
     p.spec = spec;
+    // Relative paths (top-level string parameters declared "format": "path") from base_dir.
+    const json& properties = p.library->schema.contains("properties") ? p.library->schema["properties"] : json::object();
+    if (!spec.base_dir.empty() && properties.is_object())
+      for (auto it = p.spec.params.begin(); it != p.spec.params.end(); ++it) {
+        const auto prop = properties.find(it.key());
+        if (prop == properties.end() || !prop->is_object() || prop->value("format", "") != "path" || !it->is_string()) continue;
+        const fs::path path(it->get<std::string>());
+        if (path.is_relative()) *it = (fs::path(spec.base_dir) / path).lexically_normal().string();
+      }
     validate_params(p, p.spec.params);
     log.detail("plugin " + spec.id + ": " + p.file + " (" + p.description() + ")");
     set.push_back(std::move(p));
@@ -311,7 +322,9 @@ PluginSet load_plugins(const std::vector<PluginSpec>& specs, const Log& log) {
   return set;
 }
 
-PluginSet load_plugins(const json& list, const Log& log) { return load_plugins(parse_plugin_list(list, "plugins"), log); }
+PluginSet load_plugins(const json& list, const Log& log, const std::string& base_dir) {
+  return load_plugins(parse_plugin_list(list, "plugins", base_dir), log);
+}
 
 std::vector<DensityFactor> density_factors(const PluginSet& set, const Dem& dem, Progress& progress, const Log& log) {
   std::vector<DensityFactor> out;

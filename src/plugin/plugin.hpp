@@ -26,13 +26,18 @@ struct PluginSpec {
   std::string id;
   double weight = 1;
   nlohmann::json params = nlohmann::json::object();
+  /// Folder that relative paths in the parameters are relative to (the parameter file's or the
+  /// scenario's; empty = the current folder). Paths are the top-level string parameters whose
+  /// schema says "format": "path"; load_plugins makes them absolute before validation.
+  std::string base_dir;
 };
 
 /// Parses a JSON list of specs [{"id": ..., "weight": ..., "params": {...}}, ...]; `origin`
-/// names the list in errors. Throws bad_input.
-std::vector<PluginSpec> parse_plugin_list(const nlohmann::json& list, const std::string& origin);
-/// Parses the command-line form ID[:WEIGHT][:PARAMS] where PARAMS is a JSON file or an inline
-/// JSON object ("{...}"). Throws bad_input naming --plugin.
+/// names the list in errors, `base_dir` goes to every spec. Throws bad_input.
+std::vector<PluginSpec> parse_plugin_list(const nlohmann::json& list, const std::string& origin, const std::string& base_dir = "");
+/// Parses the command-line form ID[:WEIGHT][:PARAMS] where PARAMS is a JSON file (relative paths
+/// inside are relative to its folder) or an inline JSON object ("{...}", relative to the current
+/// folder). Throws bad_input naming --plugin.
 PluginSpec parse_plugin_option(const std::string& text);
 
 /// A shared library opened with dlopen and checked (ABI version, entry point, schema).
@@ -63,8 +68,9 @@ void validate_params(const LoadedPlugin& plugin, const nlohmann::json& params);
 
 /// Finds, opens, checks every plugin of the list and validates its parameters.
 PluginSet load_plugins(const std::vector<PluginSpec>& specs, const Log& log);
-/// Same from the JSON list form (a scenario's "plugins" array).
-PluginSet load_plugins(const nlohmann::json& list, const Log& log);
+/// Same from the JSON list form (a scenario's "plugins" array; relative paths in the parameters
+/// are relative to `base_dir`, e.g. the scenario's folder).
+PluginSet load_plugins(const nlohmann::json& list, const Log& log, const std::string& base_dir = "");
 
 /// A plugin's density factor on the DEM's grid.
 struct DensityFactor {

@@ -91,9 +91,18 @@ TEST(Plugin, ParsesTheCommandLineForm) {
   s = plugin::parse_plugin_option("example:0:" + dir.file("p.json"));
   EXPECT_EQ(s.weight, 0);
   EXPECT_EQ(s.params["value"], 0.3);
+  EXPECT_EQ(fs::path(s.base_dir), dir.path());
   EXPECT_NE(bad_input_of([] { plugin::parse_plugin_option("Bad-Id"); }).find("--plugin Bad-Id"), std::string::npos);
   EXPECT_NE(bad_input_of([] { plugin::parse_plugin_option("example:nofile.json"); }).find("nofile.json: no such parameter file"), std::string::npos);
   EXPECT_NE(bad_input_of([] { plugin::parse_plugin_option("example:{oops"); }).find("not valid JSON"), std::string::npos);
+}
+
+TEST(Plugin, RelativePathsAreResolvedFromTheBaseFolder) {
+  const json list = json::parse(R"([{"id": "distance", "params": {"vector": "layers/roads.geojson", "where": "a = 'b'"}}])");
+  const auto set = plugin::load_plugins(list, Log(LogLevel::quiet), "/data/scenario");
+  EXPECT_EQ(set[0].spec.params["vector"], "/data/scenario/layers/roads.geojson");
+  EXPECT_EQ(set[0].spec.params["where"], "a = 'b'");  // not a path
+  EXPECT_EQ(plugin::load_plugins(list, Log(LogLevel::quiet))[0].spec.params["vector"], "layers/roads.geojson");
 }
 
 /// The density of the Corsica sample with the example plugin's constant factor `value` at `weight`.
