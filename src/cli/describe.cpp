@@ -94,7 +94,7 @@ ordered_json describe_option(CLI::Option& o) {
     j["default"] = items;
   }
   // Validators print as "{a,b}" (IsMember), "INT in [1 - 16]" (Range), "NONNEGATIVE", "POSITIVE".
-  static const std::regex set_re(R"(\{([^}]*)\})"), range_re(R"(\[\s*([-+0-9.eE]+)\s*-\s*([-+0-9.eE]+)\s*\])");
+  const std::regex set_re(R"(\{([^}]*)\})"), range_re(R"(\[\s*([-+0-9.eE]+)\s*-\s*([-+0-9.eE]+)\s*\])");
   std::smatch m;
   std::string validators = full.find(':') == std::string::npos ? "" : full.substr(full.find(':') + 1);
   if (std::regex_search(validators, m, set_re)) {

@@ -16,7 +16,6 @@
 #include <cstdlib>
 #include <limits>
 #include <fstream>
-#include <regex>
 #include <sstream>
 
 #include "core/error.hpp"
@@ -46,9 +45,9 @@ class Library {
 
 namespace {
 
-const std::regex& id_pattern() {
-  static const std::regex re("^[a-z0-9_]+$");
-  return re;
+/// Plugin ids: lower-case letters, digits, underscores (they name files).
+bool valid_id(const std::string& id) {
+  return !id.empty() && std::all_of(id.begin(), id.end(), [](char c) { return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_'; });
 }
 
 std::string pointer_of(const std::vector<std::string>& context) {
@@ -173,7 +172,7 @@ std::vector<PluginSpec> parse_plugin_list(const json& list, const std::string& o
         throw bad_input(at + "/" + it.key() + ": unknown key (expected id, weight, params)");
       }
     }
-    if (!std::regex_match(s.id, id_pattern())) throw bad_input(at + "/id: '" + s.id + "' is not a plugin id ([a-z0-9_]+)");
+    if (!valid_id(s.id)) throw bad_input(at + "/id: '" + s.id + "' is not a plugin id ([a-z0-9_]+)");
     specs.push_back(std::move(s));
   }
   return specs;
@@ -184,7 +183,7 @@ PluginSpec parse_plugin_option(const std::string& text) {
   PluginSpec s;
   const auto colon = text.find(':');
   s.id = text.substr(0, colon);
-  if (!std::regex_match(s.id, id_pattern())) throw bad_input(option + ": expected ID[:WEIGHT][:PARAMS] with ID made of [a-z0-9_]");
+  if (!valid_id(s.id)) throw bad_input(option + ": expected ID[:WEIGHT][:PARAMS] with ID made of [a-z0-9_]");
   if (colon == std::string::npos) return s;
   std::string rest = text.substr(colon + 1);
   const auto next = rest.find(':');
@@ -264,7 +263,7 @@ LoadedPlugin open_plugin(const fs::path& file) {
     throw bad_input(name + ": plugin ABI version " + std::to_string(api->abi_version) + ", this Terrapolis needs version " +
                     std::to_string(TERRAPOLIS_PLUGIN_ABI_VERSION) + " (rebuild the plugin)");
   const std::string id = api->id ? api->id : "";
-  if (!std::regex_match(id, id_pattern())) throw bad_input(name + ": plugin id '" + id + "' is not made of [a-z0-9_]");
+  if (!valid_id(id)) throw bad_input(name + ": plugin id '" + id + "' is not made of [a-z0-9_]");
   if (!api->density_factor && !api->road_cost) throw bad_input(name + ": plugin " + id + " provides neither a density factor nor a road cost");
   try {
     library->schema = json::parse(api->parameter_schema ? api->parameter_schema : "");
