@@ -64,6 +64,31 @@ both = (a == 1) & (base == 1)
 assert abs(dens[both] - base_dens[both]).max() < 0.05, abs(dens[both] - base_dens[both]).max()
 PY
 
+# `roads` takes the same term: a one-link network across the reserve is laid round it.
+mkdir net
+cat > net/network.geojson <<'JSON'
+{"type": "FeatureCollection", "features": [
+{"type": "Feature", "properties": {"from": 0, "to": 1, "kind": "roots", "kept": 1, "length_m": 10000, "detour_ratio": null},
+ "geometry": {"type": "LineString", "coordinates": [[9.30, 42.68], [9.42, 42.70]]}}]}
+JSON
+cat > net/cities.geojson <<'JSON'
+{"type": "FeatureCollection", "features": [
+{"type": "Feature", "properties": {"id": 0, "radius_m": 900, "class": 0, "population": 40000, "density": 300, "parent": null, "depth": 0}, "geometry": {"type": "Point", "coordinates": [9.30, 42.68]}},
+{"type": "Feature", "properties": {"id": 1, "radius_m": 700, "class": 1, "population": 20000, "density": 200, "parent": 0, "depth": 1}, "geometry": {"type": "Point", "coordinates": [9.42, 42.70]}}]}
+JSON
+"$TP" -q roads "$DEM" net/network.geojson roads_out --plugin "distance:$PROTECT"
+$PY - <<'PY' || fail "roads with a protected area"
+from osgeo import ogr
+ds, rs = ogr.Open("protected.geojson"), ogr.Open("roads_out/roads.geojson")
+feature = ds.GetLayer(0).GetNextFeature()  # kept alive while its geometry is used
+reserve = feature.GetGeometryRef().Clone()
+count = 0
+for f in rs.GetLayer(0):
+    count += 1
+    assert not f.GetGeometryRef().Intersects(reserve), "a road of `roads` enters the reserve"
+assert count >= 1
+PY
+
 # ---- land cover: a raster in another CRS, classes mapped to attractiveness and road cost -------
 $PY - <<'PY' || fail "could not write the land-cover raster"
 from osgeo import gdal, osr
