@@ -136,6 +136,8 @@ struct ProgressBridge {
     grid.progress = nullptr;
     grid.progress_context = nullptr;
     if (cancelled) throw Error(ErrorKind::cancelled, "cancelled");
+    error.back() = '\0';  // messages stay one terminated line whatever the plugin wrote
+    std::replace_if(error.begin(), error.end(), [](char c) { return c == '\n' || c == '\r'; }, ' ');
     if (status != 0) throw bad_input(where(p) + ": " + (error[0] ? std::string(error.data()) : std::string(what) + " failed"));
     char line[128];
     std::snprintf(line, sizeof line, ": %s in %.3f s", what, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
