@@ -282,14 +282,14 @@ LoadedPlugin open_plugin(const fs::path& file) {
   LoadedPlugin p;
   p.spec.id = id;
   p.file = name;
-  p.library = library;
+  p.module = library;
   p.api = api;
   return p;
 }
 
 void validate_params(const LoadedPlugin& plugin, const json& params) {
   valijson::Schema schema;
-  parse_schema(plugin.library->schema, schema);
+  parse_schema(plugin.module->schema, schema);
   valijson::Validator validator;
   valijson::ValidationResults results;
   valijson::adapters::NlohmannJsonAdapter target(params);
@@ -308,7 +308,7 @@ PluginSet load_plugins(const std::vector<PluginSpec>& specs, const Log& log) {
     if (p.spec.id != spec.id) throw bad_input(p.file + ": declares id '" + p.spec.id + "', expected '" + spec.id + "'");
     p.spec = spec;
     // Relative paths (top-level string parameters declared "format": "path") from base_dir.
-    const json& properties = p.library->schema.contains("properties") ? p.library->schema["properties"] : json::object();
+    const json& properties = p.module->schema.contains("properties") ? p.module->schema["properties"] : json::object();
     if (!spec.base_dir.empty() && properties.is_object())
       for (auto it = p.spec.params.begin(); it != p.spec.params.end(); ++it) {
         const auto prop = properties.find(it.key());

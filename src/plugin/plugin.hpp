@@ -47,7 +47,7 @@ class Library;
 struct LoadedPlugin {
   PluginSpec spec;
   std::string file;                   ///< the library's path
-  std::shared_ptr<const Library> library;
+  std::shared_ptr<const Library> module;  ///< keeps the shared library loaded
   const TerrapolisPlugin* api = nullptr;
   std::string description() const;
   bool has_density_factor() const;

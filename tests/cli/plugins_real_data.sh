@@ -27,6 +27,10 @@ assert dens[on].min() > 0.996, dens[on].min()
 # Far from every stream (> 3 km: at least 3 cells of 15" away in both axes) the factor is 0.
 assert dens[ok & ~on].min() < 0.01
 PY
+# Same bytes whatever the thread count.
+"$TP" -q --threads 1 density "$DEM" near1 --hydrometry hydro/hydrometry.tif \
+  --plugin 'distance:1000:{"vector":"hydro/streams.geojson","density":{"points":[[0,1],[3000,0]]}}'
+for f in density buildable; do cmp -s near/$f.tif near1/$f.tif || fail "$f.tif differs with 1 thread"; done
 # Weight 0 changes nothing.
 "$TP" -q density "$DEM" zero --hydrometry hydro/hydrometry.tif --plugin 'distance:0:{"vector":"hydro/streams.geojson","density":{"points":[[0,1]]}}'
 $PY -c "
