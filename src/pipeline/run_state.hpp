@@ -13,6 +13,7 @@
 #include "io/raster_io.hpp"
 #include "io/vector_io.hpp"
 #include "pipeline/scenario.hpp"
+#include "plugin/plugin.hpp"
 #include "sites/sites.hpp"
 
 namespace terrapolis::pipeline {
@@ -43,6 +44,7 @@ struct RunState {
   std::filesystem::path folder;  ///< the run folder being written (a temporary name until the end)
   std::string dem_sha256;
   Dem dem;
+  plugin::PluginSet plugins;  ///< the scenario's plugins, loaded and checked before any work
   // Typed results of the stages, filled in data-flow order.
   std::optional<Raster<float>> hydrometry;        ///< hydro: [0,1]
   std::optional<Raster<float>> density;           ///< density: [0,1]

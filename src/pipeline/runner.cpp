@@ -138,6 +138,8 @@ json run_scenario(const Scenario& scenario, const RunOptions& options, Progress&
 
   Dem dem = read_dem(dem_path, read);  // before creating anything: bad input leaves no folder
   const std::string dem_sha256 = file_sha256(dem_path);
+  plugin::PluginSet plugins = plugin::load_plugins(nlohmann::json::parse(scenario.resolved["plugins"].dump()), log,
+                                                   scenario.base_dir.string());
   if (rerun) check_reusable(output, saved, scenario, dem_sha256, plan);
   const fs::path temp = output.string() + ".tmp-" + std::to_string(::getpid());
   fs::remove_all(temp, ec);
@@ -149,6 +151,7 @@ json run_scenario(const Scenario& scenario, const RunOptions& options, Progress&
   if (ec) throw bad_input(output.string() + ": cannot create the run folder (" + ec.message() + ")");
   try {
     RunState state(scenario, temp, dem_sha256, std::move(dem));
+    state.plugins = std::move(plugins);
     json timings = json::array();
     json ran = json::array(), reused = json::array(), stale = json::array();
     for (std::size_t i = 0; i < stages().size(); ++i) {

@@ -146,6 +146,15 @@ Scenario load_scenario(const std::string& file, const std::vector<std::string>& 
   const std::string problem = validate_scenario(doc);
   if (!problem.empty()) throw bad_input(s.source + ": " + problem);
   s.resolved = with_defaults(doc, schema_defaults());
+  // Objects listed in a top-level array (plugins) get their own defaults too.
+  const nlohmann::json schema = nlohmann::json::parse(scenario_schema_text());
+  for (const auto& [key, sub] : schema["properties"].items())
+    if (sub.value("type", "") == "array" && sub.contains("items") && sub["items"].contains("properties")) {
+      const json item_defaults = defaults_of(sub["items"]);
+      for (auto& item : s.resolved[key])
+        for (const auto& [field, value] : item_defaults.items())
+          if (!item.contains(field)) item[field] = value;
+    }
   return s;
 }
 

@@ -88,8 +88,10 @@ void hydro_load(RunState& s) {
 
 // ---- density (Belhadj 2007 §4.2; docs/density.md) -----------------------------------------
 
-void density_run(RunState& s, Progress& progress, const Log&) {
-  density::DensityResult r = density::compute_density(s.dem, *s.hydrometry, density_options(s.scenario), progress);
+void density_run(RunState& s, Progress& progress, const Log& log) {
+  density::DensityOptions options = density_options(s.scenario);
+  plugin::add_to_density(plugin::density_factors(s.plugins, s.dem, progress, log), options);
+  density::DensityResult r = density::compute_density(s.dem, *s.hydrometry, options, progress);
   const std::pair<const char*, const Raster<float>*> characteristics[] = {{"coast", &r.coast}, {"plateau", &r.plateau}, {"plain", &r.plain}};
   for (const auto& [name, raster] : characteristics)
     s.write("density", std::string(name) + ".tif", *raster, density::describe_output(name), Style::unit_ramp);
@@ -179,6 +181,7 @@ void roads_run(RunState& s, Progress& progress, const Log& log) {
                               settings.model.road_radius_m);
   if (!settings.vegetation.empty())
     terrain.set_vegetation(read_resampled(settings.vegetation, s.dem.georef(), s.dem.cols(), s.dem.rows(), Resampling::bilinear));
+  plugin::add_to_terrain(plugin::road_terms(s.plugins, s.dem, progress, log), terrain);
   const roads::RoadGraph graph(terrain, settings.model, settings.routing.graph);
   const roads::NetworkResult r = roads::route_network(terrain, graph, *s.network, &*s.cities, settings.routing, progress);
   for (const auto& f : r.failed) log.warn("no road: " + f);
@@ -207,7 +210,7 @@ const std::vector<StageDef>& stages() {
   static const std::vector<StageDef> list = {
       {"terrain", {"dem", "input"}, terrain_run, terrain_load},
       {"hydro", {"water", "hydro"}, hydro_run, hydro_load},
-      {"density", {"density"}, density_run, density_load},
+      {"density", {"density", "plugins"}, density_run, density_load},
       {"sites", {"sites", "seed"}, sites_run, sites_load},
       {"network", {"network"}, network_run, network_load},
       {"roads", {"roads"}, roads_run, roads_load},

@@ -175,6 +175,7 @@ double RoadGraph::arc_cost(Cell from, int arc) const {
       const double depth = terrain_.depth_at(from.col + dc * (i - 0.5), from.row + dr * (i - 0.5));
       double c = road_slope_cost(std::fabs(z1 - z0) / dl) + veg0 + (depth > 0 ? sc.water_depth_m(depth) : water0);
       if (veg) c += sc.vegetation(terrain_.vegetation_at(from.col + dc * (i - 0.5), from.row + dr * (i - 0.5)));
+      c += terrain_.extra_cost_at(Structure::road, from.col + dc * (i - 0.5), from.row + dr * (i - 0.5));  // cost layers (plugins)
       if (c == kInfinity) return kInfinity;
       total += c * dl;
       z0 = z1;
@@ -205,6 +206,7 @@ double RoadGraph::arc_cost(Cell from, int arc) const {
       c = sc.depth_m(d) + sc.water_depth_m(depth);
       c += sc.vegetation(terrain_.vegetation_at(col, row));
     }
+    c += terrain_.extra_cost_at(a.structure, col, row);  // cost layers (plugins)
     if (c == kInfinity) return kInfinity;
     total += (c + per_m_slope) * dl;
   }
