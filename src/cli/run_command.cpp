@@ -24,8 +24,12 @@ class RunCommand final : public Command {
     app.add_option("--seed", seed_, "Seed of the run (overrides the scenario's)");
     app.add_option("-o,--output", output_, "Run folder (overrides the scenario's)");
     app.add_flag("--overwrite", overwrite_, "Replace the run folder if it exists");
-    app.add_option("--from", from_, "Rerun from this stage on, reading the earlier stages from the saved run folder");
-    app.add_option("--only", only_, "Rerun only these stages (later stages keep their saved, now stale, files)")->expected(1, -1);
+    const std::vector<std::string> stages = pipeline::stage_names();
+    app.add_option("--from", from_, "Rerun from this stage on, reading the earlier stages' results back from the run")
+        ->check(CLI::IsMember(stages));
+    app.add_option("--only", only_, "Rerun only these stages (later stages keep their saved, now stale, results)")
+        ->expected(1, -1)
+        ->check(CLI::IsMember(stages));
     app.add_flag("--print-scenario", print_, "Print the resolved scenario (defaults filled) and exit");
   }
   void run(Context& context) override {

@@ -67,7 +67,7 @@ cmp -s run1/cities.geojson rerun/cities.geojson || fail "--from network rewrote 
 /usr/bin/python3 -c "import json; r=json.load(open('rerun/run.json'))['rerun']; assert r['stale']==['sites','network','roads'], r" || fail "--only"
 cmp -s run1/density.tif rerun/density.tif && fail "--only density did not change density.tif"
 expect_fail 2 "other 'density' parameters; rerun from density" "$TP" run -o rerun --from sites --set density.r_max_m=6000
-expect_fail 2 "unknown stage 'dunes'" "$TP" run -o rerun --from dunes
+expect_fail 2 "dunes" "$TP" run -o rerun --from dunes
 expect_fail 2 "nosuch: no saved run to rerun from" "$TP" run -o nosuch --from roads
 no_leftovers "$WORK"
 echo "rerun: ok"

@@ -21,12 +21,13 @@ from processing.core.Processing import Processing  # noqa: E402 (needs the appli
 Processing.initialize()
 import processing  # noqa: E402
 
+from terrapolis_provider.algorithm import load_layer  # noqa: E402
 from terrapolis_provider.provider import TerrapolisProvider  # noqa: E402
 
 provider = TerrapolisProvider()
 assert QgsApplication.processingRegistry().addProvider(provider), "the provider does not register"
 ids = sorted(a.id() for a in provider.algorithms())
-for name in ("info", "hydro", "density", "sites", "network", "path", "roads", "fill", "generate"):
+for name in ("info", "hydro", "density", "sites", "network", "path", "roads", "fill", "generate", "run"):
     assert "terrapolis:" + name in ids, (name, ids)
 
 # Typed parameters, straight from --describe-json.
@@ -77,6 +78,15 @@ for path_ in layers + [os.path.join(hydro_dir, "streams.geojson")]:
     assert layer.crs().authid() == "EPSG:4326", (path_, layer.crs().authid())
 streams = QgsVectorLayer(os.path.join(hydro_dir, "streams.geojson"), "streams", "ogr")
 assert streams.featureCount() > 10, streams.featureCount()
+
+# The whole pipeline from the toolbox (few cities, so it is quick): the run folder's layers load.
+run_dir = os.path.join(work, "run_from_qgis")
+result = processing.run("terrapolis:run", {"set": "dem=%s\nsites.quota_scale=0.01" % dem, "output": run_dir}, feedback=Recorder())
+run_layers = result["OUTPUT_LAYERS"]
+assert any(p.endswith("roads.geojson") for p in run_layers) and any(p.endswith("density.tif") for p in run_layers), run_layers
+assert os.path.exists(os.path.join(run_dir, "project.qgs")), "no project.qgs in the run folder"
+for path_ in run_layers:
+    assert load_layer(path_).isValid(), path_
 
 # Cancel: the process is killed, the algorithm fails, nothing is written.
 cancelled_dir = os.path.join(work, "cancelled")

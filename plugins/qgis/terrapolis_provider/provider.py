@@ -5,8 +5,8 @@ from qgis.core import QgsMessageLog, QgsProcessingProvider, Qgis
 from . import cli
 from .algorithm import TerrapolisAlgorithm
 
-# Commands whose inputs or outputs a Processing dialog cannot express (a run folder, a comparison).
-SKIPPED = {"run", "compare"}
+# Commands whose result a Processing dialog cannot show (a comparison printed as a table).
+SKIPPED = {"compare"}
 
 
 class TerrapolisProvider(QgsProcessingProvider):
