@@ -3,6 +3,7 @@
 #include "hydro/depressions.hpp"
 
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <functional>
 #include <deque>
@@ -117,85 +118,111 @@ Dem fill_depressions(const Dem& dem, const FillOptions& options, Progress& progr
   return z;
 }
 
-FlatGradient resolve_flats(const Dem& filled, const Raster<std::uint8_t>& d8) {
+void drain_flats(const Dem& filled, Raster<std::uint8_t>& d8) {
+  // Everything works on a grid padded with one cell of "outside" (kind 0, label 0) so that the
+  // waves need no bounds test and no division, and the label and gradient of a cell share one
+  // 8-byte slot: a wave step reads one array. The waves are the breadth-first rings of Barnes
+  // 2014b; each cell's value depends only on its ring distance, not on visiting order.
   const int cols = filled.cols(), rows = filled.rows();
-  FlatGradient out{filled.like<std::int32_t>(0), filled.like<std::int32_t>(0)};
-  auto& mask = out.mask;
-  auto& labels = out.labels;
-  std::vector<std::uint32_t> low, high;
-  // Edges (Barnes 2014b, Algorithm 3): a low edge drains and has a same-elevation undrained
-  // neighbour; a high edge is undrained with a higher neighbour. Only undrained cells and their
-  // neighbours can be edges, so only they are looked at; the waves below depend on the ring
-  // distances only, not on the order of the edges.
-  std::vector<std::uint8_t> is_low(0);
+  const std::size_t width = std::size_t(cols) + 2;
+  const std::size_t padded = width * (std::size_t(rows) + 2);
+  std::ptrdiff_t poff[8], uoff[8];
+  for (int k = 0; k < 8; ++k) {
+    poff[k] = std::ptrdiff_t(drow[k]) * std::ptrdiff_t(width) + dcol[k];
+    uoff[k] = neighbour_offset(cols, k);
+  }
+  // kind: 0 outside, nodata or terminal; 1 draining; 2 undrained (kNoFlow); bit 4: low edge seen.
+  constexpr std::uint8_t kOut = 0, kDrains = 1, kFlat = 2, kLowSeen = 4;
+  BigVector<std::uint8_t> kind(padded, kOut);
   for (int r = 0; r < rows; ++r)
     for (int c = 0; c < cols; ++c) {
-      const std::size_t i = filled.index(c, r);
-      if (d8[i] != kNoFlow) continue;
-      const float zc = filled[i];
+      const std::uint8_t v = d8(c, r);
+      kind[std::size_t(r + 1) * width + std::size_t(c) + 1] =
+          v == kNoData || v == kTerminal ? kOut : v == kNoFlow ? kFlat : kDrains;
+    }
+  auto unpadded = [&](std::size_t p) {
+    const std::size_t r = p / width - 1;
+    return r * std::size_t(cols) + (p - (r + 1) * width - 1);
+  };
+  // Edges (Barnes 2014b, Algorithm 3): a low edge drains and has a same-elevation undrained
+  // neighbour; a high edge is undrained with a higher neighbour.
+  std::vector<std::uint32_t> low, high;  // padded indices
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c) {
+      const std::size_t p = std::size_t(r + 1) * width + std::size_t(c) + 1;
+      if ((kind[p] & 3) != kFlat) continue;
+      const std::size_t u = filled.index(c, r);
+      const float zc = filled[u];
       bool higher = false;
       for (int k = 0; k < 8; ++k) {
-        const int nc = c + dcol[k], nr = r + drow[k];
-        if (!filled.inside(nc, nr)) continue;
-        const std::size_t n = filled.index(nc, nr);
-        const std::uint8_t dn = d8[n];
-        if (dn == kNoData || dn == kTerminal) continue;
-        if (filled[n] > zc) higher = true;
-        if (dn != kNoFlow && filled[n] == zc) {
-          if (is_low.empty()) is_low.assign(filled.size(), 0);
-          if (!is_low[n]) {
-            is_low[n] = 1;
-            low.push_back(std::uint32_t(n));
-          }
+        const std::size_t pn = std::size_t(std::ptrdiff_t(p) + poff[k]);
+        const std::uint8_t kn = kind[pn];
+        if ((kn & 3) == kOut) continue;
+        const float zn = filled[std::size_t(std::ptrdiff_t(u) + uoff[k])];
+        if (zn > zc) higher = true;
+        if ((kn & 3) == kDrains && zn == zc && !(kn & kLowSeen)) {
+          kind[pn] = kn | kLowSeen;
+          low.push_back(std::uint32_t(pn));
         }
       }
-      if (higher) high.push_back(std::uint32_t(i));
+      if (higher) high.push_back(std::uint32_t(p));
     }
-  // Label each flat from its low edges (8-connected cells of equal elevation).
+  if (low.empty()) {  // no flat can drain
+    for (auto& v : d8.values())
+      if (v == kNoFlow) v = kTerminal;
+    return;
+  }
+  // Label each flat from its low edges (8-connected cells of equal elevation): +label on undrained
+  // cells, -label on draining ones, so that a wave step tests membership with one comparison.
+  struct Slot {
+    std::int32_t label;
+    std::int32_t mask;
+  };
+  BigVector<Slot> cell(padded, Slot{0, 0});
   std::int32_t next_label = 1;
-  std::vector<std::uint32_t> stack;
+  std::vector<std::uint64_t> stack;  // padded index << 32 | unpadded index
   for (std::uint32_t seed : low) {
-    if (labels[seed] != 0) continue;
-    const float zf = filled[seed];
-    labels[seed] = next_label;
-    stack.push_back(seed);
+    if (cell[seed].label != 0) continue;
+    const std::size_t useed = unpadded(seed);
+    const float zf = filled[useed];
+    cell[seed].label = -next_label;
+    stack.push_back(std::uint64_t(seed) << 32 | useed);
     while (!stack.empty()) {
-      const std::uint32_t i = stack.back();
+      const std::uint64_t top = stack.back();
       stack.pop_back();
-      const int c = int(i % std::uint32_t(cols)), r = int(i / std::uint32_t(cols));
+      const std::size_t p = std::size_t(top >> 32), u = std::size_t(top & 0xffffffffu);
       for (int k = 0; k < 8; ++k) {
-        const int nc = c + dcol[k], nr = r + drow[k];
-        if (!filled.inside(nc, nr)) continue;
-        const std::size_t n = filled.index(nc, nr);
-        if (labels[n] != 0 || filled[n] != zf || d8[n] == kNoData || d8[n] == kTerminal) continue;
-        labels[n] = next_label;
-        stack.push_back(std::uint32_t(n));
+        const std::size_t pn = std::size_t(std::ptrdiff_t(p) + poff[k]);
+        const std::uint8_t kn = kind[pn] & 3;
+        if (kn == kOut || cell[pn].label != 0) continue;
+        const std::size_t un = std::size_t(std::ptrdiff_t(u) + uoff[k]);
+        if (filled[un] != zf) continue;
+        cell[pn].label = kn == kFlat ? next_label : -next_label;
+        stack.push_back(std::uint64_t(pn) << 32 | un);
       }
     }
     ++next_label;
   }
   std::vector<std::int32_t> flat_height(std::size_t(next_label), 0);
   // Breadth-first wave over undrained cells of the same flat, one ring per loop. A cell is
-  // marked (mask > 0 after `set`) when it is first reached, so each is queued once; its value
-  // depends only on its ring, as in Barnes's algorithm where duplicates are skipped when popped.
+  // marked (mask > 0 after `set`) when it is first reached, so each is queued once.
   auto wave = [&](const std::vector<std::uint32_t>& seeds, auto&& set) {
     std::vector<std::uint32_t> front, next;
-    for (std::uint32_t i : seeds)
-      if (mask[i] <= 0) {
-        set(i, 1);
-        front.push_back(i);
+    for (std::uint32_t p : seeds)
+      if (cell[p].mask <= 0) {
+        set(p, 1);
+        front.push_back(p);
       }
     for (std::int32_t loops = 2; !front.empty(); ++loops) {
       next.clear();
-      for (std::uint32_t i : front) {
-        const int c = int(i % std::uint32_t(cols)), r = int(i / std::uint32_t(cols));
+      for (std::uint32_t p : front) {
+        const std::int32_t label = std::abs(cell[p].label);
         for (int k = 0; k < 8; ++k) {
-          const int nc = c + dcol[k], nr = r + drow[k];
-          if (!filled.inside(nc, nr)) continue;
-          const std::size_t n = filled.index(nc, nr);
-          if (mask[n] > 0 || d8[n] != kNoFlow || labels[n] != labels[i]) continue;
-          set(n, loops);
-          next.push_back(std::uint32_t(n));
+          const std::size_t pn = std::size_t(std::ptrdiff_t(p) + poff[k]);
+          const Slot s = cell[pn];
+          if (s.label != label || s.mask > 0) continue;  // not an undrained cell of this flat, or seen
+          set(pn, loops);
+          next.push_back(std::uint32_t(pn));
         }
       }
       std::swap(front, next);
@@ -203,19 +230,38 @@ FlatGradient resolve_flats(const Dem& filled, const Raster<std::uint8_t>& d8) {
   };
   // Gradient away from higher terrain (only high edges of labelled, i.e. drainable, flats).
   std::vector<std::uint32_t> high_labelled;
-  for (std::uint32_t i : high)
-    if (labels[i] != 0) high_labelled.push_back(i);
-  wave(high_labelled, [&](std::size_t i, std::int32_t loops) {
-    mask[i] = loops;
-    flat_height[std::size_t(labels[i])] = loops;
+  for (std::uint32_t p : high)
+    if (cell[p].label != 0) high_labelled.push_back(p);
+  wave(high_labelled, [&](std::size_t p, std::int32_t loops) {
+    cell[p].mask = loops;
+    flat_height[std::size_t(cell[p].label)] = loops;
   });
   // Gradient towards lower terrain, combined: 2*towards + (height - away), always > 0.
-  for (auto& m : mask.values()) m = -m;
-  wave(low, [&](std::size_t i, std::int32_t loops) {
-    if (mask[i] < 0) mask[i] = flat_height[std::size_t(labels[i])] + mask[i] + 2 * loops;
-    else mask[i] = 2 * loops;
+  for (auto& s : cell) s.mask = -s.mask;
+  wave(low, [&](std::size_t p, std::int32_t loops) {
+    Slot& s = cell[p];
+    if (s.mask < 0) s.mask = flat_height[std::size_t(std::abs(s.label))] + s.mask + 2 * loops;
+    else s.mask = 2 * loops;
   });
-  return out;
+  // Directions (Barnes 2014b, D8FlowFlats): towards the same-flat neighbour of smallest gradient,
+  // the first in neighbour order on ties; none smaller than the cell itself: terminal.
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c) {
+      const std::size_t p = std::size_t(r + 1) * width + std::size_t(c) + 1;
+      if ((kind[p] & 3) != kFlat) continue;
+      const std::int32_t label = cell[p].label;  // > 0 on a labelled undrained cell
+      int best = -1;
+      std::int32_t best_mask = cell[p].mask;
+      if (label != 0)
+        for (int k = 0; k < 8; ++k) {
+          const Slot s = cell[std::size_t(std::ptrdiff_t(p) + poff[k])];
+          if (std::abs(s.label) == label && s.mask < best_mask) {
+            best_mask = s.mask;
+            best = k;
+          }
+        }
+      d8(c, r) = best >= 0 ? std::uint8_t(best) : kTerminal;
+    }
 }
 
 }  // namespace terrapolis::hydro

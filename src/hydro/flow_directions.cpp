@@ -63,27 +63,7 @@ Raster<std::uint8_t> d8_directions(const Dem& filled, const CellMetrics& metrics
     }
   step.update(0.5);
   if (!any_flat) return d8;
-  // Flats (Barnes et al. 2014b, D8FlowFlats): towards the same-flat neighbour of smallest mask.
-  const FlatGradient flats = resolve_flats(filled, d8);
-  for (int r = 0; r < filled.rows(); ++r)
-    for (int c = 0; c < filled.cols(); ++c) {
-      const std::size_t i = d8.index(c, r);
-      if (d8[i] != kNoFlow) continue;
-      const std::int32_t label = flats.labels[i];
-      int best = -1;
-      std::int32_t best_mask = flats.mask[i];
-      if (label != 0)
-        for (int k = 0; k < 8; ++k) {
-          const int nc = c + dcol[k], nr = r + drow[k];
-          if (!filled.inside(nc, nr)) continue;
-          const std::size_t n = d8.index(nc, nr);
-          if (flats.labels[n] == label && flats.mask[n] < best_mask) {
-            best_mask = flats.mask[n];
-            best = k;
-          }
-        }
-      d8[i] = best >= 0 ? std::uint8_t(best) : kTerminal;
-    }
+  drain_flats(filled, d8);  // Barnes et al. 2014b
   return d8;
 }
 
