@@ -201,6 +201,20 @@ std::uint8_t FlowRouter::inner_receivers(int c, int r) const {
     if (k >= 8 || !valid(z_, c + dcol[k], r + drow[k])) return 0;
     return std::uint8_t(1u << k);
   }
+  if (method_ == FlowMethod::mfd) {
+    // The receivers of split() without its weights (no pow): every valid strictly lower neighbour
+    // (all of them inside the grid), else the D8 receiver.
+    const std::uint8_t d = d8_(c, r);
+    if (d == kNoData || d == kTerminal) return 0;
+    const float zc = z_(c, r);
+    std::uint8_t bits = 0;
+    for (int k = 0; k < 8; ++k) {
+      const int nc = c + dcol[k], nr = r + drow[k];
+      if (valid(z_, nc, nr) && double(zc) - double(z_(nc, nr)) > 0) bits = std::uint8_t(bits | (1u << k));
+    }
+    if (bits != 0) return bits;
+    return valid(z_, c + dcol[d], r + drow[d]) ? std::uint8_t(1u << d) : 0;
+  }
   FlowSplit s;
   split(c, r, s);
   std::uint8_t bits = 0;
