@@ -2,6 +2,7 @@
 # Hydrology benchmark: Terrapolis vs GRASS r.watershed and SAGA on real SRTM tiles.
 # Run from the repository root: bench/hydro.sh [path/to/terrapolis] [runs]
 # Needs grass (grass-core), saga (saga_cmd), hyperfine, GNU time; the DEMs in ../shared/dems.
+# The belhadj part also runs build/bench/bench_hydro (in-process timings) when it was built.
 # SPDX-License-Identifier: MIT
 set -euo pipefail
 bin=$(realpath "${1:-build/src/cli/terrapolis}")
