@@ -2,8 +2,8 @@
 // SPDX-License-Identifier: MIT
 #include "pipeline/preview.hpp"
 
-#include <OpenImageIO/imagebuf.h>
-#include <OpenImageIO/imagebufalgo.h>
+#include <dlfcn.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
@@ -14,6 +14,7 @@
 #include "core/geodesy.hpp"
 #include "io/crs.hpp"
 #include "pipeline/hillshade.hpp"
+#include "pipeline/png/png_writer.h"
 
 namespace terrapolis::pipeline {
 namespace {
@@ -72,6 +73,28 @@ struct LegendEntry {
 };
 
 }  // namespace
+
+/// The PNG writer module: beside the executable (installed or built), else where the build put it.
+static TerrapolisWritePng png_writer() {
+  static TerrapolisWritePng writer = [] {
+    std::vector<std::string> candidates;
+    char exe[4096] = {};
+    if (const ssize_t n = ::readlink("/proc/self/exe", exe, sizeof(exe) - 1); n > 0) {
+      const std::filesystem::path dir = std::filesystem::path(std::string(exe, std::size_t(n))).parent_path();
+      candidates.push_back((dir / "terrapolis_png.so").string());
+      candidates.push_back((dir / ".." / "lib" / "terrapolis" / "terrapolis_png.so").string());
+    }
+    candidates.push_back(TERRAPOLIS_PNG_MODULE);
+    std::string tried;
+    for (const auto& file : candidates) {
+      if (void* handle = ::dlopen(file.c_str(), RTLD_NOW | RTLD_LOCAL))
+        if (void* symbol = ::dlsym(handle, TERRAPOLIS_WRITE_PNG_SYMBOL)) return reinterpret_cast<TerrapolisWritePng>(symbol);
+      tried += (tried.empty() ? "" : ", ") + file;
+    }
+    throw processing_error("preview.png: cannot load the PNG writer module (tried " + tried + ")");
+  }();
+  return writer;
+}
 
 void write_preview(const RunState& state, const std::string& path, int width) {
   const Dem& dem = state.dem;
@@ -175,25 +198,20 @@ void write_preview(const RunState& state, const std::string& path, int width) {
   const int row_h = int(14 * unit), box_w = int(110 * unit), box_h = row_h * int(legend.size()) + int(8 * unit);
   const int bx = int(8 * unit), by = height - box_h - int(8 * unit);
   canvas.rect(bx, by, bx + box_w, by + box_h, hex(0xffffff), 0.8f);
-  OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::FLOAT);
-  OIIO::ImageBuf buf(spec, const_cast<float*>(canvas.data()));
-  OIIO::ImageBuf image;
-  image.copy(buf, OIIO::TypeDesc::UINT8);
-  const std::string font = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
-  const bool has_font = std::filesystem::exists(font);
+  std::vector<TerrapolisPngText> texts;
+  const float black[3] = {0.1f, 0.1f, 0.1f};
   for (std::size_t i = 0; i < legend.size(); ++i) {
     const int y = by + int(4 * unit) + int(i) * row_h;
-    const float c[3] = {legend[i].color[0], legend[i].color[1], legend[i].color[2]};
     const int sw = int(18 * unit), sh = legend[i].line ? std::max(2, int(3 * unit)) : int(9 * unit);
-    const int sy0 = y + (row_h - sh) / 2;
-    OIIO::ImageBufAlgo::fill(image, c, OIIO::ROI(bx + int(5 * unit), bx + int(5 * unit) + sw, sy0, sy0 + sh));
-    if (has_font) {
-      const float black[3] = {0.1f, 0.1f, 0.1f};
-      OIIO::ImageBufAlgo::render_text(image, bx + int(28 * unit), y + row_h - int(3 * unit), legend[i].label, int(11 * unit), font, black);
-    }
+    const int sx0 = bx + int(5 * unit), sy0 = y + (row_h - sh) / 2;
+    canvas.rect(sx0, sy0, sx0 + sw, sy0 + sh, legend[i].color);
+    texts.push_back({bx + int(28 * unit), y + row_h - int(3 * unit), int(11 * unit), {black[0], black[1], black[2]}, legend[i].label.c_str()});
   }
   const std::string tmp = path + ".tmp.png";
-  if (!image.write(tmp, OIIO::TypeDesc::UINT8, "png")) throw processing_error(path + ": cannot write preview (" + image.geterror() + ")");
+  char error[512] = {};
+  if (png_writer()(canvas.data(), width, height, texts.data(), int(texts.size()), "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",
+                   tmp.c_str(), error, int(sizeof(error))) != 0)
+    throw processing_error(path + ": cannot write preview (" + error + ")");
   std::filesystem::rename(tmp, path);
 }
 
