@@ -72,9 +72,9 @@ class PathCommand final : public Command {
     const auto& s = road->stats;
     char line[512];
     std::snprintf(line, sizeof line,
-                  "%s: %.0f m, cost %.1f, max grade %.1f %%, mean grade %.1f %%, bridges %.0f m, tunnels %.0f m; %zu nodes expanded, %zu stored, %.2f s",
+                  "%s: %.0f m, cost %.1f, max grade %.1f %%, mean grade %.1f %%, bridges %.0f m, tunnels %.0f m; %zu nodes expanded, %zu rings of long arcs priced, %zu stored, %.2f s",
                   road->router.c_str(), s.length_m, road->cost.value_or(NAN), s.max_grade_pct, s.mean_grade_pct, s.bridge_m, s.tunnel_m,
-                  road->expanded, road->nodes, seconds);
+                  road->expanded, road->rings_priced, road->nodes, seconds);
     context.log.info(line);
   }
 
