@@ -76,6 +76,10 @@ class PathCommand final : public Command {
                   road->router.c_str(), s.length_m, road->cost.value_or(NAN), s.max_grade_pct, s.mean_grade_pct, s.bridge_m, s.tunnel_m,
                   road->expanded, road->rings_priced, road->nodes, seconds);
     context.log.info(line);
+    const auto& g = road->geometry;
+    if (g.clothoid_corners + g.g1_corners + g.sharp_corners > 0)
+      context.log.detail("corners: " + std::to_string(g.clothoid_corners) + " clothoid pairs, " + std::to_string(g.g1_corners) +
+                         " quadratic (G1) fallbacks, " + std::to_string(g.sharp_corners) + " left sharp");
   }
 
  private:
