@@ -39,25 +39,33 @@ void densify(std::vector<GridPoint>& out, const TerrainField& terrain, GridPoint
   for (int i = 1; i <= n; ++i) out.push_back(lerp(a, b, double(i) / n));
 }
 
-/// Position of the unit clothoid of half-deflection phi at arc length s in [0, 1]: tangent angle
-/// phi s^2, so curvature 2 phi s (linear); Fresnel integrals by Simpson's rule.
-PlanePoint unit_spiral(double phi, double s) {
-  constexpr int n = 64;  // even; the integrands are smooth, so the error is far below a millimetre per km
-  const double h = s / n;
+/// Points of the unit clothoid of half-deflection phi at arc lengths i / n, i = 0..n: tangent angle
+/// phi s^2, so curvature 2 phi s (linear); the Fresnel integrals by Simpson's rule, 8 intervals per
+/// step (the integrands are smooth: the error is far below a millimetre per kilometre).
+std::vector<PlanePoint> unit_spiral(double phi, int n) {
+  constexpr int m = 8;
+  std::vector<PlanePoint> out(std::size_t(n) + 1);
+  const double h = 1.0 / (double(n) * m);
   double x = 0, y = 0;
-  for (int i = 0; i <= n; ++i) {
-    const double t = i * h, w = (i == 0 || i == n) ? 1 : (i % 2 ? 4 : 2);
-    x += w * std::cos(phi * t * t);
-    y += w * std::sin(phi * t * t);
+  for (int i = 1; i <= n; ++i) {
+    double sx = 0, sy = 0;
+    for (int j = 0; j <= m; ++j) {
+      const double t = (double(i - 1) * m + j) * h, w = (j == 0 || j == m) ? 1 : (j % 2 ? 4 : 2);
+      sx += w * std::cos(phi * t * t);
+      sy += w * std::sin(phi * t * t);
+    }
+    x += sx * h / 3;
+    y += sy * h / 3;
+    out[std::size_t(i)] = {x, y};
   }
-  return {x * h / 3, y * h / 3};
+  return out;
 }
 
 }  // namespace
 
 ClothoidShape clothoid_shape(double turn_rad) {
   const double phi = 0.5 * turn_rad;
-  const PlanePoint e = unit_spiral(phi, 1.0);
+  const PlanePoint e = unit_spiral(phi, 32).back();
   ClothoidShape c;
   c.tangent_per_m = e.x + e.y * std::tan(phi);
   c.apex_per_m = std::hypot(c.tangent_per_m - e.x, e.y);
@@ -76,8 +84,9 @@ std::vector<PlanePoint> clothoid_corner(PlanePoint a, PlanePoint v, PlanePoint b
   const PlanePoint na{-da.y, da.x}, nb{-db.y, db.x};
   std::vector<PlanePoint> out(std::size_t(2 * samples + 1));
   // First spiral from t1 along a-v bending towards b; the second is its mirror image, run back from t2.
+  const std::vector<PlanePoint> spiral = unit_spiral(0.5 * turn, samples);
   for (int i = 0; i <= samples; ++i) {
-    const PlanePoint p = unit_spiral(0.5 * turn, double(i) / samples);
+    const PlanePoint& p = spiral[std::size_t(i)];
     const PlanePoint first{t1.x + ls * (p.x * da.x + sign * p.y * na.x), t1.y + ls * (p.x * da.y + sign * p.y * na.y)};
     const PlanePoint second{t2.x + ls * (-p.x * db.x + sign * p.y * nb.x), t2.y + ls * (-p.x * db.y + sign * p.y * nb.y)};
     if (i < samples) {
