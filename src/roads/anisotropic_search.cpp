@@ -168,12 +168,14 @@ RoadGraph::RoadGraph(const TerrainField& terrain, const CostModel& model, const 
       if (pair_sampled(int(a), col - arc.dcol, row - arc.drow))
         into_by_slot[std::size_t(arc.orientation) * nr + std::size_t(ring_of_[a - surface_arcs_])].push_back(int(a));
     }
+    std::size_t k = 0;
+    for (std::size_t ring = 0; ring < nr; ++ring) {
+      for (; k < kept_from.size() && std::size_t(ring_of_[std::size_t(kept_from[k]) - surface_arcs_]) == ring; ++k)
+        long_from_.push_back(kept_from[k]);
+      long_from_start_.push_back(long_from_.size());
+    }
     for (std::size_t o = 0; o < no; ++o) {
-      std::size_t k = 0;
       for (std::size_t ring = 0; ring < nr; ++ring) {
-        for (; k < kept_from.size() && std::size_t(ring_of_[std::size_t(kept_from[k]) - surface_arcs_]) == ring; ++k)
-          if (turn_cost(int(o), kept_from[k]) < kInfinity) long_from_.push_back(kept_from[k]);
-        long_from_start_.push_back(long_from_.size());
         const auto& l = into_by_slot[o * nr + ring];
         long_into_.insert(long_into_.end(), l.begin(), l.end());
         long_into_start_.push_back(long_into_.size());
@@ -300,8 +302,7 @@ bool RoadGraph::arc_sampled(Cell from, int arc) const {
 
 std::span<const int> RoadGraph::arcs_from(Cell c, int orientation, int slot) const {
   if (slot == 0) return from_[std::size_t(orientation)];
-  const std::size_t i = (std::size_t(sample_class(rings_[std::size_t(slot - 1)].structure, c.col, c.row)) * std::size_t(orientations_) +
-                         std::size_t(orientation)) * rings_.size() + std::size_t(slot - 1);
+  const std::size_t i = std::size_t(sample_class(rings_[std::size_t(slot - 1)].structure, c.col, c.row)) * rings_.size() + std::size_t(slot - 1);
   return {long_from_.data() + long_from_start_[i], long_from_start_[i + 1] - long_from_start_[i]};
 }
 
@@ -574,14 +575,11 @@ SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMet
       const RoadGraph::Arc& arc = arcs[std::size_t(a)];
       const Cell n{c.col + arc.dcol, c.row + arc.drow};
       if (!t.inside(n.col, n.row)) continue;
-      double e;
-      if (slot == 0) {
-        e = cache.get(c, costs, a);
-      } else {
-        e = graph.arc_cost(c, a);
-      }
+      const double turn = graph.turn_cost(o, a);
+      if (turn == kInfinity) continue;  // long arcs: the lists do not depend on the orientation
+      const double e = slot == 0 ? cache.get(c, costs, a) : graph.arc_cost(c, a);
       if (e == kInfinity) continue;
-      const double g = q.g + graph.turn_cost(o, a) + e;
+      const double g = q.g + turn + e;
       bool improved;
       const std::uint32_t idx = fw.relax(key_of(n, arc.orientation), g, q.node, a, improved);
       if (improved) {

@@ -83,8 +83,8 @@ class RoadGraph {
   const std::vector<Ring>& rings() const { return rings_; }
   /// First ring of a structure, or -1 when it has no long arcs.
   int first_ring(Structure s) const { return first_ring_[int(s)]; }
-  /// Surface arcs (slot 0) or the sampled arcs of ring r (slot r + 1) that leave cell `c` in
-  /// orientation `o` with a finite turn cost.
+  /// Surface arcs with a finite turn cost (slot 0) or the sampled arcs of ring r (slot r + 1, any
+  /// turn: the caller checks it) that leave cell `c` in orientation `o`.
   std::span<const int> arcs_from(Cell c, int orientation, int slot) const;
   /// Surface arcs (slot 0) or the sampled arcs of ring r (slot r + 1) that reach cell `c` in orientation `o`.
   std::span<const int> arcs_into(Cell c, int orientation, int slot) const;
@@ -122,7 +122,8 @@ class RoadGraph {
   int sample_class(Structure s, int col, int row) const;
   bool pair_sampled(int arc, int from_col, int from_row) const;
   std::vector<std::vector<int>> from_, into_;  ///< surface arcs per orientation
-  /// Sampled long arcs per (class, orientation, ring), flattened: [start[i], start[i + 1]).
+  /// Sampled long arcs out of a cell per (class, ring), into a cell per (class, orientation, ring),
+  /// flattened: [start[i], start[i + 1]).
   std::vector<std::size_t> long_from_start_, long_into_start_;
   std::vector<int> long_from_, long_into_;
   std::vector<Structure> orientation_structure_;
