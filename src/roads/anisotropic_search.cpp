@@ -498,6 +498,38 @@ class ArcCache {
   std::vector<float> costs_;
 };
 
+/// Long-arc costs of the rings priced so far, per cell and ring (a cell's ring is priced once per
+/// orientation it is expanded in, about 6 times on an Alpine road, but its arcs cost the same from
+/// each), computed lazily (NaN = not yet) and kept as floats. Bounded: past `cap` values it stops
+/// storing and the costs are recomputed, with the same rounding, so the cache never changes a result.
+class LongArcCache {
+ public:
+  LongArcCache(std::size_t cells, std::size_t rings, std::size_t cap) : rings_(rings), cap_(cap), slot_(rings ? cells : 0, kNone) {}
+  /// The costs of ring r of a cell whose list holds n arcs, or nullptr when the cache is full; valid
+  /// until the next call.
+  float* ring(std::size_t cell, int r, std::size_t n) {
+    std::uint32_t& s = slot_[cell];
+    if (s == kNone) {
+      if (heads_.size() + values_.size() + rings_ > cap_) return nullptr;
+      s = std::uint32_t(heads_.size() / rings_);
+      heads_.resize(heads_.size() + rings_, kNone);
+    }
+    std::uint32_t& h = heads_[std::size_t(s) * rings_ + std::size_t(r)];
+    if (h == kNone) {
+      if (heads_.size() + values_.size() + n > cap_) return nullptr;
+      h = std::uint32_t(values_.size());
+      values_.resize(values_.size() + n, std::numeric_limits<float>::quiet_NaN());
+    }
+    return values_.data() + h;
+  }
+
+ private:
+  static constexpr std::uint32_t kNone = 0xffffffffu;
+  std::size_t rings_, cap_;
+  std::vector<std::uint32_t> slot_, heads_;
+  std::vector<float> values_;
+};
+
 }  // namespace
 
 SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMethod method, std::size_t max_nodes,
@@ -549,6 +581,9 @@ SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMet
 
   Frontier fw(t.size(), O), bw(bidir ? t.size() : 0, O);
   ArcCache cache(graph);
+  LongArcCache long_cache(t.size(), graph.rings().size(), std::size_t(1) << 25);  // at most 128 MB
+  // Long arcs are priced as floats in both directions, cached or not, so every search sees the same costs.
+  auto long_cost = [&](Cell from_cell, int a) { return double(float(graph.arc_cost(from_cell, a))); };
   auto check_memory = [&]() {
     if (fw.nodes.size() + bw.nodes.size() + cache.cells() * graph.surface_arcs() / 4 > max_nodes)
       throw processing_error("path: the search stored more than " + std::to_string(max_nodes) +
@@ -570,14 +605,24 @@ SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMet
   auto expand_forward = [&](const QueueItem& q, int slot) {
     const Cell c = cell_of(q.key);
     const int o = orient_of(q.key);
-    float* costs = slot == 0 ? cache.row(t.index(c.col, c.row)) : nullptr;
-    for (int a : graph.arcs_from(c, o, slot)) {
+    const std::span<const int> list = graph.arcs_from(c, o, slot);
+    float* costs = slot == 0 ? cache.row(t.index(c.col, c.row)) : long_cache.ring(t.index(c.col, c.row), slot - 1, list.size());
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const int a = list[i];
       const RoadGraph::Arc& arc = arcs[std::size_t(a)];
       const Cell n{c.col + arc.dcol, c.row + arc.drow};
       if (!t.inside(n.col, n.row)) continue;
       const double turn = graph.turn_cost(o, a);
       if (turn == kInfinity) continue;  // long arcs: the lists do not depend on the orientation
-      const double e = slot == 0 ? cache.get(c, costs, a) : graph.arc_cost(c, a);
+      double e;
+      if (slot == 0) {
+        e = cache.get(c, costs, a);
+      } else if (costs) {
+        if (std::isnan(costs[i])) costs[i] = float(long_cost(c, a));
+        e = costs[i];
+      } else {
+        e = long_cost(c, a);
+      }
       if (e == kInfinity) continue;
       const double g = q.g + turn + e;
       bool improved;
@@ -596,12 +641,7 @@ SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMet
       const RoadGraph::Arc& arc = arcs[std::size_t(a)];
       const Cell p{c.col - arc.dcol, c.row - arc.drow};
       if (!t.inside(p.col, p.row)) continue;
-      double e;
-      if (slot == 0) {
-        e = cache.get(p, t.index(p.col, p.row), a);
-      } else {
-        e = graph.arc_cost(p, a);
-      }
+      const double e = slot == 0 ? cache.get(p, t.index(p.col, p.row), a) : long_cost(p, a);
       if (e == kInfinity) continue;
       const double hp = potential(p);
       for (int po = 0; po < graph.orientations(); ++po) {
