@@ -35,8 +35,9 @@ struct GraphOptions {
 /// orientation), where the orientation is the structure and angle sector of the arc that reached
 /// the cell; arcs are the segment mask M_k (surface roads) and, when enabled, long bridge and tunnel
 /// arcs r_i..r_e long (annulus masks) of which each unordered cell pair is kept with probability
-/// s / |annulus| by a hash of (seed, structure, pair): a fixed pseudo-random graph, so results do not
-/// depend on the search order and the backward search sees exactly the forward arcs.
+/// s / |annulus| by a hash of (seed, structure, offset, position modulo 32; see arc_sampled): a
+/// fixed pseudo-random graph, so results do not depend on the search order and the backward search
+/// sees exactly the forward arcs.
 /// Arc cost = integral of the per-metre cost sampled every `sample_step_m` along the segment
 /// (midpoint rule) + the curvature cost of the turn from the previous arc. Infinite-cost arcs are
 /// never used. Reentrant: const methods may run concurrently.
