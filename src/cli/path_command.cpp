@@ -41,6 +41,7 @@ class PathCommand final : public Command {
     routing.search = search_ == "bidir" ? roads::SearchMethod::bidirectional : search_ == "dijkstra" ? roads::SearchMethod::dijkstra : roads::SearchMethod::astar;
     if (evaluate_.empty()) check_output_path(out_, options_.overwrite);
     if (!sections_.empty()) check_output_path(sections_, options_.overwrite);
+    if (evaluate_.empty() && !options_.earthworks.empty()) check_output_path(options_.earthworks, options_.overwrite);
     const roads::CostModel model = options_.cost_model();
     const Dem dem = read_dem(dem_);
     roads::TerrainField terrain(dem, options_.sea_level, model.unknown_water_depth_m, model.road_radius_m);
@@ -67,8 +68,10 @@ class PathCommand final : public Command {
     roads[0].road_class = "departmental";
     const VectorLayer layer = roads::roads_layer(terrain, roads);
     const VectorLayer sections = roads::sections_layer(terrain, roads);
+    const Dem levelled = options_.earthworks_dem(dem, terrain, roads);
     write_vector(out_, layer, options_.overwrite);
     if (!sections_.empty()) write_vector(sections_, sections, options_.overwrite);
+    options_.write_earthworks(levelled);
     const auto& s = road->stats;
     char line[512];
     std::snprintf(line, sizeof line,
