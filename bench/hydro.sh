@@ -2,6 +2,7 @@
 # Hydrology benchmark: Terrapolis vs GRASS r.watershed and SAGA on real SRTM tiles.
 # Run from the repository root: bench/hydro.sh [path/to/terrapolis] [runs]
 # Needs grass (grass-core), saga (saga_cmd), hyperfine, GNU time; the DEMs in ../shared/dems.
+# The belhadj part also runs build/bench/bench_hydro (in-process timings) when it was built.
 # SPDX-License-Identifier: MIT
 set -euo pipefail
 bin=$(realpath "${1:-build/src/cli/terrapolis}")
@@ -131,3 +132,10 @@ has belhadj || exit 0
 gdal_translate -q -srcwin 0 0 256 256 "${dems[0]}" "$work/c256.tif"
 bl=$("$bin" -v --threads 2 --progress none hydro "$work/c256.tif" "$work/c256" --outputs hydrometry --iterations 20 2>&1 | sed -n 's/.*belhadj: \(.*\)/\1/p')
 echo "256x256 (thesis case)     | Belhadj hydrometry, 20 iterations: $bl"
+# The same case in process, without start-up, reading and writing (Google Benchmark; built with
+# the project when the library is installed): median of 5 repetitions, 2 threads.
+micro=$(dirname "$bin")/../../bench/bench_hydro
+if [[ -x $micro ]]; then
+  TERRAPOLIS_BENCH_DEM=$(realpath "${dems[0]}") TERRAPOLIS_BENCH_THREADS=2 "$micro" --benchmark_filter='Belhadj256x20' \
+    --benchmark_repetitions=5 --benchmark_report_aggregates_only=true 2>/dev/null | awk '/_median/ {print "256x256 in process (median) | Belhadj hydrometry, 20 iterations: " $2 " " $3 " wall, " $NF}'
+fi

@@ -14,8 +14,10 @@
 #include "cli/command.hpp"
 #include "cli/commands_list.hpp"
 #include "cli/dem_input.hpp"
+#include "cli/plugin_options.hpp"
 #include "core/error.hpp"
 #include "density/density.hpp"
+#include "hydro/hydrometry.hpp"
 #include "io/raster_io.hpp"
 #include "terrapolis/version.hpp"
 
@@ -39,13 +41,13 @@ double parse_number(const std::string& option, const std::string& text) {
 /// The hydrometry the density model uses, on the DEM's grid, and whether it is worth writing.
 /// This is the ONE place that decides where hydrometry comes from: a file given with --hydrometry
 /// (resampled bilinearly to the DEM's grid), nothing when neither its weight nor a river-bed cap
-/// needs it (all zeros, not written), otherwise the hydrology stage.
+/// needs it (all zeros, not written), otherwise Belhadj's hydrometry computed from the DEM.
 struct Hydrometry {
   Raster<float> values;
   bool used = false;
 };
 
-Hydrometry obtain_hydrometry(const Dem& dem, const density::DensityOptions& options, const std::string& path) {
+Hydrometry obtain_hydrometry(const Dem& dem, const density::DensityOptions& options, const std::string& path, Progress& progress) {
   Hydrometry h;
   h.used = options.weights[1] != 0 || options.river_bed_cap.has_value();
   if (!path.empty()) {
@@ -61,7 +63,11 @@ Hydrometry obtain_hydrometry(const Dem& dem, const density::DensityOptions& opti
     h.values = dem.like<float>(0.0f);
     return h;
   }
-  throw bad_input("--hydrometry FILE is required when the hydrometry weight is not 0 or --river-bed-cap is set");
+  // Belhadj's hydrometry (thesis Alg. 12) with the sea as outlet, as `terrapolis hydro --sea-level` does.
+  hydro::HydrometryOptions hydrometry;
+  hydrometry.sea_level = options.sea_level_m;
+  h.values = hydro::compute_hydrometry(dem, hydrometry, progress);
+  return h;
 }
 
 class DensityCommand final : public Command {
@@ -86,6 +92,7 @@ class DensityCommand final : public Command {
     app.add_option("--max-altitude", options_.max_altitude_m, "Cells above this altitude are uninhabitable, metres")->capture_default_str();
     app.add_option("--max-slope", max_slope_, "Cells steeper than this are uninhabitable, degrees (default: no limit)");
     app.add_option("--river-bed-cap", river_bed_cap_, "Cells whose hydrometry exceeds this (0..1) are river beds, uninhabitable");
+    plugins_.setup(app, "adds its density factor, combined like a --layer of that weight, and its exclusions");
     app.add_flag("--report", report_, "Print the buildable share and the density histogram");
     app.add_flag("--cog", cog_, "Write Cloud Optimized GeoTIFFs");
     app.add_flag("--overwrite", overwrite_, "Replace existing outputs");
@@ -113,8 +120,10 @@ class DensityCommand final : public Command {
     using clock = std::chrono::steady_clock;
     const auto seconds = [](clock::time_point a, clock::time_point b) { return format(std::chrono::duration<double>(b - a).count(), 3); };
     const auto t0 = clock::now();
+    const plugin::PluginSet plugins = plugins_.load(context.log);
     const Dem dem = dem_.read();
-    const Hydrometry hydrometry = obtain_hydrometry(dem, options, hydrometry_path_);
+    const Hydrometry hydrometry = obtain_hydrometry(dem, options, hydrometry_path_, context.progress);
+    plugin::add_to_density(plugin::density_factors(plugins, dem, context.progress, context.log), options);
     const auto t1 = clock::now();
     const std::clock_t cpu1 = std::clock();  // processor time of all threads
     const density::DensityResult result = density::compute_density(dem, hydrometry.values, options, context.progress);
@@ -184,6 +193,7 @@ class DensityCommand final : public Command {
     std::ostringstream w;
     w << o.weights[0] << ',' << o.weights[1] << ',' << o.weights[2] << ',' << o.weights[3];
     for (const auto& [path, weight] : o.layers) w << ';' << fs::path(path).filename().string() << ':' << weight;
+    for (const auto& f : o.factors) w << ';' << f.name << ':' << f.weight;
     std::vector<std::pair<std::string, std::string>> m = {
         {"TERRAPOLIS_VERSION", terrapolis::version},
         {"TERRAPOLIS_STAGE", "density"},
@@ -221,6 +231,7 @@ class DensityCommand final : public Command {
   }
 
   DemInput dem_;
+  PluginOptions plugins_;
   std::string out_dir_, weights_, hydrometry_path_, max_slope_, river_bed_cap_;
   std::vector<std::string> layers_, exclusions_;
   density::DensityOptions options_;

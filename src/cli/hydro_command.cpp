@@ -137,6 +137,7 @@ class HydroCommand final : public Command {
       w.cog = cog_;
       w.overwrite = overwrite_;
       w.description = description;
+      w.deflate_level = 1;  // 13 M-cell float rasters: a third of the compression time, files ~4 % larger
       w.metadata = provenance;
       w.metadata.insert(w.metadata.end(), extra.begin(), extra.end());
       return w;

@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cstdio>
 #include <optional>
@@ -10,6 +11,7 @@
 #include <vector>
 
 #include "cli/command.hpp"
+#include "cli/describe.hpp"
 #include "core/error.hpp"
 #include "io/raster_io.hpp"
 #include "terrapolis/version.hpp"
@@ -51,6 +53,8 @@ int main(int argc, char** argv) {
   app.add_option("--progress", progress_kind, "Progress on stderr: console (GDAL style), json (one object per line), none")
       ->check(CLI::IsMember({"console", "json", "none"}));
   app.add_option("--threads", threads, "Worker threads (0: all cores); outputs do not depend on it")->check(CLI::NonNegativeNumber);
+  bool describe = false;
+  app.add_flag("--describe-json", describe, "Print every command and option as JSON (for GUIs such as the QGIS provider) and exit");
 
   auto commands = cli::all_commands();
   std::vector<std::pair<CLI::App*, cli::Command*>> subs;
@@ -61,6 +65,10 @@ int main(int argc, char** argv) {
   }
 
   auto args = join_negative_values(argc, argv);
+  if (std::find(args.begin(), args.end(), "--describe-json") != args.end()) {  // no subcommand needed
+    std::printf("%s\n", cli::describe_cli(app, terrapolis::version).dump(2).c_str());
+    return 0;
+  }
   std::reverse(args.begin(), args.end());  // CLI11 takes the arguments reversed
   try {
     app.parse(args);

@@ -43,9 +43,10 @@ class PathCommand final : public Command {
     if (!sections_.empty()) check_output_path(sections_, options_.overwrite);
     if (evaluate_.empty() && !options_.earthworks.empty()) check_output_path(options_.earthworks, options_.overwrite);
     const roads::CostModel model = options_.cost_model();
+    const plugin::PluginSet plugins = options_.plugins.load(context.log);
     const Dem dem = read_dem(dem_);
     roads::TerrainField terrain(dem, options_.sea_level, model.unknown_water_depth_m, model.road_radius_m);
-    options_.load_layers(terrain);
+    options_.load_layers(terrain, plugins, dem, context.progress, context.log);
     const auto a = locate("--from", from_, terrain), b = locate("--to", to_, terrain);
     if (a == b) throw bad_input("--from/--to: both points fall in the same cell");
     for (const auto& [opt, c] : {std::pair{"--from", a}, std::pair{"--to", b}}) {

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <string>
 
+#include "cli/plugin_options.hpp"
 #include "io/raster_io.hpp"
 #include "roads/earthworks.hpp"
 #include "roads/road_network.hpp"
@@ -21,6 +22,7 @@ struct RoadOptions {
   std::string router = "galin";
   int bezier_evaluations = 1000, bezier_tries = 20;
   double bezier_threshold = 0.1;
+  PluginOptions plugins;
 
   void setup(CLI::App& app) {
     app.add_option("--router", router, "Router: galin (anisotropic shortest path) or bezier (Belhadj 2007 Alg. 16)")
@@ -37,6 +39,7 @@ struct RoadOptions {
     app.add_option("--bezier-threshold", bezier_threshold, "Bézier router: stop when the worst position costs less (0..1)")->check(CLI::Range(0.0, 1.0));
     app.add_option("--bezier-tries", bezier_tries, "Bézier router: control points drawn per worst position")->check(CLI::Range(1, 100000));
     app.add_option("--earthworks", earthworks, "Also write the DEM after cut-and-fill along the surface roads (GeoTIFF; 8 m carriageway, 2:3 sides)");
+    plugins.setup(app, "adds its road cost term (characteristic priced by its transfer functions; galin router)");
     app.add_flag("--overwrite", overwrite, "Replace existing outputs");
   }
 
@@ -61,10 +64,11 @@ struct RoadOptions {
     if (!tunnels) m.tunnel.enabled = false;
     return m;
   }
-  /// Loads --vegetation onto the DEM's grid when given.
-  void load_layers(roads::TerrainField& terrain) const {
-    if (vegetation.empty()) return;
-    terrain.set_vegetation(read_resampled(vegetation, terrain.georef(), terrain.cols(), terrain.rows(), Resampling::bilinear));
+  /// Loads --vegetation onto the DEM's grid when given, and adds the plugins' road cost terms.
+  void load_layers(roads::TerrainField& terrain, const plugin::PluginSet& set, const Dem& dem, Progress& progress, const Log& log) const {
+    if (!vegetation.empty())
+      terrain.set_vegetation(read_resampled(vegetation, terrain.georef(), terrain.cols(), terrain.rows(), Resampling::bilinear));
+    plugin::add_to_terrain(plugin::road_terms(set, dem, progress, log), terrain);
   }
   roads::GraphOptions graph() const { return {k, angles, seed}; }
   roads::RoutingOptions routing() const {

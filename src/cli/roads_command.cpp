@@ -45,9 +45,10 @@ class RoadsCommand final : public Command {
     if (!options_.earthworks.empty()) check_output_path(options_.earthworks, options_.overwrite);
 
     const roads::CostModel model = options_.cost_model();
+    const plugin::PluginSet plugins = options_.plugins.load(context.log);
     const Dem dem = read_dem(dem_);
     roads::TerrainField terrain(dem, options_.sea_level, model.unknown_water_depth_m, model.road_radius_m);
-    options_.load_layers(terrain);
+    options_.load_layers(terrain, plugins, dem, context.progress, context.log);
     VectorLayer network = read_vector(network_, dem.georef().crs);
     network.name = network_;  // errors name the file
     std::string cities_path = cities_;

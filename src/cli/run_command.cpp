@@ -24,6 +24,12 @@ class RunCommand final : public Command {
     app.add_option("--seed", seed_, "Seed of the run (overrides the scenario's)");
     app.add_option("-o,--output", output_, "Run folder (overrides the scenario's)");
     app.add_flag("--overwrite", overwrite_, "Replace the run folder if it exists");
+    const std::vector<std::string> stages = pipeline::stage_names();
+    app.add_option("--from", from_, "Rerun from this stage on, reading the earlier stages' results back from the run")
+        ->check(CLI::IsMember(stages));
+    app.add_option("--only", only_, "Rerun only these stages (later stages keep their saved, now stale, results)")
+        ->expected(1, -1)
+        ->check(CLI::IsMember(stages));
     app.add_flag("--print-scenario", print_, "Print the resolved scenario (defaults filled) and exit");
   }
   void run(Context& context) override {
@@ -37,6 +43,8 @@ class RunCommand final : public Command {
     }
     pipeline::RunOptions options;
     options.overwrite = overwrite_;
+    options.from = from_;
+    options.only = only_;
     const auto manifest = pipeline::run_scenario(scenario, options, context.progress, context.log);
     if (context.log.level() != LogLevel::quiet) {
       std::printf("%s", pipeline::format_summary(manifest).c_str());
@@ -45,8 +53,8 @@ class RunCommand final : public Command {
   }
 
  private:
-  std::string file_, output_;
-  std::vector<std::string> sets_;
+  std::string file_, output_, from_;
+  std::vector<std::string> sets_, only_;
   long long seed_ = -1;
   bool overwrite_ = false, print_ = false;
 };

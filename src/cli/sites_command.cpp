@@ -1,4 +1,4 @@
-// `terrapolis sites DENSITY_DIR OUTDIR`: city sites and their hierarchy from a density model (Belhadj §4.3.1).
+// `terrapolis sites DENSITY_DIR_OR_DEM OUTDIR`: city sites and their hierarchy from a density model (Belhadj §4.3.1).
 // SPDX-License-Identifier: MIT
 #include <CLI/CLI.hpp>
 
@@ -12,6 +12,8 @@
 #include "cli/commands_list.hpp"
 #include "cli/output_dir.hpp"
 #include "core/error.hpp"
+#include "density/density.hpp"
+#include "hydro/hydrometry.hpp"
 #include "io/raster_io.hpp"
 #include "sites/layers.hpp"
 #include "sites/sites.hpp"
@@ -53,13 +55,27 @@ DensityInputs read_density_dir(const std::string& dir) {
   return in;
 }
 
+/// A DEM instead of a density folder: the density model with its defaults (hydrometry by
+/// Belhadj's method, the sea at 0 m as outlet and water), as `terrapolis density` writes it.
+DensityInputs density_from_dem(const std::string& path, Progress& progress) {
+  const Dem dem = read_dem(path);
+  const density::DensityOptions options;
+  hydro::HydrometryOptions hydrometry;
+  hydrometry.sea_level = options.sea_level_m;
+  density::DensityResult model = density::compute_density(dem, hydro::compute_hydrometry(dem, hydrometry, progress), options, progress);
+  return {std::move(model.density), std::move(model.buildable)};
+}
+
 class SitesCommand final : public Command {
  public:
   std::string name() const override { return "sites"; }
   std::string summary() const override { return "Place city sites with size quotas and their hierarchy on a density model (Belhadj Alg. 13-15)"; }
 
   void setup(CLI::App& app) override {
-    app.add_option("DENSITY_DIR", dir_, "Folder holding density.tif (float, [0,1]) and buildable.tif (1 = buildable) on the DEM grid")->required();
+    app.add_option("DENSITY_DIR_OR_DEM", dir_,
+                   "Folder holding density.tif (float, [0,1]) and buildable.tif (1 = buildable) on the DEM grid, or a DEM "
+                   "(the density model is then computed with its defaults)")
+        ->required();
     app.add_option("OUTDIR", out_, "Output folder: cities.geojson, city_extents.geojson")->required();
     // The seed is recorded as a 64-bit signed integer field: keep it in that range.
     app.add_option("--seed", options_.seed, "Seed of the candidate draw (0 .. 2^63-1); recorded in the outputs")
@@ -78,6 +94,10 @@ class SitesCommand final : public Command {
     app.add_option("--refill", options_.refill_rounds, "Rounds giving the quota of removed sites back to the growth (0: Algorithm 14 as printed)")
         ->check(CLI::NonNegativeNumber)
         ->capture_default_str();
+    app.add_option("--quota-scale", options_.quota_scale,
+                   "Multiplies every quota (region area / 543940 km2 of the census fit; 1: the thesis)")
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str();
     app.add_flag("--report", report_, "Print the quota table");
     app.add_flag("--overwrite", overwrite_, "Replace existing outputs");
   }
@@ -87,7 +107,8 @@ class SitesCommand final : public Command {
     options_.disc_test = disc_test_ == "perimeter" ? sites::SitesOptions::DiscTest::perimeter : sites::SitesOptions::DiscTest::exact;
     OutputDir outputs(out_, {"cities.geojson", "city_extents.geojson"}, overwrite_);
     const auto t0 = std::chrono::steady_clock::now();
-    const DensityInputs in = read_density_dir(dir_);
+    const bool dem = std::filesystem::is_regular_file(dir_);
+    const DensityInputs in = dem ? density_from_dem(dir_, context.progress) : read_density_dir(dir_);
     const auto t1 = std::chrono::steady_clock::now();
     const sites::SitesResult result = sites::place_sites(in.density, in.buildable, options_, context.progress);
     const auto t2 = std::chrono::steady_clock::now();

@@ -83,6 +83,13 @@ void check_options(const Dem& dem, const Raster<float>& hydrometry, const Densit
     if (!std::isfinite(w)) throw bad_input("--layer " + path + ": weight must be a finite number");
     any = any || w != 0;
   }
+  for (const auto& f : o.factors) {
+    if (!std::isfinite(f.weight)) throw bad_input(f.name + ": weight must be a finite number");
+    if (f.values.cols() != dem.cols() || f.values.rows() != dem.rows()) throw bad_input(f.name + ": factor is not on the DEM's grid");
+    any = any || f.weight != 0;
+  }
+  for (const auto& m : o.exclusion_masks)
+    if (m.cols() != dem.cols() || m.rows() != dem.rows()) throw bad_input("exclusion mask: not on the DEM's grid");
   if (!any) throw bad_input("--weights: every weight is 0, the density would be undefined");
 }
 
@@ -164,6 +171,9 @@ DensityResult compute_density(const Dem& dem, const Raster<float>& hydrometry, c
       for (std::size_t i = 0; i < n; ++i)
         if (!std::isnan(ex[i]) && ex[i] != 0) excluded[i] = 1;
     }
+    for (const auto& ex : options.exclusion_masks)
+      for (std::size_t i = 0; i < n; ++i)
+        if (ex[i] != 0) excluded[i] = 1;
     step.update(0.5);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1 << 16), [&](const tbb::blocked_range<std::size_t>& range) {
       for (std::size_t i = range.begin(); i < range.end(); ++i) {
@@ -364,8 +374,10 @@ DensityResult compute_density(const Dem& dem, const Raster<float>& hydrometry, c
     for (const auto& [path, weight] : options.layers) layers.push_back(read_layer(path, dem));
     std::vector<double> weights(options.weights.begin(), options.weights.end());
     for (const auto& [path, weight] : options.layers) weights.push_back(weight);
+    for (const auto& f : options.factors) weights.push_back(f.weight);
+    const std::size_t first_factor = 4 + layers.size();
     for_rows(rows, step, [&](int r0, int r1) {
-      std::vector<double> values(weights.size());
+      std::vector<double> values(weights.size()), cell_weights(weights);
       for (int r = r0; r < r1; ++r)
         for (int x = 0; x < cols; ++x) {
           const std::size_t i = dem.index(x, r);
@@ -379,7 +391,15 @@ DensityResult compute_density(const Dem& dem, const Raster<float>& hydrometry, c
           values[2] = result.plateau[i];
           values[3] = result.plain[i];
           for (std::size_t l = 0; l < layers.size(); ++l) values[4 + l] = layers[l][i];
-          result.density[i] = float(combine(weights.data(), values.data(), weights.size()));
+          // A factor with no value here (NaN) takes no part in this cell's combination.
+          bool any = false;
+          for (std::size_t f = 0; f < options.factors.size(); ++f) {
+            const float v = options.factors[f].values[i];
+            values[first_factor + f] = std::isnan(v) ? 0.0 : std::clamp(double(v), 0.0, 1.0);
+            cell_weights[first_factor + f] = std::isnan(v) ? 0.0 : weights[first_factor + f];
+          }
+          for (std::size_t k = 0; k < cell_weights.size() && !any; ++k) any = cell_weights[k] != 0;
+          result.density[i] = any ? float(combine(cell_weights.data(), values.data(), cell_weights.size())) : 0.0f;
         }
     });
   }

@@ -58,6 +58,19 @@ struct DensityOptions {
   std::vector<std::pair<std::string, double>> layers;
   /// User exclusion rasters (nearest resampling): non-zero cells are uninhabitable.
   std::vector<std::string> exclusions;
+
+  // ---- pre-computed factors (plugins) --------------------------------------------------------
+  /// A factor already on the DEM's grid, values in [0,1], with its weight: it enters the
+  /// combination exactly like a user layer, except that a NaN cell takes no part in that cell's
+  /// combination (the factor has no opinion there; a cell where every weight is then 0 gets 0).
+  struct Factor {
+    std::string name;
+    Raster<float> values;
+    double weight = 1;
+  };
+  std::vector<Factor> factors;
+  /// Exclusion masks already on the DEM's grid: non-zero cells are uninhabitable.
+  std::vector<Raster<std::uint8_t>> exclusion_masks;
 };
 
 /// Figures for the calibration report.

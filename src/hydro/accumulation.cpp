@@ -62,7 +62,7 @@ Raster<double> accumulate(const Dem& filled, const FlowRouter& router,
       stack.pop_back();
       const std::uint8_t bits = receivers[i];
       if (bits == 0) continue;
-      if (std::has_single_bit(bits)) {
+      if ((bits & (bits - 1)) == 0) {  // one bit (std::has_single_bit calls libgcc's popcount without -mpopcnt)
         // One inner receiver takes everything: MFD and D-infinity only split between valid
         // cells, so no share of a single-receiver cell leaves the grid. No split to compute.
         const std::size_t n = std::size_t(std::ptrdiff_t(i) + neighbour_offset(cols, std::countr_zero(bits)));

@@ -14,8 +14,6 @@
 
 namespace terrapolis::hydro {
 namespace {
-// Order in which a sender feeds its neighbours (fixed, so sums are reproducible).
-constexpr int kGatherOrder[8] = {5, 6, 7, 4, 0, 3, 2, 1};
 constexpr int kSafetyCap = 160;  // |F| <= ~8^t: |F|^2 stays below DBL_MAX up to t ~ 170
 }  // namespace
 
@@ -80,9 +78,9 @@ BelhadjModel::BelhadjModel(const Dem& dem, const CellMetrics& metrics, VerticalS
 
 namespace {
 
-// The two passes over one row, written column-innermost on restrict pointers so that the
-// compiler vectorises them (sqrt included: the file is built with -fno-math-errno). Only
-// element-wise IEEE operations and per-cell sums in a fixed order are used, so every ISA
+// The kernels below are written column-innermost on restrict pointers so that the compiler
+// vectorises them (sqrt included: the file is built with -fno-math-errno). Only element-wise IEEE
+// operations and per-cell sums in a fixed order are used (no contraction into FMA), so every ISA
 // variant (target_clones) gives the same bits.
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 #define TP_KERNEL __attribute__((target_clones("avx2", "default")))
@@ -104,61 +102,98 @@ struct State {
   double* __restrict q2;
 };
 
-/// One sender row of `n` cells starting at padded index i0: computes its 8 R_i, N_i = |R_i| and
-/// S_i = R_i . V_i, Σn, Acc += Q, then adds R_i and N_i Q / Σn to the fed receivers (scatter,
-/// as the thesis's loop). `scratch` holds 9 n doubles. Returns Σ Q over the row.
-TP_KERNEL double sender_row(const State& st, std::size_t i0, int n, const std::ptrdiff_t* off, const int* order,
-                            const double* hx, const double* hy, bool all, double* __restrict scratch) {
+/// What one sender row sends: for each direction k, N_k = |R_k| where neighbour k is inside and
+/// fed (R_k . V_k > 0), else 0; and the share factor Q / Σn. Each array has a zero cell on both
+/// sides so that a receiver row can read its neighbours' columns c-1 and c+1 without a test.
+struct SenderRow {
+  std::vector<double> buffer;
+  int n = 0;
+  void resize(int cols) {
+    n = cols + 2;
+    buffer.assign(9 * std::size_t(n), 0.0);
+  }
+  double* norm(int k) { return buffer.data() + std::size_t(k) * std::size_t(n) + 1; }
+  double* factor() { return buffer.data() + 8 * std::size_t(n) + 1; }
+};
+
+/// Pass 1 (sender row of `n` cells at padded index i0): N_k, Σn, the factor Q / Σn, Acc += Q.
+/// Outside cells (valid 0) send nothing. `own`: the row is the caller's (not a neighbour band's
+/// edge row computed again), so Acc is updated. Returns Σ Q over the row (column order).
+TP_KERNEL double send_row(const State& st, std::size_t i0, int n, const std::ptrdiff_t* off, const double* hx,
+                          const double* hy, bool all, bool own, double* const* norms, double* __restrict factor) {
   const double* __restrict z = st.z + i0;
+  const double* __restrict valid = st.valid + i0;
   const double* __restrict fx = st.fx + i0;
   const double* __restrict fy = st.fy + i0;
   const double* __restrict fz = st.fz + i0;
   const double* __restrict q = st.q + i0;
-  double* __restrict sn = scratch;
-  // 8 rows of N_i for the fed inside neighbours, 0 for the others (a fed neighbour with N_i = 0
-  // has R_i = 0 and so receives nothing either way).
-  double* __restrict norms = scratch + n;
+  double* __restrict acc = st.acc + i0;
   const double keep = all ? 1.0 : 0.0;  // Σn over unfed neighbours too (Algorithm 12 as printed)
-  for (int c = 0; c < n; ++c) sn[c] = 0.0;
+  for (int c = 0; c < n; ++c) factor[c] = 0.0;  // Σn, in neighbour order
   for (int k = 0; k < 8; ++k) {
     const double* __restrict zn = z + off[k];
-    const double* __restrict vn = st.valid + i0 + off[k];
-    double* __restrict nk = norms + std::size_t(k) * std::size_t(n);
+    const double* __restrict vn = valid + off[k];
+    double* __restrict nk = norms[k];
     const double vx = hx[k], vy = hy[k];
     for (int c = 0; c < n; ++c) {
       const double dz = zn[c] - z[c];
       const double rx = fx[c] + vx, ry = fy[c] + vy, rz = fz[c] + dz;
       const double s = rx * vx + ry * vy + rz * dz;
       const double norm = std::sqrt(rx * rx + ry * ry + rz * rz);
-      const double inside = vn[c];  // loaded unconditionally so the loop has no branch
-      nk[c] = s > 0 ? inside * norm : 0.0;
-      sn[c] += s > 0 ? norm : keep * norm;
+      // Both validities loaded unconditionally so the loop has no branch.
+      nk[c] = s > 0 ? vn[c] * valid[c] * norm : 0.0;
+      factor[c] += s > 0 ? norm : keep * norm;
     }
   }
+  for (int c = 0; c < n; ++c) factor[c] = factor[c] > 0 ? q[c] / factor[c] : 0.0;
+  if (!own) return 0;
   double sum = 0;
-  for (int c = 0; c < n; ++c) {
-    st.acc[i0 + std::size_t(c)] += q[c];
-    sn[c] = sn[c] > 0 ? q[c] / sn[c] : 0.0;  // from here on: the share factor Q / Σn
-  }
+  for (int c = 0; c < n; ++c) acc[c] += q[c];
   for (int c = 0; c < n; ++c) sum += q[c];
-  for (int g = 0; g < 8; ++g) {
-    const int k = order[g];
-    const double* __restrict zn = z + off[k];
-    const double* __restrict nk = norms + std::size_t(k) * std::size_t(n);
-    double* __restrict ox = st.fx2 + i0 + off[k];
-    double* __restrict oy = st.fy2 + i0 + off[k];
-    double* __restrict oz = st.fz2 + i0 + off[k];
-    double* __restrict oq = st.q2 + i0 + off[k];
-    const double vx = hx[k], vy = hy[k];
-    for (int c = 0; c < n; ++c) {
-      const double m = nk[c] > 0 ? 1.0 : 0.0;
-      ox[c] += m * (fx[c] + vx);
-      oy[c] += m * (fy[c] + vy);
-      oz[c] += m * (fz[c] + (zn[c] - z[c]));
-      oq[c] += m * (nk[c] * sn[c]);
-    }
-  }
   return sum;
+}
+
+/// Pass 2 (receiver row of `n` cells; fx..z point at its first cell): each cell pulls from its 8
+/// neighbours, in neighbour order, what they send it: R = F(s) + V(s→c) where fed, and the water
+/// N Q(s) / Σn(s). `norms[k]` and `factors[k]` point at what neighbour k's row sends, column-aligned
+/// with this row; (vx[k], vy[k]) is the horizontal step from neighbour k to the cell. The sums stay
+/// in registers (the direction loop is unrolled inside the column loop) and the restrict parameters
+/// let GCC vectorise the column loop without run-time alias checks.
+TP_KERNEL void receive_row(int n, const double* __restrict fx, const double* __restrict fy,
+                           const double* __restrict fz, const double* __restrict z, const std::ptrdiff_t* offsets,
+                           const double* const* norms, const double* const* factors, const double* vxs,
+                           const double* vys, double* __restrict fx2, double* __restrict fy2,
+                           double* __restrict fz2, double* __restrict q2) {
+  std::ptrdiff_t off[8];
+  const double* ns[8];
+  const double* ws[8];
+  double vx[8], vy[8];
+  for (int k = 0; k < 8; ++k) {
+    off[k] = offsets[k];
+    ns[k] = norms[k];
+    ws[k] = factors[k];
+    vx[k] = vxs[k];
+    vy[k] = vys[k];
+  }
+  for (int c = 0; c < n; ++c) {
+    double ax = 0, ay = 0, az = 0, aq = 0;
+#pragma GCC unroll 8
+    for (int k = 0; k < 8; ++k) {
+      // A 0/1 factor rather than a select or a test (GCC would make a conditional store of it):
+      // R is finite (the iteration cap keeps |F| below 8^160), so 0 * R is 0 and adding it is exact.
+      const double norm = ns[k][c];
+      const double fed = norm > 0 ? 1.0 : 0.0;
+      const std::ptrdiff_t s = c + off[k];
+      ax += fed * (fx[s] + vx[k]);
+      ay += fed * (fy[s] + vy[k]);
+      az += fed * (fz[s] + (z[c] - z[s]));
+      aq += norm * ws[k][c];
+    }
+    fx2[c] = ax;
+    fy2[c] = ay;
+    fz2[c] = az;
+    q2[c] = aq;
+  }
 }
 
 }  // namespace
@@ -167,27 +202,53 @@ double BelhadjModel::step() {
   std::ptrdiff_t off[8];
   for (int k = 0; k < 8; ++k) off[k] = std::ptrdiff_t(drow[k]) * stride_ + dcol[k];
   const bool all = share_ == BelhadjShare::all_neighbours;
-  std::fill(fx2_.begin(), fx2_.end(), 0.0);
-  std::fill(fy2_.begin(), fy2_.end(), 0.0);
-  std::fill(fz2_.begin(), fz2_.end(), 0.0);
-  std::fill(q2_.begin(), q2_.end(), 0.0);
   const State st{z_.data(), valid_.data(), fx_.data(), fy_.data(), fz_.data(), q_.data(), acc_.data(),
                  fx2_.data(), fy2_.data(), fz2_.data(), q2_.data()};
-  // A sender row writes to rows r-1..r+1, so rows 3 apart never write the same cell: three
-  // phases (r mod 3), each parallel over its rows. Every receiver then sums its inputs in the
-  // same order (by phase, then neighbour order) whatever the number of threads.
-  for (int phase = 0; phase < 3; ++phase) {
-    const int count = (rows_ - phase + 2) / 3;
-    tbb::parallel_for(tbb::blocked_range<int>(0, count), [&](const tbb::blocked_range<int>& range) {
-      std::vector<double> scratch(9 * static_cast<std::size_t>(cols_));
-      for (int t = range.begin(); t < range.end(); ++t) {
-        const int r = phase + 3 * t;
-        const std::size_t pr = std::size_t(r + 1), i0 = pr * std::size_t(stride_) + 1;
-        row_sum_[std::size_t(r)] =
-            sender_row(st, i0, cols_, off, kGatherOrder, &hx_[pr * 8], &hy_[pr * 8], all, scratch.data());
-      }
-    });
-  }
+  // Bands of rows, each computing what its rows and the rows just outside it send (the edge rows
+  // are computed twice), then gathering row by row. Every value is a function of the previous
+  // state alone, summed in a fixed order: bit-identical whatever the bands and threads.
+  const int grain = std::max(8, std::min(64, rows_ / 8));
+  tbb::parallel_for(
+      tbb::blocked_range<int>(0, rows_, grain),
+      [&](const tbb::blocked_range<int>& range) {
+        SenderRow ring[3];
+        for (auto& row : ring) row.resize(cols_);
+        SenderRow empty;  // what the halo rows send: nothing
+        empty.resize(cols_);
+        auto sender = [&](int r) -> SenderRow* {
+          return r < 0 || r >= rows_ ? &empty : &ring[std::size_t((r + 3) % 3)];
+        };
+        auto send = [&](int r) {
+          if (r < 0 || r >= rows_) return;
+          SenderRow& row = *sender(r);
+          double* norms[8];
+          for (int k = 0; k < 8; ++k) norms[k] = row.norm(k);
+          const std::size_t pr = std::size_t(r + 1), i0 = pr * std::size_t(stride_) + 1;
+          const bool own = r >= range.begin() && r < range.end();
+          const double sum = send_row(st, i0, cols_, off, &hx_[pr * 8], &hy_[pr * 8], all, own, norms, row.factor());
+          if (own) row_sum_[std::size_t(r)] = sum;
+        };
+        send(range.begin() - 1);
+        send(range.begin());
+        for (int r = range.begin(); r < range.end(); ++r) {
+          send(r + 1);
+          const double* norms[8];
+          const double* factors[8];
+          double vx[8], vy[8];
+          for (int k = 0; k < 8; ++k) {
+            const int rs = r + drow[k], back = opposite(k);  // back: from the sender to this cell
+            norms[k] = sender(rs)->norm(back) + dcol[k];
+            factors[k] = sender(rs)->factor() + dcol[k];
+            const std::size_t ps = std::size_t(std::clamp(rs, -1, rows_) + 1);
+            vx[k] = hx_[ps * 8 + std::size_t(back)];
+            vy[k] = hy_[ps * 8 + std::size_t(back)];
+          }
+          const std::size_t i0 = std::size_t(r + 1) * std::size_t(stride_) + 1;
+          receive_row(cols_, st.fx + i0, st.fy + i0, st.fz + i0, st.z + i0, off, norms, factors, vx, vy, st.fx2 + i0,
+                      st.fy2 + i0, st.fz2 + i0, st.q2 + i0);
+        }
+      },
+      tbb::simple_partitioner());
   fx_.swap(fx2_);
   fy_.swap(fy2_);
   fz_.swap(fz2_);

@@ -39,13 +39,13 @@ class BelhadjModel {
   BelhadjModel(const Dem& dem, const CellMetrics& metrics, VerticalScale vertical, std::optional<double> sea_level,
                BelhadjShare share = BelhadjShare::all_neighbours);
 
-  /// One iteration of Algorithm 12, simultaneously for all cells (double buffer): each cell c
+  /// One iteration of Algorithm 12, simultaneously for all cells (double buffer): each valid cell c
   /// sends R_i = F(c) + V_i(c) and the share |R_i| Q(c) / Σ_j |R_j| of its water to every inside
-  /// neighbour i with R_i . V_i(c) > 0 (Σ over all 8 neighbours, so the rest is lost);
-  /// Acc += Q. Returns the mean Q over valid cells before the step (the thesis's stop test).
-  /// Parallel over rows in three phases (rows 3 apart never write the same cell), each sum in a
-  /// fixed order: bit-identical
-  /// for any thread count.
+  /// neighbour i with R_i . V_i(c) > 0 (Σ over all 8 neighbours, or the fed ones); Acc += Q.
+  /// Outside cells send nothing. Returns the mean Q over valid cells before the step (the
+  /// thesis's stop test). Computed as a gather in two passes per row band (what each cell sends,
+  /// then what each cell pulls from its 8 neighbours, summed in neighbour order k = 0..7 of
+  /// core/neighbours.hpp): bit-identical for any thread count.
   double step();
 
   int cols() const { return cols_; }
@@ -59,6 +59,11 @@ class BelhadjModel {
   }
   /// Altitude used for the outside cells (normalised16: -1; metres: min - (max - min), at least 1 m below).
   double outside_altitude() const { return z_out_; }
+  /// Horizontal part (dx east, dy south) of V_i for a cell of DEM row `row` and neighbour k.
+  std::array<double, 2> step_vector(int row, int k) const {
+    const std::size_t i = std::size_t(row + 1) * 8 + std::size_t(k);
+    return {hx_[i], hy_[i]};
+  }
   bool valid(int col, int row) const { return valid_[at(col, row)] != 0; }
 
  private:

@@ -2,7 +2,11 @@
 // SPDX-License-Identifier: MIT
 #include "hydro/depressions.hpp"
 
+#include <algorithm>
+#include <array>
+#include <bit>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <functional>
 #include <deque>
@@ -22,18 +26,68 @@ inline std::uint64_t key(float z, std::uint32_t i) {
   bits = (bits & 0x80000000u) ? ~bits : (bits | 0x80000000u);
   return (std::uint64_t(bits) << 32) | i;
 }
-using MinQueue = std::priority_queue<std::uint64_t, std::vector<std::uint64_t>, std::greater<>>;
+
+/// Binary heap on the keys: pops in (elevation, index) order, the order epsilon filling and
+/// breaching depend on.
+class HeapQueue {
+ public:
+  bool empty() const { return heap_.empty(); }
+  void push(std::uint64_t item) { heap_.push(item); }
+  std::uint64_t pop() {
+    const std::uint64_t top = heap_.top();
+    heap_.pop();
+    return top;
+  }
+
+ private:
+  std::priority_queue<std::uint64_t, std::vector<std::uint64_t>, std::greater<>> heap_;
+};
+
+/// Radix heap (Ahuja, Mehlhorn, Orlin, Tarjan 1990) on the 32 elevation bits of the keys: a
+/// monotone queue (Priority-Flood never pushes below the last popped elevation) in O(1) amortised
+/// per item instead of a heap's O(log n) cache misses. Equal elevations pop in no fixed index
+/// order, which plain filling does not see: its result, each cell raised to the lowest spill
+/// elevation of any path to an outlet, does not depend on the order of ties.
+class RadixQueue {
+ public:
+  bool empty() const { return size_ == 0; }
+  void push(std::uint64_t item) {
+    buckets_[std::size_t(bucket(std::uint32_t(item >> 32)))].push_back(item);
+    ++size_;
+  }
+  std::uint64_t pop() {
+    if (buckets_[0].empty()) {
+      std::size_t b = 1;
+      while (buckets_[b].empty()) ++b;
+      std::uint32_t lowest = 0xffffffffu;
+      for (std::uint64_t item : buckets_[b]) lowest = std::min(lowest, std::uint32_t(item >> 32));
+      last_ = lowest;
+      for (std::uint64_t item : buckets_[b]) buckets_[std::size_t(bucket(std::uint32_t(item >> 32)))].push_back(item);
+      buckets_[b].clear();
+    }
+    const std::uint64_t item = buckets_[0].back();
+    buckets_[0].pop_back();
+    --size_;
+    return item;
+  }
+
+ private:
+  int bucket(std::uint32_t key) const { return key == last_ ? 0 : 32 - std::countl_zero(key ^ last_); }
+  std::array<std::vector<std::uint64_t>, 33> buckets_;
+  std::uint32_t last_ = 0;
+  std::size_t size_ = 0;
+};
 
 /// The Priority-Flood of Barnes et al. 2014, Algorithm 2 (with its plain queue for cells inside
 /// depressions) or 3 (epsilon). `visit(cell, parent_direction)` is told the neighbour index k from
 /// which each non-seed cell was flooded, in flood order (used by breaching).
-template <class Visit>
+template <class Queue, class Visit>
 void priority_flood(Dem& z, const std::optional<double>& sea_level, bool epsilon, bool raise, Progress& progress,
                     Visit&& visit) {
   ProgressStep step(progress, epsilon ? "fill (epsilon)" : "fill");
   const int cols = z.cols(), rows = z.rows();
   std::vector<std::uint8_t> closed(z.size(), 0);
-  MinQueue open;
+  Queue open;
   std::deque<std::uint32_t> pit;
   // Seeds: every outlet (border, next to nodata, sea).
   for (int r = 0; r < rows; ++r)
@@ -56,8 +110,7 @@ void priority_flood(Dem& z, const std::optional<double>& sea_level, bool epsilon
       i = pit.front();
       pit.pop_front();
     } else {
-      i = std::uint32_t(open.top());
-      open.pop();
+      i = std::uint32_t(open.pop());
     }
     if (++done % report == 0) step.update(double(done) / double(z.size()));
     const int c = int(i % std::uint32_t(cols)), r = int(i / std::uint32_t(cols));
@@ -89,8 +142,10 @@ Dem fill_depressions(const Dem& dem, const FillOptions& options, Progress& progr
       return z;
     case FillMethod::priority_flood:
     case FillMethod::epsilon:
-      priority_flood(z, options.sea_level, options.method == FillMethod::epsilon, true, progress,
-                     [](std::size_t, int) {});
+      if (options.method == FillMethod::epsilon)
+        priority_flood<HeapQueue>(z, options.sea_level, true, true, progress, [](std::size_t, int) {});
+      else
+        priority_flood<RadixQueue>(z, options.sea_level, false, true, progress, [](std::size_t, int) {});
       return z;
     case FillMethod::breach: {
       // Flood on a filled copy to get the flooding tree (each cell's parent is the cell that
@@ -100,7 +155,7 @@ Dem fill_depressions(const Dem& dem, const FillOptions& options, Progress& progr
       std::vector<std::uint32_t> order;
       order.reserve(dem.size());
       std::vector<std::uint8_t> parent(dem.size(), kTerminal);
-      priority_flood(flooded, options.sea_level, false, true, progress, [&](std::size_t n, int k) {
+      priority_flood<HeapQueue>(flooded, options.sea_level, false, true, progress, [&](std::size_t n, int k) {
         order.push_back(std::uint32_t(n));
         parent[n] = std::uint8_t(k);
       });
@@ -117,85 +172,113 @@ Dem fill_depressions(const Dem& dem, const FillOptions& options, Progress& progr
   return z;
 }
 
-FlatGradient resolve_flats(const Dem& filled, const Raster<std::uint8_t>& d8) {
+void drain_flats(const Dem& filled, Raster<std::uint8_t>& d8) {
+  // Everything works on a grid padded with one cell of "outside" (kind 0, label 0) so that the
+  // waves need no bounds test and no division, and the label and gradient of a cell share one
+  // 8-byte slot: a wave step reads one array. The waves are the breadth-first rings of Barnes
+  // 2014b; each cell's value depends only on its ring distance, not on visiting order.
   const int cols = filled.cols(), rows = filled.rows();
-  FlatGradient out{filled.like<std::int32_t>(0), filled.like<std::int32_t>(0)};
-  auto& mask = out.mask;
-  auto& labels = out.labels;
-  std::vector<std::uint32_t> low, high;
-  // Edges (Barnes 2014b, Algorithm 3): a low edge drains and has a same-elevation undrained
-  // neighbour; a high edge is undrained with a higher neighbour. Only undrained cells and their
-  // neighbours can be edges, so only they are looked at; the waves below depend on the ring
-  // distances only, not on the order of the edges.
-  std::vector<std::uint8_t> is_low(0);
+  const std::size_t width = std::size_t(cols) + 2;
+  const std::size_t padded = width * (std::size_t(rows) + 2);
+  std::ptrdiff_t poff[8], uoff[8];
+  for (int k = 0; k < 8; ++k) {
+    poff[k] = std::ptrdiff_t(drow[k]) * std::ptrdiff_t(width) + dcol[k];
+    uoff[k] = neighbour_offset(cols, k);
+  }
+  // kind: 0 outside, nodata or terminal; 1 draining; 2 undrained (kNoFlow); bit 4: low edge seen.
+  constexpr std::uint8_t kOut = 0, kDrains = 1, kFlat = 2, kLowSeen = 4;
+  BigVector<std::uint8_t> kind(padded, kOut);
   for (int r = 0; r < rows; ++r)
     for (int c = 0; c < cols; ++c) {
-      const std::size_t i = filled.index(c, r);
-      if (d8[i] != kNoFlow) continue;
-      const float zc = filled[i];
+      const std::uint8_t v = d8(c, r);
+      kind[std::size_t(r + 1) * width + std::size_t(c) + 1] =
+          v == kNoData || v == kTerminal ? kOut : v == kNoFlow ? kFlat : kDrains;
+    }
+  auto unpadded = [&](std::size_t p) {
+    const std::size_t r = p / width - 1;
+    return r * std::size_t(cols) + (p - (r + 1) * width - 1);
+  };
+  // Edges (Barnes 2014b, Algorithm 3): a low edge drains and has a same-elevation undrained
+  // neighbour; a high edge is undrained with a higher neighbour.
+  std::vector<std::uint32_t> low, high;  // padded indices
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c) {
+      const std::size_t p = std::size_t(r + 1) * width + std::size_t(c) + 1;
+      if ((kind[p] & 3) != kFlat) continue;
+      const std::size_t u = filled.index(c, r);
+      const float zc = filled[u];
       bool higher = false;
       for (int k = 0; k < 8; ++k) {
-        const int nc = c + dcol[k], nr = r + drow[k];
-        if (!filled.inside(nc, nr)) continue;
-        const std::size_t n = filled.index(nc, nr);
-        const std::uint8_t dn = d8[n];
-        if (dn == kNoData || dn == kTerminal) continue;
-        if (filled[n] > zc) higher = true;
-        if (dn != kNoFlow && filled[n] == zc) {
-          if (is_low.empty()) is_low.assign(filled.size(), 0);
-          if (!is_low[n]) {
-            is_low[n] = 1;
-            low.push_back(std::uint32_t(n));
-          }
+        const std::size_t pn = std::size_t(std::ptrdiff_t(p) + poff[k]);
+        const std::uint8_t kn = kind[pn];
+        if ((kn & 3) == kOut) continue;
+        const float zn = filled[std::size_t(std::ptrdiff_t(u) + uoff[k])];
+        if (zn > zc) higher = true;
+        if ((kn & 3) == kDrains && zn == zc && !(kn & kLowSeen)) {
+          kind[pn] = kn | kLowSeen;
+          low.push_back(std::uint32_t(pn));
         }
       }
-      if (higher) high.push_back(std::uint32_t(i));
+      if (higher) high.push_back(std::uint32_t(p));
     }
-  // Label each flat from its low edges (8-connected cells of equal elevation).
+  if (low.empty()) {  // no flat can drain
+    for (auto& v : d8.values())
+      if (v == kNoFlow) v = kTerminal;
+    return;
+  }
+  // Label each flat from its low edges (8-connected cells of equal elevation): +label on undrained
+  // cells, -label on draining ones, so that a wave step tests membership with one comparison.
+  struct Slot {
+    std::int32_t label;
+    std::int32_t mask;
+  };
+  BigVector<Slot> cell(padded, Slot{0, 0});
   std::int32_t next_label = 1;
-  std::vector<std::uint32_t> stack;
+  std::deque<std::uint64_t> queue;  // padded index << 32 | unpadded index
   for (std::uint32_t seed : low) {
-    if (labels[seed] != 0) continue;
-    const float zf = filled[seed];
-    labels[seed] = next_label;
-    stack.push_back(seed);
-    while (!stack.empty()) {
-      const std::uint32_t i = stack.back();
-      stack.pop_back();
-      const int c = int(i % std::uint32_t(cols)), r = int(i / std::uint32_t(cols));
+    if (cell[seed].label != 0) continue;
+    const std::size_t useed = unpadded(seed);
+    const float zf = filled[useed];
+    cell[seed].label = -next_label;
+    queue.push_back(std::uint64_t(seed) << 32 | useed);
+    // Breadth first: rings stay compact in memory, where a depth-first flood wanders across rows
+    // (5 % faster on S46W066). The partition into flats is the same either way.
+    while (!queue.empty()) {
+      const std::uint64_t top = queue.front();
+      queue.pop_front();
+      const std::size_t p = std::size_t(top >> 32), u = std::size_t(top & 0xffffffffu);
       for (int k = 0; k < 8; ++k) {
-        const int nc = c + dcol[k], nr = r + drow[k];
-        if (!filled.inside(nc, nr)) continue;
-        const std::size_t n = filled.index(nc, nr);
-        if (labels[n] != 0 || filled[n] != zf || d8[n] == kNoData || d8[n] == kTerminal) continue;
-        labels[n] = next_label;
-        stack.push_back(std::uint32_t(n));
+        const std::size_t pn = std::size_t(std::ptrdiff_t(p) + poff[k]);
+        const std::uint8_t kn = kind[pn] & 3;
+        if (kn == kOut || cell[pn].label != 0) continue;
+        const std::size_t un = std::size_t(std::ptrdiff_t(u) + uoff[k]);
+        if (filled[un] != zf) continue;
+        cell[pn].label = kn == kFlat ? next_label : -next_label;
+        queue.push_back(std::uint64_t(pn) << 32 | un);
       }
     }
     ++next_label;
   }
   std::vector<std::int32_t> flat_height(std::size_t(next_label), 0);
   // Breadth-first wave over undrained cells of the same flat, one ring per loop. A cell is
-  // marked (mask > 0 after `set`) when it is first reached, so each is queued once; its value
-  // depends only on its ring, as in Barnes's algorithm where duplicates are skipped when popped.
+  // marked (mask > 0 after `set`) when it is first reached, so each is queued once.
   auto wave = [&](const std::vector<std::uint32_t>& seeds, auto&& set) {
     std::vector<std::uint32_t> front, next;
-    for (std::uint32_t i : seeds)
-      if (mask[i] <= 0) {
-        set(i, 1);
-        front.push_back(i);
+    for (std::uint32_t p : seeds)
+      if (cell[p].mask <= 0) {
+        set(p, 1);
+        front.push_back(p);
       }
     for (std::int32_t loops = 2; !front.empty(); ++loops) {
       next.clear();
-      for (std::uint32_t i : front) {
-        const int c = int(i % std::uint32_t(cols)), r = int(i / std::uint32_t(cols));
+      for (std::uint32_t p : front) {
+        const std::int32_t label = std::abs(cell[p].label);
         for (int k = 0; k < 8; ++k) {
-          const int nc = c + dcol[k], nr = r + drow[k];
-          if (!filled.inside(nc, nr)) continue;
-          const std::size_t n = filled.index(nc, nr);
-          if (mask[n] > 0 || d8[n] != kNoFlow || labels[n] != labels[i]) continue;
-          set(n, loops);
-          next.push_back(std::uint32_t(n));
+          const std::size_t pn = std::size_t(std::ptrdiff_t(p) + poff[k]);
+          const Slot s = cell[pn];
+          if (s.label != label || s.mask > 0) continue;  // not an undrained cell of this flat, or seen
+          set(pn, loops);
+          next.push_back(std::uint32_t(pn));
         }
       }
       std::swap(front, next);
@@ -203,19 +286,38 @@ FlatGradient resolve_flats(const Dem& filled, const Raster<std::uint8_t>& d8) {
   };
   // Gradient away from higher terrain (only high edges of labelled, i.e. drainable, flats).
   std::vector<std::uint32_t> high_labelled;
-  for (std::uint32_t i : high)
-    if (labels[i] != 0) high_labelled.push_back(i);
-  wave(high_labelled, [&](std::size_t i, std::int32_t loops) {
-    mask[i] = loops;
-    flat_height[std::size_t(labels[i])] = loops;
+  for (std::uint32_t p : high)
+    if (cell[p].label != 0) high_labelled.push_back(p);
+  wave(high_labelled, [&](std::size_t p, std::int32_t loops) {
+    cell[p].mask = loops;
+    flat_height[std::size_t(cell[p].label)] = loops;
   });
   // Gradient towards lower terrain, combined: 2*towards + (height - away), always > 0.
-  for (auto& m : mask.values()) m = -m;
-  wave(low, [&](std::size_t i, std::int32_t loops) {
-    if (mask[i] < 0) mask[i] = flat_height[std::size_t(labels[i])] + mask[i] + 2 * loops;
-    else mask[i] = 2 * loops;
+  for (auto& s : cell) s.mask = -s.mask;
+  wave(low, [&](std::size_t p, std::int32_t loops) {
+    Slot& s = cell[p];
+    if (s.mask < 0) s.mask = flat_height[std::size_t(std::abs(s.label))] + s.mask + 2 * loops;
+    else s.mask = 2 * loops;
   });
-  return out;
+  // Directions (Barnes 2014b, D8FlowFlats): towards the same-flat neighbour of smallest gradient,
+  // the first in neighbour order on ties; none smaller than the cell itself: terminal.
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c) {
+      const std::size_t p = std::size_t(r + 1) * width + std::size_t(c) + 1;
+      if ((kind[p] & 3) != kFlat) continue;
+      const std::int32_t label = cell[p].label;  // > 0 on a labelled undrained cell
+      int best = -1;
+      std::int32_t best_mask = cell[p].mask;
+      if (label != 0)
+        for (int k = 0; k < 8; ++k) {
+          const Slot s = cell[std::size_t(std::ptrdiff_t(p) + poff[k])];
+          if (std::abs(s.label) == label && s.mask < best_mask) {
+            best_mask = s.mask;
+            best = k;
+          }
+        }
+      d8(c, r) = best >= 0 ? std::uint8_t(best) : kTerminal;
+    }
 }
 
 }  // namespace terrapolis::hydro

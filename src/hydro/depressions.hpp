@@ -12,7 +12,7 @@ namespace terrapolis::hydro {
 enum class FillMethod {
   /// Priority-Flood (Barnes, Lehman, Mulla 2014, "Priority-Flood: an optimal depression-filling and
   /// watershed-labeling algorithm", Algorithm 2): depressions raised to their spill elevation,
-  /// leaving flats that `resolve_flats` then drains.
+  /// leaving flats that `drain_flats` then drains.
   priority_flood,
   /// Priority-Flood+epsilon (same paper, Algorithm 3): each raised cell is one float ulp above the
   /// cell that floods it (std::nextafter), so every cell has a strictly lower neighbour.
@@ -41,22 +41,16 @@ struct FillOptions {
 /// (breach: 6 bytes/cell).
 Dem fill_depressions(const Dem& dem, const FillOptions& options, Progress& progress);
 
-/// Flat resolution result (Barnes, Lehman, Mulla 2014, "An efficient assignment of drainage
-/// direction over flat surfaces in raster digital elevation models", Computers & Geosciences 62).
-struct FlatGradient {
-  /// Per cell: 0 outside flats; in a flat, an increment combining "away from higher terrain" and
-  /// "towards lower terrain" (twice weighted): water goes to the neighbour of the same flat with
-  /// the smallest value.
-  Raster<std::int32_t> mask;
-  /// Per cell: 0 outside flats, else the label (1..) of the flat the cell belongs to.
-  Raster<std::int32_t> labels;
-};
-
-/// Computes the flat gradient of `filled` given first-pass D8 receivers `d8` (0..7, kTerminal,
-/// kNoData, and kNoFlow for cells without a strictly lower neighbour that are not outlets).
-/// @post following the smallest-mask neighbour of the same label from a kNoFlow cell of a flat
-///   that has an outlet reaches a draining cell in finitely many steps (mask strictly decreases).
-FlatGradient resolve_flats(const Dem& filled, const Raster<std::uint8_t>& d8);
+/// Drains flats (Barnes, Lehman, Mulla 2014, "An efficient assignment of drainage direction over
+/// flat surfaces in raster digital elevation models", Computers & Geosciences 62): every kNoFlow
+/// cell of `d8` (first-pass receivers of `filled`: 0..7, kTerminal, kNoData, kNoFlow) gets the
+/// neighbour of its flat with the smallest gradient value, the gradient combining "away from higher
+/// terrain" and "towards lower terrain" (twice weighted); cells of flats without an outlet get
+/// kTerminal. A flat is a set of 8-connected cells of equal elevation that holds a low edge (a
+/// draining cell next to an undrained one).
+/// @post from every kNoFlow cell of a drainable flat, following d8 reaches a draining cell (the
+///   gradient strictly decreases along the way).
+void drain_flats(const Dem& filled, Raster<std::uint8_t>& d8);
 
 /// First-pass code: a valid cell with no strictly lower neighbour that is not an outlet.
 inline constexpr std::uint8_t kNoFlow = 9;

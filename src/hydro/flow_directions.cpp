@@ -63,27 +63,7 @@ Raster<std::uint8_t> d8_directions(const Dem& filled, const CellMetrics& metrics
     }
   step.update(0.5);
   if (!any_flat) return d8;
-  // Flats (Barnes et al. 2014b, D8FlowFlats): towards the same-flat neighbour of smallest mask.
-  const FlatGradient flats = resolve_flats(filled, d8);
-  for (int r = 0; r < filled.rows(); ++r)
-    for (int c = 0; c < filled.cols(); ++c) {
-      const std::size_t i = d8.index(c, r);
-      if (d8[i] != kNoFlow) continue;
-      const std::int32_t label = flats.labels[i];
-      int best = -1;
-      std::int32_t best_mask = flats.mask[i];
-      if (label != 0)
-        for (int k = 0; k < 8; ++k) {
-          const int nc = c + dcol[k], nr = r + drow[k];
-          if (!filled.inside(nc, nr)) continue;
-          const std::size_t n = d8.index(nc, nr);
-          if (flats.labels[n] == label && flats.mask[n] < best_mask) {
-            best_mask = flats.mask[n];
-            best = k;
-          }
-        }
-      d8[i] = best >= 0 ? std::uint8_t(best) : kTerminal;
-    }
+  drain_flats(filled, d8);  // Barnes et al. 2014b
   return d8;
 }
 
@@ -220,6 +200,20 @@ std::uint8_t FlowRouter::inner_receivers(int c, int r) const {
     const int k = d8_(c, r);
     if (k >= 8 || !valid(z_, c + dcol[k], r + drow[k])) return 0;
     return std::uint8_t(1u << k);
+  }
+  if (method_ == FlowMethod::mfd) {
+    // The receivers of split() without its weights (no pow): every valid strictly lower neighbour
+    // (all of them inside the grid), else the D8 receiver.
+    const std::uint8_t d = d8_(c, r);
+    if (d == kNoData || d == kTerminal) return 0;
+    const float zc = z_(c, r);
+    std::uint8_t bits = 0;
+    for (int k = 0; k < 8; ++k) {
+      const int nc = c + dcol[k], nr = r + drow[k];
+      if (valid(z_, nc, nr) && double(zc) - double(z_(nc, nr)) > 0) bits = std::uint8_t(bits | (1u << k));
+    }
+    if (bits != 0) return bits;
+    return valid(z_, c + dcol[d], r + drow[d]) ? std::uint8_t(1u << d) : 0;
   }
   FlowSplit s;
   split(c, r, s);

@@ -30,7 +30,7 @@ enum class D8Codes {
 /// sea cell, unfilled pit or undrainable flat) or kNoData.
 /// Slopes are drops over geodesic centre distances (CellMetrics::step_m); ties go to the lowest k.
 /// Cells on the border or next to nodata with no lower valid neighbour flow out of the grid (their
-/// code points to the first outside neighbour). Flats get directions from `resolve_flats`
+/// code points to the first outside neighbour). Flats get directions from `drain_flats`
 /// (Barnes et al. 2014). Parallel over rows, deterministic.
 Raster<std::uint8_t> d8_directions(const Dem& filled, const CellMetrics& metrics, const std::optional<double>& sea_level,
                                    Progress& progress);

@@ -3,7 +3,14 @@
 #pragma once
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
+#include <memory>
+#include <new>
 #include <optional>
+#include <vector>
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
 
 #include "core/neighbours.hpp"
 #include "core/raster.hpp"
@@ -26,6 +33,39 @@ inline bool touches_outside(const Dem& dem, int col, int row) {
     if (std::isnan(dem(col + dcol[k], row + drow[k]))) return true;
   return false;
 }
+
+/// Allocator for the large per-cell scratch arrays of the kernels: blocks of 4 MiB or more are
+/// 2 MiB-aligned and marked for transparent huge pages (Linux madvise; a hint, ignored elsewhere
+/// or when disabled), which spares the TLB misses of breadth-first waves that touch every row.
+template <class T>
+struct HugePageAllocator {
+  using value_type = T;
+  static constexpr std::size_t kHuge = std::size_t(2) << 20;
+  static constexpr std::size_t kMinimum = std::size_t(4) << 20;
+  HugePageAllocator() = default;
+  template <class U>
+  HugePageAllocator(const HugePageAllocator<U>&) {}
+  T* allocate(std::size_t n) {
+    const std::size_t bytes = n * sizeof(T);
+    if (bytes < kMinimum) return std::allocator<T>{}.allocate(n);
+    void* p = std::aligned_alloc(kHuge, (bytes + kHuge - 1) / kHuge * kHuge);
+    if (!p) throw std::bad_alloc();
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    madvise(p, (bytes + kHuge - 1) / kHuge * kHuge, MADV_HUGEPAGE);
+#endif
+    return static_cast<T*>(p);
+  }
+  void deallocate(T* p, std::size_t n) {
+    if (n * sizeof(T) < kMinimum) std::allocator<T>{}.deallocate(p, n);
+    else std::free(p);
+  }
+  template <class U>
+  bool operator==(const HugePageAllocator<U>&) const { return true; }
+};
+
+/// A per-cell scratch array (see HugePageAllocator).
+template <class T>
+using BigVector = std::vector<T, HugePageAllocator<T>>;
 
 /// Index offset of neighbour k in a row-major grid of `cols` columns.
 inline std::ptrdiff_t neighbour_offset(int cols, int k) { return std::ptrdiff_t(drow[k]) * cols + dcol[k]; }

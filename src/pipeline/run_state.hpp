@@ -13,12 +13,18 @@
 #include "io/raster_io.hpp"
 #include "io/vector_io.hpp"
 #include "pipeline/scenario.hpp"
+#include "plugin/plugin.hpp"
+#include "sites/sites.hpp"
 
 namespace terrapolis::pipeline {
 
 /// How a layer is drawn in QGIS and in the preview.
 enum class Style { elevation, hillshade, unit_ramp, density, mask, flow_direction, accumulation,
                    streams, cities, city_extents, network, roads, road_sections };
+
+/// Style names as recorded in run.json ("elevation", "road_sections"...), and back.
+const char* style_name(Style style);
+Style style_from_name(const std::string& name);
 
 /// One file of the run folder.
 struct OutputFile {
@@ -31,20 +37,28 @@ struct OutputFile {
 };
 
 struct RunState {
+  RunState(const Scenario& s, std::filesystem::path run_folder, std::string sha256, Dem elevation)
+      : scenario(s), folder(std::move(run_folder)), dem_sha256(std::move(sha256)), dem(std::move(elevation)) {}
+
   const Scenario& scenario;
   std::filesystem::path folder;  ///< the run folder being written (a temporary name until the end)
   std::string dem_sha256;
   Dem dem;
+  plugin::PluginSet plugins;  ///< the scenario's plugins, loaded and checked before any work
   // Typed results of the stages, filled in data-flow order.
-  std::optional<Raster<float>> hydrometry;
-  std::optional<Raster<float>> density;
+  std::optional<Raster<float>> hydrometry;        ///< hydro: [0,1]
+  std::optional<Raster<float>> density;           ///< density: [0,1]
+  std::optional<Raster<std::uint8_t>> buildable;  ///< density: 1 habitable, 0 not, 255 nodata
+  std::vector<sites::Site> sites;                 ///< sites: sorted by radius, decreasing
+  std::optional<VectorLayer> cities, network;     ///< sites and network layers, in the DEM's CRS
   std::vector<OutputFile> outputs;
   std::vector<std::pair<Style, VectorLayer>> vectors;  ///< vector layers written, kept for the preview
   nlohmann::ordered_json summary = nlohmann::ordered_json::object();  ///< per-stage figures for the summary and compare
 
   /// Writes a raster of the run with provenance metadata, and records it.
   template <class T>
-  void write(const std::string& stage, const std::string& name, const Raster<T>& raster, const std::string& description, Style style);
+  void write(const std::string& stage, const std::string& name, const Raster<T>& raster, const std::string& description, Style style,
+             const std::vector<std::pair<std::string, std::string>>& metadata = {});
   /// Writes a vector layer of the run and records it.
   void write(const std::string& stage, const std::string& name, const VectorLayer& layer, const std::string& description, Style style);
 };

@@ -5,17 +5,17 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
-#include <sstream>
 
 #include "core/error.hpp"
 #include "io/checksum.hpp"
 #include "io/raster_io.hpp"
-#include "pipeline/hillshade.hpp"
 #include "pipeline/publish.hpp"
 #include "pipeline/run_state.hpp"
+#include "pipeline/stages.hpp"
 #include "terrapolis/version.hpp"
 
 namespace terrapolis::pipeline {
@@ -23,37 +23,89 @@ namespace {
 
 using json = nlohmann::ordered_json;
 
-struct StageDef {
-  const char* name;
-  void (*run)(RunState&, Progress&, const Log&);
-};
-
-void terrain_stage(RunState& s, Progress&, const Log&) {
-  s.write("terrain", "elevation.tif", s.dem, "elevation in metres (as read from the input DEM)", Style::elevation);
-  s.write("terrain", "hillshade.tif", hillshade(s.dem), "hillshade (Horn 1981), light from 315 deg at 45 deg", Style::hillshade);
-  double lo = 1e300, hi = -1e300;
-  std::size_t valid = 0;
-  for (float v : s.dem.values()) {
-    if (std::isnan(v)) continue;
-    lo = std::min(lo, double(v));
-    hi = std::max(hi, double(v));
-    ++valid;
-  }
-  s.summary["terrain"] = {{"cols", s.dem.cols()}, {"rows", s.dem.rows()}, {"min_m", lo}, {"max_m", hi},
-                          {"nodata_share", 1.0 - double(valid) / double(s.dem.size())}};
-}
-
-/// The stages, in data-flow order: the one list the runner, --help and the docs read.
-std::vector<StageDef> stages() {
-  return {
-      {"terrain", terrain_stage},
-  };
-}
-
 long peak_rss_kb() {
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
   return usage.ru_maxrss;
+}
+
+
+/// What a run does with each stage.
+enum class Action { run, load, keep };
+
+std::size_t stage_index(const std::string& option, const std::string& name) {
+  std::string names;
+  for (std::size_t i = 0; i < stages().size(); ++i) {
+    if (name == stages()[i].name) return i;
+    names += std::string(i ? ", " : "") + stages()[i].name;
+  }
+  throw bad_input(option + ": unknown stage '" + name + "' (stages: " + names + ")");
+}
+
+/// --from X: the stages before X are read back, X and after run. --only S...: those run, the
+/// stages before the last of them are read back, the stages after it keep their saved files.
+std::vector<Action> plan_stages(const RunOptions& options) {
+  const std::size_t n = stages().size();
+  if (!options.from.empty() && !options.only.empty()) throw bad_input("--from and --only: give one or the other");
+  std::vector<Action> plan(n, Action::run);
+  if (!options.from.empty()) {
+    const std::size_t from = stage_index("--from", options.from);
+    for (std::size_t i = 0; i < from; ++i) plan[i] = Action::load;
+  } else if (!options.only.empty()) {
+    std::vector<bool> only(n, false);
+    std::size_t last = 0;
+    for (const auto& name : options.only) {
+      const std::size_t i = stage_index("--only", name);
+      only[i] = true;
+      last = std::max(last, i);
+    }
+    for (std::size_t i = 0; i < n; ++i) plan[i] = only[i] ? Action::run : i < last ? Action::load : Action::keep;
+  }
+  return plan;
+}
+
+json read_manifest(const std::filesystem::path& folder) {
+  std::ifstream in(folder / "run.json");
+  if (!in) throw bad_input(folder.string() + ": no saved run to rerun from (run.json missing; run the whole scenario first)");
+  try {
+    return json::parse(in);
+  } catch (const json::exception&) {
+    throw bad_input((folder / "run.json").string() + ": not a valid run record");
+  }
+}
+
+/// A saved stage can be reused only for the same DEM and the same parameters of it and of every
+/// stage before it; otherwise its results would not be what the new scenario asks.
+void check_reusable(const std::filesystem::path& folder, const json& saved, const Scenario& scenario, const std::string& dem_sha256,
+                    const std::vector<Action>& plan) {
+  if (saved["input"].value("sha256", "") != dem_sha256)
+    throw bad_input(folder.string() + ": the saved run was made from another DEM; run the whole scenario");
+  for (std::size_t i = 0; i < plan.size() && plan[i] == Action::load; ++i)
+    for (const auto& key : stages()[i].sections)
+      if (!saved["scenario"].contains(key) || saved["scenario"][key] != scenario.resolved[key])
+        throw bad_input(folder.string() + ": the saved run used other '" + key + "' parameters; rerun from " + stages()[i].name +
+                        " (--from " + stages()[i].name + ")");
+  for (std::size_t i = 0; i < plan.size(); ++i)
+    if (plan[i] != Action::run && !saved["summary"].contains(stages()[i].name) && std::string(stages()[i].name) != "terrain")
+      throw bad_input(folder.string() + ": the saved run has no " + stages()[i].name + " stage; rerun from it");
+}
+
+/// Records a saved stage's files (vector layers read back for the preview), figures and timing.
+void reuse_saved(RunState& state, const json& saved, const std::string& stage, json& timings) {
+  for (const auto& o : saved["outputs"]) {
+    if (o["stage"] != stage) continue;
+    OutputFile file{o["file"].get<std::string>(), stage, o["description"].get<std::string>(), style_from_name(o.value("style", "")),
+                    o["kind"] == "raster", o.value("features", std::size_t(0))};
+    if (!file.raster) state.vectors.emplace_back(file.style, read_vector((state.folder / file.name).string(), state.dem.georef().crs));
+    state.outputs.push_back(file);
+  }
+  if (saved["summary"].contains(stage)) state.summary[stage] = saved["summary"][stage];
+  for (const auto& t : saved["timings"])
+    if (t["stage"] == stage) {
+      json entry = t;
+      entry["reused"] = true;
+      timings.push_back(entry);
+    }
 }
 
 }  // namespace
@@ -67,9 +119,15 @@ std::vector<std::string> stage_names() {
 json run_scenario(const Scenario& scenario, const RunOptions& options, Progress& progress, const Log& log) {
   namespace fs = std::filesystem;
   const fs::path output = scenario.path("output");
+  const std::vector<Action> plan = plan_stages(options);
+  const bool rerun = std::any_of(plan.begin(), plan.end(), [](Action a) { return a != Action::run; });
   std::error_code ec;
-  if (fs::exists(output, ec) && !options.overwrite)
+  json saved;
+  if (rerun) {
+    saved = read_manifest(output);
+  } else if (fs::exists(output, ec) && !options.overwrite) {
     throw bad_input(output.string() + ": run folder exists (use --overwrite to replace it)");
+  }
   const fs::path parent = output.parent_path().empty() ? fs::path(".") : output.parent_path();
   if (!fs::is_directory(parent, ec)) throw bad_input(output.string() + ": folder " + parent.string() + " does not exist");
 
@@ -79,19 +137,38 @@ json run_scenario(const Scenario& scenario, const RunOptions& options, Progress&
   if (auto crs = scenario.resolved["input"]["assume_crs"].get<std::string>(); !crs.empty()) read.assume_crs = crs;
 
   Dem dem = read_dem(dem_path, read);  // before creating anything: bad input leaves no folder
+  const std::string dem_sha256 = file_sha256(dem_path);
+  plugin::PluginSet plugins = plugin::load_plugins(nlohmann::json::parse(scenario.resolved["plugins"].dump()), log,
+                                                   scenario.base_dir.string());
+  if (rerun) check_reusable(output, saved, scenario, dem_sha256, plan);
   const fs::path temp = output.string() + ".tmp-" + std::to_string(::getpid());
   fs::remove_all(temp, ec);
-  if (!fs::create_directory(temp, ec)) throw bad_input(output.string() + ": cannot create the run folder (" + ec.message() + ")");
+  if (rerun) {
+    fs::copy(output, temp, fs::copy_options::recursive, ec);
+  } else {
+    fs::create_directory(temp, ec);
+  }
+  if (ec) throw bad_input(output.string() + ": cannot create the run folder (" + ec.message() + ")");
   try {
-    RunState state{.scenario = scenario, .folder = temp, .dem_sha256 = file_sha256(dem_path), .dem = std::move(dem),
-                   .hydrometry = {}, .density = {}, .outputs = {}, .vectors = {}, .summary = nlohmann::ordered_json::object()};
+    RunState state(scenario, temp, dem_sha256, std::move(dem));
+    state.plugins = std::move(plugins);
     json timings = json::array();
-    for (const auto& stage : stages()) {
+    json ran = json::array(), reused = json::array(), stale = json::array();
+    for (std::size_t i = 0; i < stages().size(); ++i) {
+      const StageDef& stage = stages()[i];
       const Log stage_log = log.stage(stage.name);
+      if (plan[i] != Action::run) {
+        // A saved stage: its files, figures and timing come from the saved run.
+        reuse_saved(state, saved, stage.name, timings);
+        if (plan[i] == Action::load) stage.load(state);
+        (plan[i] == Action::load ? reused : stale).push_back(stage.name);
+        continue;
+      }
       const auto start = std::chrono::steady_clock::now();
       stage.run(state, progress, stage_log);
       const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       timings.push_back({{"stage", stage.name}, {"seconds", seconds}, {"peak_memory_mb", double(peak_rss_kb()) / 1024.0}});
+      ran.push_back(stage.name);
       stage_log.detail("done in " + std::to_string(seconds) + " s");
     }
 
@@ -107,13 +184,15 @@ json run_scenario(const Scenario& scenario, const RunOptions& options, Progress&
     manifest["libraries"] = libs;
     json outputs = json::array();
     for (const auto& o : state.outputs) {
-      json entry = {{"file", o.name}, {"stage", o.stage}, {"description", o.description}, {"kind", o.raster ? "raster" : "vector"}};
+      json entry = {{"file", o.name}, {"stage", o.stage}, {"description", o.description}, {"kind", o.raster ? "raster" : "vector"},
+                    {"style", style_name(o.style)}};
       if (!o.raster) entry["features"] = o.features;
       outputs.push_back(entry);
     }
     manifest["outputs"] = outputs;
     manifest["summary"] = state.summary;
     manifest["timings"] = timings;
+    if (rerun) manifest["rerun"] = {{"ran", ran}, {"reused", reused}, {"stale", stale}};
     publish(state, manifest, log.stage("publish"));
     {
       std::ofstream out(temp / "run.json");
@@ -130,22 +209,53 @@ json run_scenario(const Scenario& scenario, const RunOptions& options, Progress&
 }
 
 std::string format_summary(const json& manifest) {
-  std::ostringstream s;
-  const auto& sum = manifest["summary"];
-  s << "Run of " << manifest["input"]["dem"].get<std::string>() << " (seed " << manifest["scenario"]["seed"] << ")\n";
+  std::string out;
+  auto line = [&out](const char* format, auto... values) {
+    char buf[256];
+    std::snprintf(buf, sizeof(buf), format, values...);
+    out += buf;
+  };
+  const json& sum = manifest["summary"];
+  line("Run of %s (seed %llu)\n", manifest["input"]["dem"].get<std::string>().c_str(),
+       static_cast<unsigned long long>(manifest["scenario"]["seed"].get<std::uint64_t>()));
   if (sum.contains("terrain")) {
-    const auto& t = sum["terrain"];
-    s << "  terrain: " << t["cols"] << " x " << t["rows"] << " cells, " << t["min_m"].get<double>() << " .. "
-      << t["max_m"].get<double>() << " m\n";
+    const json& t = sum["terrain"];
+    line("  terrain  %d x %d cells, %.0f .. %.0f m, %.1f%% nodata\n", t["cols"].get<int>(), t["rows"].get<int>(), t["min_m"].get<double>(),
+         t["max_m"].get<double>(), 100 * t["nodata_share"].get<double>());
   }
-  s << "  timings:";
-  for (const auto& t : manifest["timings"]) {
-    char buf[64];
-    std::snprintf(buf, sizeof(buf), " %s %.2f s", t["stage"].get<std::string>().c_str(), t["seconds"].get<double>());
-    s << buf;
+  if (sum.contains("hydro")) {
+    const json& h = sum["hydro"];
+    line("  hydro    %d stream reaches, %.1f km, Strahler up to %d, largest catchment %.1f km2\n", h["stream_reaches"].get<int>(),
+         h["stream_length_km"].get<double>(), h["max_strahler"].get<int>(), h["largest_catchment_km2"].get<double>());
   }
-  s << "\n";
-  return s.str();
+  if (sum.contains("density")) {
+    const json& d = sum["density"];
+    line("  density  %.1f%% water, %.1f%% of the land buildable, mean density %.3f\n", 100 * d["water_share"].get<double>(),
+         100 * d["buildable_land_share"].get<double>(), d["mean_density"].get<double>());
+  }
+  if (sum.contains("sites")) {
+    const json& c = sum["sites"];
+    line("  sites    %d cities (%d roots, %d suburbs), %.0f people\n", c["cities"].get<int>(), c["roots"].get<int>(),
+         c["suburbs"].get<int>(), c["population"].get<double>());
+    for (const auto& [k, v] : c["per_class"].items())
+      line("           class %s (radius %.0f m): %d\n", k.c_str(), v["radius_m"].get<double>(), v["cities"].get<int>());
+  }
+  if (sum.contains("network")) {
+    const json& n = sum["network"];
+    line("  network  %d of %d candidate links kept, %.1f km\n", n["kept_edges"].get<int>(), n["candidate_edges"].get<int>(),
+         n["kept_length_km"].get<double>());
+  }
+  if (sum.contains("roads")) {
+    const json& r = sum["roads"];
+    line("  roads    %d roads (%d not routable), bridges %.0f m, tunnels %.0f m\n", r["roads"].get<int>(), r["failed"].get<int>(),
+         r["bridge_m"].get<double>(), r["tunnel_m"].get<double>());
+    for (const auto& [cls, km] : r["length_km"].items()) line("           %-13s %9.1f km\n", cls.c_str(), km.get<double>());
+  }
+  out += "  timings ";
+  for (const auto& t : manifest["timings"])
+    line(" %s %.2f s%s", t["stage"].get<std::string>().c_str(), t["seconds"].get<double>(), t.value("reused", false) ? " (saved)" : "");
+  out += "\n";
+  return out;
 }
 
 }  // namespace terrapolis::pipeline

@@ -17,6 +17,10 @@ std::vector<std::string> stage_names();
 
 struct RunOptions {
   bool overwrite = false;  ///< replace an existing run folder
+  /// Rerun from this stage on, reading the earlier stages' results from the saved run folder.
+  std::string from;
+  /// Rerun only these stages; earlier ones are read back, later ones keep their saved files (stale).
+  std::vector<std::string> only;
 };
 
 /// Runs `scenario` into its output folder, written under a temporary name and renamed at the end

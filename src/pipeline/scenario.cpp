@@ -88,13 +88,18 @@ void apply_set(json& doc, const std::string& set) {
 }  // namespace
 
 std::string Scenario::path(const std::string& field) const {
-  const std::filesystem::path p = resolved.at(field).get<std::string>();
-  if (p.is_absolute()) return p.string();
+  const json& value = field.starts_with('/') ? resolved.at(json::json_pointer(field)) : resolved.at(field);
+  return file(value.get<std::string>(), field == "dem");
+}
+
+std::string Scenario::file(const std::string& name, bool bundled_fallback) const {
+  const std::filesystem::path p = name;
+  if (name.empty() || p.is_absolute()) return name;
   if (!base_dir.empty()) return (base_dir / p).lexically_normal().string();
   // The default scenario names the bundled DEM relative to the source tree; find it from elsewhere too.
   std::error_code ec;
   const std::filesystem::path bundled = std::filesystem::path(TERRAPOLIS_SOURCE_DIR) / p;
-  if (field == "dem" && !std::filesystem::exists(p, ec) && std::filesystem::exists(bundled, ec)) return bundled.string();
+  if (bundled_fallback && !std::filesystem::exists(p, ec) && std::filesystem::exists(bundled, ec)) return bundled.string();
   return p.string();
 }
 
@@ -141,6 +146,15 @@ Scenario load_scenario(const std::string& file, const std::vector<std::string>& 
   const std::string problem = validate_scenario(doc);
   if (!problem.empty()) throw bad_input(s.source + ": " + problem);
   s.resolved = with_defaults(doc, schema_defaults());
+  // Objects listed in a top-level array (plugins) get their own defaults too.
+  const nlohmann::json schema = nlohmann::json::parse(scenario_schema_text());
+  for (const auto& [key, sub] : schema["properties"].items())
+    if (sub.value("type", "") == "array" && sub.contains("items") && sub["items"].contains("properties")) {
+      const json item_defaults = defaults_of(sub["items"]);
+      for (auto& item : s.resolved[key])
+        for (const auto& [field, value] : item_defaults.items())
+          if (!item.contains(field)) item[field] = value;
+    }
   return s;
 }
 

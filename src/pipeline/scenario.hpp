@@ -20,8 +20,12 @@ struct Scenario {
   nlohmann::ordered_json resolved;  ///< the complete scenario, as recorded in run.json
   std::filesystem::path base_dir;   ///< relative paths in the scenario are relative to this
   std::string source;               ///< the scenario file, or "(default scenario)"
-  /// Absolute-or-as-given path of a path field, resolved against base_dir.
+  /// Path field (a top-level key or a JSON pointer such as "/roads/costs") resolved against base_dir;
+  /// "" stays "" (the field is unset).
   std::string path(const std::string& field) const;
+  /// A file name from the scenario resolved against base_dir; `bundled_fallback` also looks in the
+  /// source tree (the default scenario's bundled DEM).
+  std::string file(const std::string& name, bool bundled_fallback = false) const;
 };
 
 /// Loads `file` (empty: the embedded default scenario, relative to the working folder), applies

@@ -334,6 +334,7 @@ double RoadGraph::arc_cost(Cell from, int arc) const {
       const double depth = terrain_.depth_at(from.col + dc * (i - 0.5), from.row + dr * (i - 0.5));
       double c = road_slope_cost(std::fabs(z1 - z0) / dl) + veg0 + (depth > 0 ? sc.water_depth_m(depth) : water0);
       if (veg) c += sc.vegetation(terrain_.vegetation_at(from.col + dc * (i - 0.5), from.row + dr * (i - 0.5)));
+      c += terrain_.extra_cost_at(Structure::road, from.col + dc * (i - 0.5), from.row + dr * (i - 0.5));  // cost layers (plugins)
       if (c == kInfinity) return kInfinity;
       total += c * dl;
       z0 = z1;
@@ -356,11 +357,13 @@ double RoadGraph::arc_cost(Cell from, int arc) const {
     if (bridge) {
       const double h = deck - terrain_.surface_at(col, row);
       if (h < 0) return kInfinity;  // the deck would cut the ground
-      return sc.height_m(h) + sc.water_depth_m(depth) + sc.vegetation(terrain_.vegetation_at(col, row));
+      return sc.height_m(h) + sc.water_depth_m(depth) + sc.vegetation(terrain_.vegetation_at(col, row)) +
+             terrain_.extra_cost_at(a.structure, col, row);  // cost layers (plugins)
     }
     const double d = terrain_.ground_at(col, row) - deck;
     if (d < 0) return kInfinity;  // the tube would leave the ground (or the sea floor)
-    return sc.depth_m(d) + sc.water_depth_m(depth) + sc.vegetation(terrain_.vegetation_at(col, row));
+    return sc.depth_m(d) + sc.water_depth_m(depth) + sc.vegetation(terrain_.vegetation_at(col, row)) +
+           terrain_.extra_cost_at(a.structure, col, row);  // cost layers (plugins)
   };
   // Most long arcs are infeasible somewhere along their span: probe every eighth sample first so
   // that they are rejected early, then sum in order (the same sum as a plain loop, bit for bit).

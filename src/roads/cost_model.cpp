@@ -173,6 +173,18 @@ json structure_json(const StructureCosts& s, bool bridge, bool tunnel) {
 
 }  // namespace
 
+TransferFunction parse_transfer_function(const std::string& text, const std::string& origin) {
+  json j;
+  try {
+    j = json::parse(text);
+  } catch (const json::exception& e) {
+    throw bad_input(origin + ": not valid JSON (" + std::string(e.what()) + ")");
+  }
+  TransferFunction f;
+  read_transfer(j, f, origin, "transfer function");
+  return f;
+}
+
 CostModel parse_cost_model(const std::string& text, const std::string& origin, CostModel m) {
   json j;
   try {

@@ -69,5 +69,8 @@ CostModel load_cost_model(const std::string& path, CostModel base = default_cost
 CostModel parse_cost_model(const std::string& text, const std::string& origin, CostModel base = default_cost_model());
 /// The model as JSON (the format load_cost_model reads).
 std::string cost_model_json(const CostModel& model);
+/// One transfer function from its JSON text {"points": [[kappa, cost], ...], "threshold": x|null}
+/// (the format of the cost model file); `origin` names it in errors. Throws bad_input.
+TransferFunction parse_transfer_function(const std::string& text, const std::string& origin);
 
 }  // namespace terrapolis::roads

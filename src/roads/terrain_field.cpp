@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "core/error.hpp"
 #include "core/neighbours.hpp"
@@ -112,6 +113,22 @@ void TerrainField::set_vegetation(const Raster<float>& density) {
   if (density.cols() != cols_ || density.rows() != rows_) throw bad_input("vegetation layer: not on the DEM's grid");
   vegetation_.resize(density.size());
   for (std::size_t i = 0; i < density.size(); ++i) vegetation_[i] = std::isnan(density[i]) ? 0.f : density[i];
+}
+
+void TerrainField::add_cost_layer(const std::string& name, const Raster<float>& kappa, const std::array<TransferFunction, 3>& transfer,
+                                  const std::array<bool, 3>& priced) {
+  if (kappa.cols() != cols_ || kappa.rows() != rows_) throw bad_input(name + ": cost layer not on the DEM's grid");
+  for (int s = 0; s < 3; ++s) {
+    if (!priced[std::size_t(s)]) continue;
+    auto& v = extra_[std::size_t(s)];
+    if (v.empty()) v.assign(size(), 0.f);
+    const TransferFunction& mu = transfer[std::size_t(s)];
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      const float k = kappa[i];
+      if (std::isnan(k)) continue;
+      v[i] = std::isinf(k) && k > 0 ? std::numeric_limits<float>::infinity() : float(double(v[i]) + mu(k));
+    }
+  }
 }
 
 float TerrainField::vegetation_at(double col, double row) const {

@@ -1,11 +1,16 @@
 // The terrain as the road search sees it: ground surface, water depth, metric cell sizes.
 // SPDX-License-Identifier: MIT
 #pragma once
+#include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "core/geodesy.hpp"
 #include "core/raster.hpp"
+#include "roads/cost_model.hpp"
 
 namespace terrapolis::roads {
 
@@ -44,6 +49,20 @@ class TerrainField {
   /// Vegetation density at the nearest cell (0 without a layer).
   float vegetation_at(double col, double row) const;
   bool has_vegetation() const { return !vegetation_.empty(); }
+  /// Adds a per-metre cost term (e.g. from a plugin): a characteristic kappa per cell (same grid
+  /// as the DEM) priced by one transfer function per structure (road, bridge, tunnel). The terms'
+  /// costs are summed per cell once here. NaN kappa costs nothing; +infinity kappa forbids the
+  /// cell to every structure whose function is given (`priced[s]`); unpriced structures pay nothing.
+  void add_cost_layer(const std::string& name, const Raster<float>& kappa, const std::array<TransferFunction, 3>& transfer,
+                      const std::array<bool, 3>& priced);
+  /// Sum of the added terms' costs per metre (>= 0, +infinity where forbidden) at the nearest cell
+  /// for structure `s`; 0 without terms.
+  float extra_cost_at(Structure s, double col, double row) const {
+    const auto& v = extra_[int(s)];
+    if (v.empty()) return 0.f;
+    const int c = std::clamp(int(std::lround(col)), 0, cols_ - 1), r = std::clamp(int(std::lround(row)), 0, rows_ - 1);
+    return v[index(c, r)];
+  }
   bool water(int col, int row) const { return water_[index(col, row)] != 0; }
   bool has_bathymetry() const { return bathymetry_; }
   double sea_level() const { return sea_level_; }
@@ -75,6 +94,7 @@ class TerrainField {
   bool bathymetry_ = false;
   double min_cell_m_ = 1, typical_cell_m_ = 1;
   std::vector<float> surface_, ground_, depth_, vegetation_;
+  std::array<std::vector<float>, 3> extra_;  // summed cost layers per structure (empty: none)
   std::vector<std::uint8_t> water_;
   std::vector<std::int32_t> land_;
 };

@@ -24,6 +24,7 @@ void check_options(const SitesOptions& o) {
   positive(o.x_max, "x_max");
   positive(o.p, "p");
   positive(o.people_per_m, "people_per_m");
+  positive(o.quota_scale, "quota_scale");
   if (!(std::isfinite(o.u_min) && o.u_min >= 0)) throw bad_input("sites: u_min must be >= 0");
   if (!(std::isfinite(o.u_max) && o.u_max >= o.u_min)) throw bad_input("sites: u_max must be >= u_min");
   if (!(std::isfinite(o.r_min_m) && o.r_min_m >= 0)) throw bad_input("sites: r_min must be >= 0 metres (0: automatic)");
@@ -64,7 +65,7 @@ QuotaTable compute_quotas(double cell_size_m, const SitesOptions& o) {
   double sum = 0;
   for (int i = 0; i < n; ++i) {
     const double r = table.r_min_m + i * table.dr_m;
-    const double units = units_for_people(o.people_per_m * r, o);
+    const double units = o.quota_scale * units_for_people(o.people_per_m * r, o);
     sum += std::floor(units);
     if (sum > 5e7) throw bad_input("sites: the quotas add up to more than 5x10^7 sites; check u_max and the radius range");
     // Class 0 is the largest radius; Algorithm 13's index i counts from r_min.

@@ -35,6 +35,10 @@ struct SitesOptions {
   double x_max = 1e6;       ///< people at which f reaches u_min, eq. 4.1
   double p = 4;             ///< decay exponent of f (> 1), eq. 4.1
   double people_per_m = 400;  ///< g(r) = people_per_m x r, eq. 4.2
+  /// Multiplies every quota: Q[i] = floor(quota_scale x f(g(r_i))). The census fit describes
+  /// metropolitan France (543 940 km², INSEE 1999); a region of A km² is A / 543940 of it.
+  /// 1 is the thesis (the whole fit on any DEM).
+  double quota_scale = 1;
   /// Inclusion removal (Belhadj §4.3.1.2): paris keeps partially included sites at most half the
   /// size of their container as suburbs (radio-concentric cities); manhattan removes every
   /// site whose centre lies in a larger one (regular tiling).

@@ -25,8 +25,7 @@ expect_error "missing.tif" "$tmp/missing.tif" "$tmp/out" --weights 1,0,1,0
 expect_error "every weight is 0" "$dem" "$tmp/out" --weights 0,0,0,0
 expect_error "expected 4 numbers" "$dem" "$tmp/out" --weights 1,2
 expect_error "is not a number" "$dem" "$tmp/out" --weights 1,x,0,0
-expect_error "--hydrometry FILE is required" "$dem" "$tmp/out"
-expect_error "--hydrometry FILE is required" "$dem" "$tmp/out" --weights 1,0,1,0 --river-bed-cap 0.9
+expect_error "missing.tif: no such file" "$dem" "$tmp/out" --hydrometry "$tmp/missing.tif"
 expect_error "--r-max" "$dem" "$tmp/out" --weights 1,0,1,0 --r-min 2000 --r-max 1000
 expect_error "--max-slope" "$dem" "$tmp/out" --weights 1,0,1,0 --max-slope 120
 expect_error "expected FILE:WEIGHT" "$dem" "$tmp/out" --weights 1,0,1,0 --layer nolayer

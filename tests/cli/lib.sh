@@ -19,6 +19,13 @@ expect_fail() {
   [[ $(grep -c . "$WORK/stderr") -ge 1 ]] || fail "no error message"
 }
 
+# expect_refused OUT PATTERN CMD...: bad input: exit 2, stderr matches PATTERN, OUT not created.
+expect_refused() {
+  local out=$1 pattern=$2; shift 2
+  expect_fail 2 "$pattern" "$@"
+  [[ ! -e $out ]] || fail "'$*' left $out behind"
+}
+
 # no_leftovers DIR: nothing but what was there before (no partial or temporary outputs).
 no_leftovers() {
   local found

@@ -1,9 +1,7 @@
 # `terrapolis network` on the cities of the Corsica sample and on a planner's own file; clean failures.
-set -euo pipefail
-BIN=$1
-SAMPLES=$2
-T=$(mktemp -d)
-trap 'rm -rf "$T"' EXIT
+source "$(dirname "$0")/lib.sh" "$@"
+BIN=$TP
+T=$WORK
 DEM=$SAMPLES/gebco2022_15s_north_corsica_capcorse.asc
 mkdir "$T/in"
 gdal_calc.py --quiet -A "$DEM" --outfile "$T/in/buildable.tif" --type Byte --calc "(A>0)*(A<1000)" --NoDataValue 255
@@ -46,24 +44,13 @@ JSON
 "$BIN" --quiet network "$T/plan.geojson" "$T/p"
 grep -q '"from": 10, "to": 20, "kind": "parent_child", "kept": 1' "$T/p/network.geojson"
 
-expect_fail() {
-  local out=$1 pattern=$2
-  shift 2
-  set +e
-  "$BIN" --quiet network "$@" "$out" 2> "$T/err.txt"
-  local rc=$?
-  set -e
-  cat "$T/err.txt"
-  test $rc -eq 2 || { echo "exit code $rc"; exit 1; }
-  grep -q "$pattern" "$T/err.txt" || { echo "message lacks $pattern"; exit 1; }
-  test ! -e "$out" || { echo "output left behind"; exit 1; }
-}
+refuse() { expect_refused "$1" "$2" "$BIN" --quiet network "${@:3}" "$1"; }
 sed 's/"radius_m": 800, //' "$T/plan.geojson" > "$T/noradius.geojson"
-expect_fail "$T/x1" "radius_m" "$T/noradius.geojson"
+refuse "$T/x1" "radius_m" "$T/noradius.geojson"
 sed 's/"parent": 10/"parent": 99/' "$T/plan.geojson" > "$T/orphan.geojson"
-expect_fail "$T/x2" "parent 99" "$T/orphan.geojson"
-expect_fail "$T/x3" "no such file" "$T/missing.geojson"
-expect_fail "$T/x4" "k" "$T/plan.geojson" --k 1
+refuse "$T/x2" "parent 99" "$T/orphan.geojson"
+refuse "$T/x3" "no such file" "$T/missing.geojson"
+refuse "$T/x4" "k" "$T/plan.geojson" --k 1
 # Existing output refused unless --overwrite.
 set +e
 "$BIN" --quiet network "$T/plan.geojson" "$T/p" 2> /dev/null

@@ -8,9 +8,24 @@ for f in run1/*; do
   [[ $name == run.json ]] && continue  # holds timings and memory of the run
   cmp -s "$f" "run2/$name" || fail "$name differs between two runs of the same scenario"
 done
-for f in elevation.tif hillshade.tif elevation.qml project.qgs preview.png run.json; do
+for f in elevation.tif hillshade.tif filled.tif flowdir.tif accumulation.tif hydrometry.tif streams.geojson \
+         coast.tif plateau.tif plain.tif buildable.tif density.tif cities.geojson city_extents.geojson \
+         network.geojson roads.geojson road_sections.geojson elevation.qml roads.qml project.qgs preview.png run.json; do
   [[ -s run1/$f ]] || fail "run1/$f missing"
 done
+# Every stage ran and the summary holds its figures; the kept network is connected and each kept
+# link has its road (or is reported as not routable).
+/usr/bin/python3 - run1/run.json <<'PY' || fail "run.json figures"
+import json, sys
+m = json.load(open(sys.argv[1]))
+assert [t["stage"] for t in m["timings"]] == ["terrain", "hydro", "density", "sites", "network", "roads"], m["timings"]
+s = m["summary"]
+assert s["hydro"]["stream_reaches"] > 0 and s["sites"]["cities"] > 0, s
+assert sum(c["cities"] for c in s["sites"]["per_class"].values()) == s["sites"]["cities"], s["sites"]
+assert 0 < s["density"]["mean_density"] <= 1, s["density"]
+assert s["roads"]["roads"] + s["roads"]["failed"] == s["network"]["kept_edges"], (s["roads"], s["network"])
+assert sum(s["roads"]["length_km"].values()) > 0, s["roads"]
+PY
 gdalinfo run1/elevation.tif | grep -q "LAYOUT=COG" || fail "elevation.tif is not a COG"
 gdalinfo run1/elevation.tif | grep -q "TERRAPOLIS_INPUT_SHA256=" || fail "no provenance in elevation.tif"
 /usr/bin/python3 -c "import json,sys; m=json.load(open('run1/run.json')); assert m['input']['sha256'] and m['timings'], m" || fail "run.json"
@@ -33,8 +48,33 @@ else
 fi
 echo "run: ok"
 
+# Reruns from saved results: --from reads the earlier stages back, --only reruns just some.
+cp -r run1 rerun
+"$TP" --quiet run -o rerun --from network --set network.k=1.3
+/usr/bin/python3 - run1/run.json rerun/run.json <<'PY' || fail "--from network"
+import json, sys
+old, m = (json.load(open(f)) for f in sys.argv[1:3])
+assert m["rerun"] == {"ran": ["network", "roads"], "reused": ["terrain", "hydro", "density", "sites"], "stale": []}, m["rerun"]
+assert m["scenario"]["network"]["k"] == 1.3
+# The same candidates as the full run (the cities read back are the same); a smaller detour
+# factor removes fewer links (fewer detours are short enough).
+assert m["summary"]["network"]["candidate_edges"] == old["summary"]["network"]["candidate_edges"], m["summary"]["network"]
+assert m["summary"]["network"]["kept_edges"] > old["summary"]["network"]["kept_edges"], (m["summary"], old["summary"])
+assert m["summary"]["sites"] == old["summary"]["sites"]
+PY
+cmp -s run1/cities.geojson rerun/cities.geojson || fail "--from network rewrote the cities"
+"$TP" --quiet run -o rerun --only density --set density.weights.plain=1
+/usr/bin/python3 -c "import json; r=json.load(open('rerun/run.json'))['rerun']; assert r['stale']==['sites','network','roads'], r" || fail "--only"
+cmp -s run1/density.tif rerun/density.tif && fail "--only density did not change density.tif"
+expect_fail 2 "other 'density' parameters; rerun from density" "$TP" run -o rerun --from sites --set density.r_max_m=6000
+expect_fail 2 "dunes" "$TP" run -o rerun --from dunes
+expect_fail 2 "nosuch: no saved run to rerun from" "$TP" run -o nosuch --from roads
+no_leftovers "$WORK"
+echo "rerun: ok"
+
 # compare: two runs differing in one parameter.
-"$TP" --quiet run -o run3 --set outputs.preview_width=500
+cp -r run1 run3
+"$TP" --quiet run -o run3 --only terrain --set outputs.preview_width=500
 "$TP" compare run1 run3 > cmp.txt
 grep -Eq "outputs.preview_width +400 +500" cmp.txt || fail "compare does not show the changed parameter: $(cat cmp.txt)"
 "$TP" compare --json run1 run1 | /usr/bin/python3 -c "import json,sys; c=json.load(sys.stdin); assert c['parameters']==[], c" || fail "compare of a run with itself"

@@ -1,9 +1,7 @@
 # `terrapolis sites` on the Corsica sample: outputs and fields, quota report, seeds, modes, clean failures.
-set -euo pipefail
-BIN=$1
-SAMPLES=$2
-T=$(mktemp -d)
-trap 'rm -rf "$T"' EXIT
+source "$(dirname "$0")/lib.sh" "$@"
+BIN=$TP
+T=$WORK
 DEM=$SAMPLES/gebco2022_15s_north_corsica_capcorse.asc
 mkdir "$T/in"
 # The density stage's outputs, made from the DEM: buildable = land below 1000 m, density = exp(-z / 400 m).
@@ -56,25 +54,20 @@ cmp "$T/a/cities.geojson" "$T/b/cities.geojson"
 "$BIN" --quiet sites "$T/in" "$T/a" --seed 9 --overwrite
 grep -q '"seed": 9' "$T/a/cities.geojson"
 
+# A DEM instead of a density folder: the same cities as `terrapolis density` then `terrapolis sites`.
+"$BIN" --quiet sites "$DEM" "$T/from_dem"
+"$BIN" --quiet density "$DEM" "$T/model"
+"$BIN" --quiet sites "$T/model" "$T/from_model"
+cmp "$T/from_dem/cities.geojson" "$T/from_model/cities.geojson"
+
 # Bad inputs: exit 2, one line naming the problem, no output folder left.
-expect_fail() {
-  local out=$1 pattern=$2
-  shift 2
-  set +e
-  "$BIN" --quiet sites "$@" "$out" 2> "$T/err.txt"
-  local rc=$?
-  set -e
-  cat "$T/err.txt"
-  test $rc -eq 2 || { echo "exit code $rc"; exit 1; }
-  grep -q "$pattern" "$T/err.txt" || { echo "message lacks $pattern"; exit 1; }
-  test ! -e "$out" || { echo "output left behind"; exit 1; }
-}
-expect_fail "$T/x1" "no such folder" "$T/missing"
+refuse() { expect_refused "$1" "$2" "$BIN" --quiet sites "${@:3}" "$1"; }
+refuse "$T/x1" "no such folder" "$T/missing"
 mkdir "$T/half"
 cp "$T/in/density.tif" "$T/half/"
-expect_fail "$T/x2" "buildable.tif" "$T/half"
-expect_fail "$T/x3" "r_max" "$T/in" --r-min 3000 --r-max 3100
-expect_fail "$T/x5" "seed" "$T/in" --seed 18446744073709551615
+refuse "$T/x2" "buildable.tif" "$T/half"
+refuse "$T/x3" "r_max" "$T/in" --r-min 3000 --r-max 3100
+refuse "$T/x5" "seed" "$T/in" --seed 18446744073709551615
 gdal_calc.py --quiet -A "$DEM" --outfile "$T/half/buildable.tif" --type Byte --calc "A*0"
-expect_fail "$T/x4" "no buildable cell" "$T/half"
+refuse "$T/x4" "no buildable cell" "$T/half"
 echo OK

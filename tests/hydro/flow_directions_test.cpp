@@ -139,3 +139,29 @@ TEST(FlowDirections, MfdSharesFollowSlopePower) {
     }
   }
 }
+
+TEST(FlowDirections, InnerReceiversAreTheValidReceiversOfSplit) {
+  // inner_receivers has a fast path for MFD (no weights): it must name exactly split()'s receivers
+  // that lie inside the grid on valid data, for every method.
+  SilentProgress p;
+  for (std::uint64_t seed = 1; seed <= 4; ++seed) {
+    const Dem dem = test::random_dem(23, 17, seed, seed % 2 == 0);
+    const Dem filled = fill_depressions(dem, {}, p);
+    const CellMetrics m = cell_metrics(dem.georef(), dem.cols(), dem.rows());
+    const auto d8 = d8_directions(filled, m, std::nullopt, p);
+    for (FlowMethod method : {FlowMethod::d8, FlowMethod::dinf, FlowMethod::mfd}) {
+      const FlowRouter router(filled, d8, m, method);
+      FlowSplit s;
+      for (int r = 0; r < dem.rows(); ++r)
+        for (int c = 0; c < dem.cols(); ++c) {
+          router.split(c, r, s);
+          std::uint8_t bits = 0;
+          for (int j = 0; j < s.count; ++j) {
+            const int k = s.k[std::size_t(j)], nc = c + dcol[k], nr = r + drow[k];
+            if (filled.inside(nc, nr) && !std::isnan(filled(nc, nr))) bits = std::uint8_t(bits | (1u << k));
+          }
+          ASSERT_EQ(router.inner_receivers(c, r), bits) << c << "," << r;
+        }
+    }
+  }
+}

@@ -48,8 +48,18 @@ for name, layer in layers.items():
             sys.exit("vector %s has CRS %s, expected EPSG:4326 (RFC 7946)" % (name, layer.crs().authid()))
         if layer.featureCount() != out["features"]:
             sys.exit("vector %s has %d features, run.json says %d" % (name, layer.featureCount(), out["features"]))
-        if layer.renderer().type() not in ("categorizedSymbol", "singleSymbol", "graduatedSymbol"):
+        renderer = layer.renderer()
+        if renderer.type() not in ("categorizedSymbol", "singleSymbol", "graduatedSymbol"):
             sys.exit("vector %s is not styled" % name)
+        if renderer.type() == "categorizedSymbol":
+            # The style names a real field and each feature falls in one of its classes.
+            field = renderer.classAttribute()
+            if layer.fields().indexOf(field) < 0:
+                sys.exit("vector %s is styled by a field %s it does not have" % (name, field))
+            values = {str(c.value()) for c in renderer.categories()}
+            for feature in ([] if "" in values else layer.getFeatures()):  # "": a class for every other value
+                if str(feature[field]) not in values:
+                    sys.exit("vector %s: %s = %s has no class in its style %s" % (name, field, feature[field], sorted(values)))
     # Every layer lies inside the DEM's extent.
     dem = layers["elevation"]
     if not dem.extent().buffered(dem.extent().width() * 0.01).contains(

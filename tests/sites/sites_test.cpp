@@ -37,6 +37,20 @@ TEST(Quotas, ThesisCorsicaTable) {
   EXPECT_EQ(t.total(), 623);
 }
 
+// The same table scaled to Corsica (8680 km2 of the 543940 km2 the census fit describes):
+//   scale 0.015958 x (4, 5.7088, 31.3408, 142.4128, 441.4528) = (0.064, 0.091, 0.500, 2.273, 7.045)
+TEST(Quotas, ScaledToARegion) {
+  SitesOptions o;
+  o.r_min_m = 500;
+  o.r_max_m = 3000;
+  o.quota_scale = 8680.0 / 543940.0;
+  const QuotaTable t = compute_quotas(500.0, o);
+  const int quotas[5] = {0, 0, 0, 2, 7};
+  for (int k = 0; k < 5; ++k) EXPECT_EQ(t.classes[std::size_t(k)].quota, quotas[k]) << k;
+  o.quota_scale = 0;
+  EXPECT_THROW(compute_quotas(500.0, o), Error);
+}
+
 TEST(Quotas, StepAndAutomaticRange) {
   SitesOptions o;
   EXPECT_EQ(class_step_m(30.85, o), 50.0);    // dr_min wins on fine grids

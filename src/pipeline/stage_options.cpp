@@ -1,0 +1,117 @@
+// Each stage's options from a resolved scenario.
+// SPDX-License-Identifier: MIT
+#include "pipeline/stage_options.hpp"
+
+#include <map>
+
+namespace terrapolis::pipeline {
+namespace {
+
+using json = nlohmann::ordered_json;
+
+/// The schema's enum already restricted the value: an unknown one is a programming error.
+template <class E>
+E choice(const json& value, const std::map<std::string, E>& choices) {
+  return choices.at(value.get<std::string>());
+}
+
+}  // namespace
+
+hydro::HydroOptions hydro_options(const Scenario& scenario) {
+  using namespace hydro;
+  const json& h = scenario.resolved["hydro"];
+  HydroOptions o;
+  o.fill = choice<FillMethod>(h["fill"], {{"priority-flood", FillMethod::priority_flood}, {"epsilon", FillMethod::epsilon},
+                                          {"breach", FillMethod::breach}, {"none", FillMethod::none}});
+  o.flow = choice<FlowMethod>(h["flow"], {{"d8", FlowMethod::d8}, {"dinf", FlowMethod::dinf}, {"mfd", FlowMethod::mfd}});
+  o.mfd_exponent = h["mfd_exponent"].get<double>();
+  o.hydrometry.method = choice<HydrometryMethod>(
+      h["hydrometry"], {{"belhadj", HydrometryMethod::belhadj}, {"accumulation", HydrometryMethod::accumulation}});
+  o.hydrometry.max_iterations = h["iterations"].get<int>();
+  o.hydrometry.threshold = h["threshold"].get<double>();
+  o.hydrometry.vertical =
+      choice<VerticalScale>(h["vertical"], {{"metres", VerticalScale::metres}, {"normalised16", VerticalScale::normalised16}});
+  o.hydrometry.share =
+      choice<BelhadjShare>(h["belhadj_share"], {{"all", BelhadjShare::all_neighbours}, {"fed", BelhadjShare::fed_neighbours}});
+  o.streams.threshold_km2 = h["streams_threshold_km2"].get<double>();
+  // The sea drains the land: its cells are outlets for every step (density treats them as water).
+  o.sea_level = scenario.resolved["water"]["sea_level_m"].get<double>();
+  return o;
+}
+
+hydro::D8Codes d8_codes(const Scenario& scenario) {
+  using hydro::D8Codes;
+  return choice<D8Codes>(scenario.resolved["hydro"]["d8_codes"],
+                         {{"esri", D8Codes::esri}, {"grass", D8Codes::grass}, {"taudem", D8Codes::taudem}});
+}
+
+density::DensityOptions density_options(const Scenario& scenario) {
+  const json& w = scenario.resolved["water"];
+  const json& d = scenario.resolved["density"];
+  density::DensityOptions o;
+  o.sea_level_m = w["sea_level_m"].get<double>();
+  o.nodata_is_sea = w["nodata_is_sea"].get<bool>();
+  o.water_mask = scenario.path("/water/water_mask");
+  o.max_altitude_m = d["max_altitude_m"].get<double>();
+  // 90 degrees and a cap of 1 exclude nothing: the schema's "off" values.
+  if (const double slope = d["max_slope_deg"].get<double>(); slope < 90) o.max_slope_deg = slope;
+  if (const double cap = d["river_bed_cap"].get<double>(); cap < 1) o.river_bed_cap = cap;
+  o.r_min_m = d["r_min_m"].get<double>();
+  o.r_max_m = d["r_max_m"].get<double>();
+  o.plateau_min_m = d["plateau_min_m"].get<double>();
+  o.plateau_max_m = d["plateau_max_m"].get<double>();
+  o.plain_max_variation_m = d["plain_max_variation_m"].get<double>();
+  const json& weights = d["weights"];
+  o.weights = {weights["coast"].get<double>(), weights["hydrometry"].get<double>(), weights["plateau"].get<double>(),
+               weights["plain"].get<double>()};
+  for (const auto& layer : d["layers"])
+    o.layers.emplace_back(scenario.file(layer["file"].get<std::string>()), layer["weight"].get<double>());
+  for (const auto& file : d["exclusions"]) o.exclusions.push_back(scenario.file(file.get<std::string>()));
+  return o;
+}
+
+sites::SitesOptions sites_options(const Scenario& scenario) {
+  const json& s = scenario.resolved["sites"];
+  sites::SitesOptions o;
+  o.seed = scenario.resolved["seed"].get<std::uint64_t>();
+  o.mode = s["mode"] == "manhattan" ? sites::SitesOptions::Mode::manhattan : sites::SitesOptions::Mode::paris;
+  o.disc_test = s["disc_test"] == "perimeter" ? sites::SitesOptions::DiscTest::perimeter : sites::SitesOptions::DiscTest::exact;
+  o.candidates = s["candidates"].get<int>();
+  o.r_min_m = s["r_min_m"].get<double>();
+  o.r_max_m = s["r_max_m"].get<double>();
+  o.dr_min_m = s["dr_min_m"].get<double>();
+  o.u_min = s["u_min"].get<double>();
+  o.u_max = s["u_max"].get<double>();
+  o.x_max = s["x_max"].get<double>();
+  o.p = s["p"].get<double>();
+  o.people_per_m = s["people_per_m"].get<double>();
+  o.quota_scale = s["quota_scale"].get<double>();
+  o.refill_rounds = s["refill_rounds"].get<int>();
+  return o;
+}
+
+network::NetworkOptions network_options(const Scenario& scenario) {
+  network::NetworkOptions o;
+  o.k = scenario.resolved["network"]["k"].get<double>();
+  return o;
+}
+
+RoadsSettings roads_settings(const Scenario& scenario) {
+  const json& r = scenario.resolved["roads"];
+  RoadsSettings s;
+  const std::string costs = scenario.path("/roads/costs");
+  s.model = costs.empty() ? roads::default_cost_model() : roads::load_cost_model(costs);
+  if (!r["bridges"].get<bool>()) s.model.bridge.enabled = false;
+  if (!r["tunnels"].get<bool>()) s.model.tunnel.enabled = false;
+  const std::uint64_t seed = scenario.resolved["seed"].get<std::uint64_t>();
+  s.routing.router = r["router"] == "bezier" ? roads::Router::bezier : roads::Router::galin;
+  s.routing.graph = {r["k"].get<int>(), r["angles"].get<int>(), seed};
+  s.routing.bezier.seed = seed;
+  s.routing.bezier.max_evaluations = r["bezier_evaluations"].get<int>();
+  s.routing.bezier.threshold = r["bezier_threshold"].get<double>();
+  s.routing.bezier.tries = r["bezier_tries"].get<int>();
+  s.vegetation = scenario.path("/roads/vegetation");
+  return s;
+}
+
+}  // namespace terrapolis::pipeline

@@ -1,0 +1,221 @@
+// The stages of a run: each one calls its module and writes its files with provenance.
+// SPDX-License-Identifier: MIT
+#include "pipeline/stages.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "core/error.hpp"
+#include "io/raster_io.hpp"
+#include "network/layers.hpp"
+#include "pipeline/hillshade.hpp"
+#include "pipeline/stage_options.hpp"
+#include "roads/road_network.hpp"
+#include "roads/terrain_field.hpp"
+#include "sites/layers.hpp"
+
+namespace terrapolis::pipeline {
+namespace {
+
+using json = nlohmann::ordered_json;
+
+double round_to(double v, double step) { return std::round(v / step) * step; }
+
+std::string saved(const RunState& s, const std::string& name) { return (s.folder / name).string(); }
+
+// ---- terrain -------------------------------------------------------------------------------
+
+void terrain_run(RunState& s, Progress&, const Log&) {
+  s.write("terrain", "elevation.tif", s.dem, "elevation in metres (as read from the input DEM)", Style::elevation);
+  s.write("terrain", "hillshade.tif", hillshade(s.dem), "hillshade (Horn 1981), light from 315 deg at 45 deg", Style::hillshade);
+  double lo = 1e300, hi = -1e300;
+  std::size_t valid = 0;
+  for (float v : s.dem.values()) {
+    if (std::isnan(v)) continue;
+    lo = std::min(lo, double(v));
+    hi = std::max(hi, double(v));
+    ++valid;
+  }
+  s.summary["terrain"] = {{"cols", s.dem.cols()}, {"rows", s.dem.rows()}, {"min_m", lo}, {"max_m", hi},
+                          {"nodata_share", 1.0 - double(valid) / double(s.dem.size())}};
+}
+
+void terrain_load(RunState&) {}  // the DEM is always read from the input
+
+// ---- hydro (Belhadj 2007 §4.2.2; Barnes et al. 2014; docs/hydro.md) ----------------------
+
+void hydro_run(RunState& s, Progress& progress, const Log& log) {
+  const hydro::HydroOptions options = hydro_options(s.scenario);
+  hydro::HydroResult r = hydro::run_hydro(s.dem, options, progress);
+  const json& h = s.scenario.resolved["hydro"];
+  const hydro::D8Codes codes = d8_codes(s.scenario);
+  s.write("hydro", "filled.tif", r.filled, "conditioned elevation (m), " + h["fill"].get<std::string>() + " depression handling",
+          Style::elevation);
+  s.write("hydro", "flowdir.tif", hydro::encode_d8(r.d8, codes), "D8 flow direction, " + hydro::describe(codes), Style::flow_direction,
+          {{"D8_CODES", h["d8_codes"].get<std::string>()}, {"D8_CODES_DESCRIPTION", hydro::describe(codes)}});
+  Raster<float> area = r.filled.like<float>(NAN);
+  double largest_km2 = 0;
+  for (std::size_t i = 0; i < area.size(); ++i) {
+    area[i] = float(r.accumulation[i] * 1e-6);
+    if (!std::isnan(area[i])) largest_km2 = std::max(largest_km2, double(area[i]));
+  }
+  s.write("hydro", "accumulation.tif", area, "upstream area (km2), " + h["flow"].get<std::string>() + " routing", Style::accumulation,
+          {{"UNIT", "km2"}});
+  s.write("hydro", "hydrometry.tif", r.hydrometry, "hydrometry in [0,1] (" + h["hydrometry"].get<std::string>() + ")",
+          Style::unit_ramp);
+  s.write("hydro", "streams.geojson", r.streams, "stream reaches with Strahler order, upstream area (km2), length (m)",
+          Style::streams);
+  const int f_order = r.streams.field_index("strahler"), f_length = r.streams.field_index("length_m");
+  std::int64_t max_order = 0;
+  double length_m = 0;
+  for (const auto& f : r.streams.features) {
+    max_order = std::max(max_order, std::get<std::int64_t>(f.values[std::size_t(f_order)]));
+    length_m += std::get<double>(f.values[std::size_t(f_length)]);
+  }
+  s.summary["hydro"] = {{"stream_reaches", r.streams.features.size()},
+                        {"stream_length_km", round_to(length_m / 1000, 0.01)},
+                        {"max_strahler", max_order},
+                        {"largest_catchment_km2", round_to(largest_km2, 0.01)},
+                        {"belhadj_iterations", r.hydrometry_iterations}};
+  if (r.hydrometry_iterations > 0) log.detail("belhadj: " + std::to_string(r.hydrometry_iterations) + " iterations");
+  s.hydrometry = std::move(r.hydrometry);
+}
+
+void hydro_load(RunState& s) {
+  s.hydrometry = read_resampled(saved(s, "hydrometry.tif"), s.dem.georef(), s.dem.cols(), s.dem.rows(), Resampling::nearest);
+}
+
+// ---- density (Belhadj 2007 §4.2; docs/density.md) -----------------------------------------
+
+void density_run(RunState& s, Progress& progress, const Log& log) {
+  density::DensityOptions options = density_options(s.scenario);
+  plugin::add_to_density(plugin::density_factors(s.plugins, s.dem, progress, log), options);
+  density::DensityResult r = density::compute_density(s.dem, *s.hydrometry, options, progress);
+  const std::pair<const char*, const Raster<float>*> characteristics[] = {{"coast", &r.coast}, {"plateau", &r.plateau}, {"plain", &r.plain}};
+  for (const auto& [name, raster] : characteristics)
+    s.write("density", std::string(name) + ".tif", *raster, density::describe_output(name), Style::unit_ramp);
+  s.write("density", "buildable.tif", r.buildable, density::describe_output("buildable"), Style::mask);
+  s.write("density", "density.tif", r.density, density::describe_output("density"), Style::density);
+  const auto& st = r.stats;
+  const std::size_t land = st.known_cells - st.water_cells;
+  s.summary["density"] = {{"buildable_land_share", land ? round_to(double(st.buildable_cells) / double(land), 1e-4) : 0.0},
+                          {"water_share", st.known_cells ? round_to(double(st.water_cells) / double(st.known_cells), 1e-4) : 0.0},
+                          {"mean_density", round_to(st.mean_density, 1e-4)}};
+  s.density = std::move(r.density);
+  s.buildable = std::move(r.buildable);
+}
+
+void density_load(RunState& s) {
+  s.density = read_resampled(saved(s, "density.tif"), s.dem.georef(), s.dem.cols(), s.dem.rows(), Resampling::nearest);
+  const Raster<float> buildable =
+      read_resampled(saved(s, "buildable.tif"), s.dem.georef(), s.dem.cols(), s.dem.rows(), Resampling::nearest);
+  s.buildable = s.dem.like<std::uint8_t>(255);
+  for (std::size_t i = 0; i < buildable.size(); ++i)
+    (*s.buildable)[i] = std::isnan(buildable[i]) ? std::uint8_t(255) : std::uint8_t(buildable[i]);
+}
+
+// ---- sites (Belhadj 2007 §4.3.1, Algorithms 13-15; docs/sites.md) --------------------------
+
+void sites_run(RunState& s, Progress& progress, const Log&) {
+  const sites::SitesResult r = sites::place_sites(*s.density, *s.buildable, sites_options(s.scenario), progress);
+  const Crs& crs = s.dem.georef().crs;
+  s.cities = sites::cities_layer(r, crs);
+  s.write("sites", "cities.geojson", *s.cities, "city centres with radius, class, population, parent and depth", Style::cities);
+  s.write("sites", "city_extents.geojson", sites::city_extents_layer(r, crs), "city discs (geodesic circles)", Style::city_extents);
+  std::map<int, int> per_class;
+  std::int64_t population = 0;
+  int roots = 0;
+  for (const auto& site : r.sites) {
+    ++per_class[site.radius_class];
+    population += site.population;
+    roots += site.parent < 0;
+  }
+  json classes = json::object();  // keyed by class so `compare` lines them up
+  for (std::size_t k = 0; k < r.quotas.size(); ++k)
+    if (per_class.count(int(k))) classes[std::to_string(k)] = {{"radius_m", r.quotas[k].radius_m}, {"cities", per_class[int(k)]}};
+  s.summary["sites"] = {{"cities", r.sites.size()}, {"roots", roots}, {"suburbs", int(r.sites.size()) - roots},
+                        {"population", population}, {"per_class", classes}};
+  s.sites = r.sites;
+}
+
+void sites_load(RunState& s) {
+  s.cities = read_vector(saved(s, "cities.geojson"), s.dem.georef().crs);
+  s.sites = sites::sites_from_layer(*s.cities, saved(s, "cities.geojson"));
+  // Centres lie on cell centres; GeoJSON keeps 7 decimals of lon/lat. Snap them back so the
+  // network (Delaunay on grid-aligned, often co-circular points) is the one a full run builds.
+  const GeoTransform& t = s.dem.georef().transform;
+  if (t[2] != 0 || t[4] != 0) return;  // rotated grids: keep the positions as read
+  for (auto& site : s.sites) {
+    site.col = std::clamp(int(std::floor((site.x - t[0]) / t[1])), 0, s.dem.cols() - 1);
+    site.row = std::clamp(int(std::floor((site.y - t[3]) / t[5])), 0, s.dem.rows() - 1);
+    const auto xy = s.dem.georef().cell_centre(site.col, site.row);
+    site.x = xy[0];
+    site.y = xy[1];
+  }
+}
+
+// ---- network (Belhadj 2007 §4.3.2; docs/sites.md) -------------------------------------------
+
+void network_run(RunState& s, Progress& progress, const Log&) {
+  const Crs& crs = s.dem.georef().crs;
+  const network::SiteGraph graph = network::build_network(s.sites, crs, network_options(s.scenario), progress);
+  s.network = network::network_layer(graph, s.sites, crs);
+  s.write("network", "network.geojson", *s.network, "candidate links between cities (kept = in the simplified network)",
+          Style::network);
+  std::size_t kept = 0;
+  double length_m = 0;
+  for (const auto& e : graph.edges)
+    if (e.kept) ++kept, length_m += e.length_m;
+  s.summary["network"] = {{"candidate_edges", graph.edges.size()}, {"kept_edges", kept},
+                          {"kept_length_km", round_to(length_m / 1000, 0.01)}};
+}
+
+void network_load(RunState& s) { s.network = read_vector(saved(s, "network.geojson"), s.dem.georef().crs); }
+
+// ---- roads (Galin et al. 2010, Peytavie 2010 ch. 4; Belhadj 2007 Alg. 16; docs/roads.md) ----
+
+void roads_run(RunState& s, Progress& progress, const Log& log) {
+  const RoadsSettings settings = roads_settings(s.scenario);
+  roads::TerrainField terrain(s.dem, s.scenario.resolved["water"]["sea_level_m"].get<double>(), settings.model.unknown_water_depth_m,
+                              settings.model.road_radius_m);
+  if (!settings.vegetation.empty())
+    terrain.set_vegetation(read_resampled(settings.vegetation, s.dem.georef(), s.dem.cols(), s.dem.rows(), Resampling::bilinear));
+  plugin::add_to_terrain(plugin::road_terms(s.plugins, s.dem, progress, log), terrain);
+  const roads::RoadGraph graph(terrain, settings.model, settings.routing.graph);
+  const roads::NetworkResult r = roads::route_network(terrain, graph, *s.network, &*s.cities, settings.routing, progress);
+  for (const auto& f : r.failed) log.warn("no road: " + f);
+  s.write("roads", "roads.geojson", roads::roads_layer(terrain, r.roads), "roads with class, router, length, cost, grades, structures",
+          Style::roads);
+  s.write("roads", "road_sections.geojson", roads::sections_layer(terrain, r.roads), "road, bridge, tunnel and ferry sections",
+          Style::road_sections);
+  std::map<std::string, double> km;
+  double bridge_m = 0, tunnel_m = 0;
+  for (const auto& road : r.roads) {
+    km[road.ferry ? "maritime" : road.road_class] += road.stats.length_m / 1000;
+    bridge_m += road.stats.bridge_m;
+    tunnel_m += road.stats.tunnel_m;
+  }
+  json per_class = json::object();
+  for (const char* c : {"motorway", "national", "departmental", "maritime"}) per_class[c] = round_to(km[c], 0.01);
+  s.summary["roads"] = {{"roads", r.roads.size()}, {"failed", r.failed.size()}, {"length_km", per_class},
+                        {"bridge_m", round_to(bridge_m, 0.1)}, {"tunnel_m", round_to(tunnel_m, 0.1)}};
+}
+
+void roads_load(RunState&) {}  // nothing downstream
+
+}  // namespace
+
+const std::vector<StageDef>& stages() {
+  static const std::vector<StageDef> list = {
+      {"terrain", {"dem", "input"}, terrain_run, terrain_load},
+      {"hydro", {"water", "hydro"}, hydro_run, hydro_load},
+      {"density", {"density", "plugins"}, density_run, density_load},
+      {"sites", {"sites", "seed"}, sites_run, sites_load},
+      {"network", {"network"}, network_run, network_load},
+      {"roads", {"roads"}, roads_run, roads_load},
+  };
+  return list;
+}
+
+}  // namespace terrapolis::pipeline
