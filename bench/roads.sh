@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Roads benchmark: one long road on the SRTM3 Alps tile (k = 5, m = 8), surface only and with
-# bridges and tunnels, against GRASS r.walk + r.drain between the same points; prints time, nodes
-# expanded, peak memory and each path's cost under the Terrapolis cost model.
+# bridges and tunnels, by A* and bidirectional A*, against GRASS r.walk + r.drain between the same
+# points; prints time, nodes expanded, long-arc rings priced, peak memory and each path's cost under
+# the Terrapolis cost model. Then a shorter road in the same tile, and a network on an island.
 # Usage: bench/roads.sh [BUILD_DIR]   (run from the repository root)
 set -euo pipefail
 build=${1:-build}
@@ -10,15 +11,17 @@ dem=../shared/dems/N47E009.hgt
 from=9.2,47.5; to=9.6,47.3          # Toggenburg (Thur valley) to the Rhine valley near Feldkirch
 out=$(mktemp -d); trap 'rm -rf "$out"' EXIT
 
-run() {  # label, extra arguments
+run() {  # label, extra arguments (the end points are $from and $to)
   local label=$1; shift
-  /usr/bin/time -f "%e %U %M" -o "$out/time" "$bin" --progress none path "$dem" --from $from --to $to "$out/$label.geojson" "$@" 2>"$out/$label.log"
+  /usr/bin/time -f "%e %U %M" -o "$out/time" "$bin" -v --progress none path "$dem" --from $from --to $to "$out/$label.geojson" "$@" 2>"$out/$label.log"
   read -r secs user kb <"$out/time"
   echo "$label: $(grep -o 'galin:.*' "$out/$label.log") | wall ${secs} s, CPU ${user} s, peak ${kb} kB"
+  grep -o 'corners:.*' "$out/$label.log" | sed "s/^/  $label /"
 }
 run surface_astar --no-bridges --no-tunnels
 run surface_bidir --no-bridges --no-tunnels --search bidir
 run structures_astar
+run structures_bidir --search bidir
 
 if command -v grass >/dev/null; then
   # GRASS: r.walk (anisotropic walking cost, Naismith/Langmuir) from the start, r.drain back from the end.
@@ -45,6 +48,12 @@ if command -v grass >/dev/null; then
 else
   echo "GRASS not installed (apt-get install -y grass-core): peer skipped"
 fi
+
+# A shorter road in the same tile (18 km), surface only and with bridges and tunnels.
+from=9.3,47.4; to=9.45,47.3
+run short_surface_astar --no-bridges --no-tunnels
+run short_structures_astar
+from=9.2,47.5; to=9.6,47.3
 
 # A whole network on an island: Corsica (GEBCO 15", bundled sample), 200 land sites every few
 # cells, each joined to its two nearest neighbours (about 200 roads), both routers.

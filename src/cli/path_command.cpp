@@ -41,6 +41,7 @@ class PathCommand final : public Command {
     routing.search = search_ == "bidir" ? roads::SearchMethod::bidirectional : search_ == "dijkstra" ? roads::SearchMethod::dijkstra : roads::SearchMethod::astar;
     if (evaluate_.empty()) check_output_path(out_, options_.overwrite);
     if (!sections_.empty()) check_output_path(sections_, options_.overwrite);
+    if (evaluate_.empty() && !options_.earthworks.empty()) check_output_path(options_.earthworks, options_.overwrite);
     const roads::CostModel model = options_.cost_model();
     const plugin::PluginSet plugins = options_.plugins.load(context.log);
     const Dem dem = read_dem(dem_);
@@ -68,15 +69,21 @@ class PathCommand final : public Command {
     roads[0].road_class = "departmental";
     const VectorLayer layer = roads::roads_layer(terrain, roads);
     const VectorLayer sections = roads::sections_layer(terrain, roads);
+    const Dem levelled = options_.earthworks_dem(dem, terrain, roads);
     write_vector(out_, layer, options_.overwrite);
     if (!sections_.empty()) write_vector(sections_, sections, options_.overwrite);
+    options_.write_earthworks(levelled);
     const auto& s = road->stats;
     char line[512];
     std::snprintf(line, sizeof line,
-                  "%s: %.0f m, cost %.1f, max grade %.1f %%, mean grade %.1f %%, bridges %.0f m, tunnels %.0f m; %zu nodes expanded, %zu stored, %.2f s",
+                  "%s: %.0f m, cost %.1f, max grade %.1f %%, mean grade %.1f %%, bridges %.0f m, tunnels %.0f m; %zu nodes expanded, %zu rings of long arcs priced, %zu stored, %.2f s",
                   road->router.c_str(), s.length_m, road->cost.value_or(NAN), s.max_grade_pct, s.mean_grade_pct, s.bridge_m, s.tunnel_m,
-                  road->expanded, road->nodes, seconds);
+                  road->expanded, road->rings_priced, road->nodes, seconds);
     context.log.info(line);
+    const auto& g = road->geometry;
+    if (g.clothoid_corners + g.g1_corners + g.sharp_corners > 0)
+      context.log.detail("corners: " + std::to_string(g.clothoid_corners) + " clothoid pairs, " + std::to_string(g.g1_corners) +
+                         " quadratic (G1) fallbacks, " + std::to_string(g.sharp_corners) + " left sharp");
   }
 
  private:

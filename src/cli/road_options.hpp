@@ -8,13 +8,14 @@
 
 #include "cli/plugin_options.hpp"
 #include "io/raster_io.hpp"
+#include "roads/earthworks.hpp"
 #include "roads/road_network.hpp"
 
 namespace terrapolis::cli {
 
 struct RoadOptions {
   int k = 5, angles = 8;
-  std::string costs, vegetation;
+  std::string costs, vegetation, earthworks;
   bool bridges = true, tunnels = true, overwrite = false;
   std::uint64_t seed = 1;
   double sea_level = 0;
@@ -37,8 +38,24 @@ struct RoadOptions {
     app.add_option("--bezier-evaluations", bezier_evaluations, "Bézier router budget: curve evaluations per road (replaces the thesis' 1000 ms, for reproducible roads)")->check(CLI::Range(1, 1000000));
     app.add_option("--bezier-threshold", bezier_threshold, "Bézier router: stop when the worst position costs less (0..1)")->check(CLI::Range(0.0, 1.0));
     app.add_option("--bezier-tries", bezier_tries, "Bézier router: control points drawn per worst position")->check(CLI::Range(1, 100000));
+    app.add_option("--earthworks", earthworks, "Also write the DEM after cut-and-fill along the surface roads (GeoTIFF; 8 m carriageway, 2:3 sides)");
     plugins.setup(app, "adds its road cost term (characteristic priced by its transfer functions; galin router)");
     app.add_flag("--overwrite", overwrite, "Replace existing outputs");
+  }
+
+  /// The DEM after the earthworks of the roads (empty when --earthworks is not given).
+  Dem earthworks_dem(const Dem& dem, const roads::TerrainField& terrain, const std::vector<roads::Road>& roads) const {
+    if (earthworks.empty()) return Dem();
+    std::vector<const roads::RoadGeometry*> geometries;
+    for (const roads::Road& r : roads) geometries.push_back(&r.geometry);
+    return roads::earthworks(dem, terrain, geometries);
+  }
+  void write_earthworks(const Dem& levelled) const {
+    if (earthworks.empty()) return;
+    WriteOptions w;
+    w.overwrite = overwrite;
+    w.description = "terrain after cut-and-fill along the roads (m)";
+    write_raster(earthworks, levelled, w);
   }
 
   roads::CostModel cost_model() const {

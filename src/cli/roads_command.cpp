@@ -42,6 +42,7 @@ class RoadsCommand final : public Command {
       check_output_path(roads_path, options_.overwrite);
       check_output_path(sections_path, options_.overwrite);
     }
+    if (!options_.earthworks.empty()) check_output_path(options_.earthworks, options_.overwrite);
 
     const roads::CostModel model = options_.cost_model();
     const plugin::PluginSet plugins = options_.plugins.load(context.log);
@@ -68,6 +69,7 @@ class RoadsCommand final : public Command {
         roads::route_network(terrain, graph, network, cities ? &*cities : nullptr, options_.routing(), context.progress);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     for (const std::string& f : result.failed) context.log.warn("no road under the cost model for edge " + f + " (left out)");
+    const Dem levelled = options_.earthworks_dem(dem, terrain, result.roads);
     if (create_folder) {
       std::error_code ec;
       fs::create_directories(outdir_, ec);
@@ -75,6 +77,7 @@ class RoadsCommand final : public Command {
     }
     write_vector(roads_path, roads::roads_layer(terrain, result.roads), options_.overwrite);
     write_vector(sections_path, roads::sections_layer(terrain, result.roads), options_.overwrite);
+    options_.write_earthworks(levelled);
     std::size_t ferries = 0;
     double km = 0;
     for (const auto& r : result.roads) {

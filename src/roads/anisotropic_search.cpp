@@ -67,6 +67,7 @@ RoadGraph::RoadGraph(const TerrainField& terrain, const CostModel& model, const 
     const double keep = ring.empty() ? 0.0 : std::min(1.0, double(sc.samples) / double(ring.size()));
     const std::uint64_t threshold = keep >= 1.0 ? ~std::uint64_t(0) : std::uint64_t(keep * 18446744073709551615.0);
     (s == Structure::bridge ? bridge_keep_ : tunnel_keep_) = threshold;
+    period_[int(s)] = keep >= 1.0 ? 1 : kSamplePeriod;
     if (keep <= 0) continue;
     const int b = block[int(s)];
     for (const MaskArc& a : ring) arcs_.push_back({a.dcol, a.drow, s, b * m + sector_of(a.angle_rad, m), a.angle_rad});
@@ -87,6 +88,9 @@ RoadGraph::RoadGraph(const TerrainField& terrain, const CostModel& model, const 
       if (c == kInfinity) continue;
       pts.push_back({std::tan(sdeg / kDeg), 0.99 * c});
     }
+    // A path of total grade t may climb steeper in places, so the bound must not decrease with
+    // the grade: take the cheapest cost at any steeper grade (a no-op for increasing curves).
+    for (std::size_t i = pts.size(); i-- > 1;) pts[i - 1][1] = std::min(pts[i - 1][1], pts[i][1]);
     std::vector<std::array<double, 2>> hull;
     for (const auto& p : pts) {
       while (hull.size() >= 2) {
@@ -109,13 +113,12 @@ RoadGraph::RoadGraph(const TerrainField& terrain, const CostModel& model, const 
     if (kappa_ == kInfinity) kappa_ = 0;
     if (!hull_c_.empty()) cheapest_ = std::min(cheapest_, hull_c_.front());
   }
+  build_rings();
   // Turn costs: the turn is the angle between the incoming sector and the new arc, less half a
   // sector (the exact incoming direction is only known to within a sector), priced by the stricter
   // of the two structures' curvature functions. m = 1 makes every turn free.
   const StructureCosts* costs[3] = {&model.road, &model.bridge, &model.tunnel};
   turn_.assign(std::size_t(orientations_) * arcs_.size(), 0.0);
-  into_.assign(std::size_t(orientations_), {});
-  for (std::size_t a = 0; a < arcs_.size(); ++a) into_[std::size_t(arcs_[a].orientation)].push_back(int(a));
   for (int o = 0; o + 1 < orientations_; ++o) {
     const int blk = o / m, sector = o % m;
     Structure in = Structure::road;
@@ -130,6 +133,133 @@ RoadGraph::RoadGraph(const TerrainField& terrain, const CostModel& model, const 
           std::max(costs[int(in)]->curvature_deg(turn), costs[int(arcs_[a].structure)]->curvature_deg(turn));
     }
   }
+  // Arc lists. Surface arcs: out of a node only those with a finite turn, into it every arc of its
+  // orientation. Long arcs: the same per ring and per sampling class of the cell (see pair_sampled).
+  from_.assign(std::size_t(orientations_), {});
+  into_.assign(std::size_t(orientations_), {});
+  orientation_structure_.assign(std::size_t(orientations_), Structure::road);
+  for (int s = 0; s < 3; ++s)
+    if (block[s] >= 0)
+      for (int i = 0; i < m; ++i) orientation_structure_[std::size_t(block[s] * m + i)] = Structure(s);
+  for (std::size_t a = 0; a < surface_arcs_; ++a) {
+    into_[std::size_t(arcs_[a].orientation)].push_back(int(a));
+    for (int o = 0; o < orientations_; ++o)
+      if (turn_cost(o, int(a)) < kInfinity) from_[std::size_t(o)].push_back(int(a));
+  }
+  const std::size_t nr = rings_.size(), no = std::size_t(orientations_);
+  int classes = 1;
+  for (int s = 1; s < 3; ++s) classes = std::max(classes, period_[s] * period_[s]);
+  // Built in index order ((class, orientation), ring) straight into the flat arrays; the long arcs
+  // are sorted by ring, so a class's kept arcs come out grouped by ring.
+  long_from_start_.assign(1, 0);
+  long_into_start_.assign(1, 0);
+  std::vector<int> kept_from, kept_into;
+  std::vector<std::vector<int>> into_by_slot(no * nr);
+  for (int cls = 0; cls < classes; ++cls) {
+    kept_from.clear();
+    for (auto& l : into_by_slot) l.clear();
+    for (std::size_t a = surface_arcs_; a < arcs_.size(); ++a) {
+      const Arc& arc = arcs_[a];
+      const int period = period_[int(arc.structure)];
+      if (cls >= period * period) continue;
+      const int col = cls % period, row = cls / period;
+      if (pair_sampled(int(a), col, row)) kept_from.push_back(int(a));
+      // Into a cell of this class: the arc from c - d exists when the pair drawn from there is kept.
+      if (pair_sampled(int(a), col - arc.dcol, row - arc.drow))
+        into_by_slot[std::size_t(arc.orientation) * nr + std::size_t(ring_of_[a - surface_arcs_])].push_back(int(a));
+    }
+    std::size_t k = 0;
+    for (std::size_t ring = 0; ring < nr; ++ring) {
+      for (; k < kept_from.size() && std::size_t(ring_of_[std::size_t(kept_from[k]) - surface_arcs_]) == ring; ++k)
+        long_from_.push_back(kept_from[k]);
+      long_from_start_.push_back(long_from_.size());
+    }
+    for (std::size_t o = 0; o < no; ++o) {
+      for (std::size_t ring = 0; ring < nr; ++ring) {
+        const auto& l = into_by_slot[o * nr + ring];
+        long_into_.insert(long_into_.end(), l.begin(), l.end());
+        long_into_start_.push_back(long_into_.size());
+      }
+    }
+  }
+}
+
+void RoadGraph::build_rings() {
+  // Sort the long arcs by structure and length, then cut each structure's arcs into bands of
+  // equal length range. Lengths use the narrowest cell of the grid, so no arc is shorter.
+  double wmin = kInfinity, hmin = kInfinity;
+  for (int r = 0; r < terrain_.rows(); ++r) {
+    wmin = std::min(wmin, terrain_.metres_x(r));
+    hmin = std::min({hmin, terrain_.metres_y(r - 0.5), terrain_.metres_y(r + 0.5)});
+  }
+  auto min_length = [&](const Arc& a) { return std::hypot(a.dcol * wmin, a.drow * hmin); };
+  std::stable_sort(arcs_.begin() + std::ptrdiff_t(surface_arcs_), arcs_.end(), [&](const Arc& a, const Arc& b) {
+    if (a.structure != b.structure) return int(a.structure) < int(b.structure);
+    return min_length(a) < min_length(b);
+  });
+  ring_of_.assign(arcs_.size() - surface_arcs_, -1);
+  constexpr int kRings = 10;
+  for (Structure s : {Structure::bridge, Structure::tunnel}) {
+    std::size_t first = arcs_.size(), last = 0;
+    for (std::size_t a = surface_arcs_; a < arcs_.size(); ++a)
+      if (arcs_[a].structure == s) first = std::min(first, a), last = a + 1;
+    if (first >= last) continue;
+    const StructureCosts& sc = s == Structure::bridge ? model_.bridge : model_.tunnel;
+    // Per-metre floor of the structure, and its margin over the heuristic's envelope g at every
+    // grade it allows: an arc of length L costs at least L (floor) and, since the heuristic is
+    // consistent (a subadditive bound of the distance and climb), e + h(target) - h(source) >= L
+    // (margin). 0.75 keeps the keys clear of rounding and of the row-to-row change of cell widths
+    // on geographic grids.
+    const double fixed = sc.water_depth_m.min_value() + sc.vegetation.min_value() +
+                         (s == Structure::bridge ? sc.height_m.min_value() : sc.depth_m.min_value());
+    double floor = kInfinity, margin = kInfinity;
+    for (double sdeg = 0; sdeg <= 89.5; sdeg += 0.05) {
+      const double c = sc.slope_deg(sdeg) + fixed;
+      if (c == kInfinity) continue;
+      floor = std::min(floor, c);
+      margin = std::min(margin, c - envelope(std::tan(sdeg / kDeg)) - 0.01);
+    }
+    if (floor == kInfinity) floor = margin = 0;
+    const double lo = min_length(arcs_[first]), hi = min_length(arcs_[last - 1]);
+    const int base = int(rings_.size());
+    for (std::size_t a = first; a < last; ++a) {
+      const double l = min_length(arcs_[a]);
+      const int r = hi > lo ? std::min(kRings - 1, int((l - lo) / (hi - lo) * kRings)) : 0;
+      ring_of_[a - surface_arcs_] = base + r;
+    }
+    for (int r = 0; r < kRings; ++r) rings_.push_back({s, kInfinity, 0, 0, -1});
+    for (std::size_t a = first; a < last; ++a) {
+      Ring& ring = rings_[std::size_t(ring_of_[a - surface_arcs_])];
+      ring.min_length_m = std::min(ring.min_length_m, min_length(arcs_[a]));
+    }
+    // Drop empty rings (renumbering), then link each to the next of its structure.
+    std::vector<int> renumber(kRings, -1);
+    int kept = base;
+    for (int r = 0; r < kRings; ++r) {
+      if (rings_[std::size_t(base + r)].min_length_m == kInfinity) continue;
+      rings_[std::size_t(kept)] = rings_[std::size_t(base + r)];
+      renumber[std::size_t(r)] = kept++;
+    }
+    rings_.resize(std::size_t(kept));
+    for (std::size_t a = first; a < last; ++a) ring_of_[a - surface_arcs_] = renumber[std::size_t(ring_of_[a - surface_arcs_] - base)];
+    first_ring_[int(s)] = base;
+    for (int r = base; r < kept; ++r) {
+      Ring& ring = rings_[std::size_t(r)];
+      ring.with_heuristic = 0.75 * std::max(0.0, margin) * ring.min_length_m;
+      ring.without_heuristic = 0.75 * floor * ring.min_length_m;
+      ring.next = r + 1 < kept ? r + 1 : -1;
+    }
+  }
+}
+
+double RoadGraph::envelope(double grade) const {
+  if (hull_t_.empty()) return cheapest_;
+  if (hull_t_.size() == 1 || grade <= hull_t_.front()) return hull_c_.front();
+  if (grade >= hull_t_.back()) return hull_c_.back();
+  const auto it = std::upper_bound(hull_t_.begin(), hull_t_.end(), grade);
+  const std::size_t j = std::size_t(it - hull_t_.begin());
+  const double f = (grade - hull_t_[j - 1]) / (hull_t_[j] - hull_t_[j - 1]);
+  return hull_c_[j - 1] + f * (hull_c_[j] - hull_c_[j - 1]);
 }
 
 double RoadGraph::road_slope_cost(double grade) const {
@@ -145,13 +275,42 @@ double RoadGraph::surface_cost_per_m(double slope_deg, double depth_m) const {
   return model_.road.slope_deg(slope_deg) + model_.road.water_depth_m(depth_m);
 }
 
-bool RoadGraph::arc_sampled(Cell from, int arc) const {
+int RoadGraph::sample_class(Structure s, int col, int row) const {
+  const int period = period_[int(s)];
+  return ((row % period + period) % period) * period + (col % period + period) % period;
+}
+
+bool RoadGraph::pair_sampled(int arc, int from_class_col, int from_class_row) const {
+  // The unordered pair {p, p + d} is drawn once, from its end with the canonical offset (south, or
+  // due east): the same draw whichever end the search stands on.
   const Arc& a = arcs_[std::size_t(arc)];
-  if (a.structure == Structure::road) return true;
-  const std::uint64_t p = terrain_.index(from.col, from.row), q = terrain_.index(from.col + a.dcol, from.row + a.drow);
-  const std::uint64_t lo = std::min(p, q), hi = std::max(p, q);
-  const std::uint64_t h = splitmix64(salt_[int(a.structure)] ^ (lo * 0x100000001b3ULL + hi));
+  if ((a.structure == Structure::bridge ? bridge_keep_ : tunnel_keep_) == ~std::uint64_t(0)) return true;
+  const bool canonical = a.drow > 0 || (a.drow == 0 && a.dcol > 0);
+  const int dc = canonical ? a.dcol : -a.dcol, dr = canonical ? a.drow : -a.drow;
+  const int period = period_[int(a.structure)];
+  const int sc = canonical ? from_class_col : from_class_col + a.dcol, sr = canonical ? from_class_row : from_class_row + a.drow;
+  const std::uint64_t cls = std::uint64_t(((sr % period + period) % period) * period + (sc % period + period) % period);
+  const std::uint64_t offset = std::uint64_t((dr + 1024) * 2048 + (dc + 1024));
+  const std::uint64_t h = splitmix64(salt_[int(a.structure)] ^ (offset * 0x100000001b3ULL + cls));
   return h <= (a.structure == Structure::bridge ? bridge_keep_ : tunnel_keep_);
+}
+
+bool RoadGraph::arc_sampled(Cell from, int arc) const {
+  if (arcs_[std::size_t(arc)].structure == Structure::road) return true;
+  return pair_sampled(arc, from.col, from.row);
+}
+
+std::span<const int> RoadGraph::arcs_from(Cell c, int orientation, int slot) const {
+  if (slot == 0) return from_[std::size_t(orientation)];
+  const std::size_t i = std::size_t(sample_class(rings_[std::size_t(slot - 1)].structure, c.col, c.row)) * rings_.size() + std::size_t(slot - 1);
+  return {long_from_.data() + long_from_start_[i], long_from_start_[i + 1] - long_from_start_[i]};
+}
+
+std::span<const int> RoadGraph::arcs_into(Cell c, int orientation, int slot) const {
+  if (slot == 0) return into_[std::size_t(orientation)];
+  const std::size_t i = (std::size_t(sample_class(rings_[std::size_t(slot - 1)].structure, c.col, c.row)) * std::size_t(orientations_) +
+                         std::size_t(orientation)) * rings_.size() + std::size_t(slot - 1);
+  return {long_into_.data() + long_into_start_[i], long_into_start_[i + 1] - long_into_start_[i]};
 }
 
 double RoadGraph::arc_cost(Cell from, int arc) const {
@@ -189,27 +348,35 @@ double RoadGraph::arc_cost(Cell from, int arc) const {
   const double za = terrain_.surface(from.col, from.row), zb = terrain_.surface(c1, r1);
   const double per_m_slope = sc.slope_deg(std::atan(std::fabs(zb - za) / length) * kDeg);
   if (per_m_slope == kInfinity) return kInfinity;
-  for (int i = 0; i < n; ++i) {
+  // Per-metre cost of sample i (infinity when the deck cuts the ground or breaks a threshold).
+  auto sample = [&](int i) {
     const double t = (i + 0.5) / n;
     const double col = from.col + dc * (i + 0.5), row = from.row + dr * (i + 0.5);
     const double deck = za + t * (zb - za);
     const double depth = terrain_.depth_at(col, row);
-    double c;
     if (bridge) {
       const double h = deck - terrain_.surface_at(col, row);
       if (h < 0) return kInfinity;  // the deck would cut the ground
-      c = sc.height_m(h) + sc.water_depth_m(depth);
-      c += sc.vegetation(terrain_.vegetation_at(col, row));
-    } else {
-      const double d = terrain_.ground_at(col, row) - deck;
-      if (d < 0) return kInfinity;  // the tube would leave the ground (or the sea floor)
-      c = sc.depth_m(d) + sc.water_depth_m(depth);
-      c += sc.vegetation(terrain_.vegetation_at(col, row));
+      return sc.height_m(h) + sc.water_depth_m(depth) + sc.vegetation(terrain_.vegetation_at(col, row)) +
+             terrain_.extra_cost_at(a.structure, col, row);  // cost layers (plugins)
     }
-    c += terrain_.extra_cost_at(a.structure, col, row);  // cost layers (plugins)
-    if (c == kInfinity) return kInfinity;
-    total += (c + per_m_slope) * dl;
-  }
+    const double d = terrain_.ground_at(col, row) - deck;
+    if (d < 0) return kInfinity;  // the tube would leave the ground (or the sea floor)
+    return sc.depth_m(d) + sc.water_depth_m(depth) + sc.vegetation(terrain_.vegetation_at(col, row)) +
+           terrain_.extra_cost_at(a.structure, col, row);  // cost layers (plugins)
+  };
+  // Most long arcs are infeasible somewhere along their span: probe every eighth sample first so
+  // that they are rejected early, then sum in order (the same sum as a plain loop, bit for bit).
+  thread_local std::vector<double> c;
+  c.assign(std::size_t(n), -1.0);
+  const int stride = std::max(1, n / 8);
+  for (int pass = 0; pass < 2; ++pass)
+    for (int i = pass == 0 ? stride / 2 : 0; i < n; i += pass == 0 ? stride : 1) {
+      if (c[std::size_t(i)] >= 0) continue;
+      c[std::size_t(i)] = sample(i);
+      if (c[std::size_t(i)] == kInfinity) return kInfinity;
+    }
+  for (int i = 0; i < n; ++i) total += (c[std::size_t(i)] + per_m_slope) * dl;
   return total;
 }
 
@@ -223,11 +390,7 @@ double RoadGraph::lower_bound(Cell a, Cell b) const {
   const double z = std::fabs(double(terrain_.surface(b.col, b.row)) - double(terrain_.surface(a.col, a.row)));
   if (hull_t_.size() < 2 || kappa_ <= 0) return cheapest_ * d;
   if (d <= 0 || z >= best_grade_ * d) return std::max(cheapest_ * d, kappa_ * z);
-  const double t = z / d;  // below the best grade: cover D at grade t along the envelope
-  const auto it = std::upper_bound(hull_t_.begin(), hull_t_.end(), t);
-  const std::size_t j = std::size_t(std::clamp<std::ptrdiff_t>(it - hull_t_.begin(), 1, std::ptrdiff_t(hull_t_.size()) - 1));
-  const double f = (t - hull_t_[j - 1]) / (hull_t_[j] - hull_t_[j - 1]);
-  return d * (hull_c_[j - 1] + f * (hull_c_[j] - hull_c_[j - 1]));
+  return d * envelope(z / d);  // below the best grade: cover D at grade z / D along the envelope
 }
 
 namespace {
@@ -242,8 +405,13 @@ struct QueueItem {
   double f;
   std::uint64_t key;
   std::uint32_t node;
+  std::int32_t ring;  ///< -1: expand the node; r >= 0: price the node's long arcs of ring r
   double g;
-  bool operator<(const QueueItem& o) const { return f != o.f ? f > o.f : key > o.key; }  // min-heap, ties by key
+  bool operator<(const QueueItem& o) const {  // min-heap; ties by key then ring, so the order is fixed
+    if (f != o.f) return f > o.f;
+    if (key != o.key) return key > o.key;
+    return ring > o.ring;
+  }
 };
 
 /// One direction of the search: its nodes and its queue. Nodes are stored per cell: a dense array
@@ -333,6 +501,38 @@ class ArcCache {
   std::vector<float> costs_;
 };
 
+/// Long-arc costs of the rings priced so far, per cell and ring (a cell's ring is priced once per
+/// orientation it is expanded in, about 6 times on an Alpine road, but its arcs cost the same from
+/// each), computed lazily (NaN = not yet) and kept as floats. Bounded: past `cap` values it stops
+/// storing and the costs are recomputed, with the same rounding, so the cache never changes a result.
+class LongArcCache {
+ public:
+  LongArcCache(std::size_t cells, std::size_t rings, std::size_t cap) : rings_(rings), cap_(cap), slot_(rings ? cells : 0, kNone) {}
+  /// The costs of ring r of a cell whose list holds n arcs, or nullptr when the cache is full; valid
+  /// until the next call.
+  float* ring(std::size_t cell, int r, std::size_t n) {
+    std::uint32_t& s = slot_[cell];
+    if (s == kNone) {
+      if (heads_.size() + values_.size() + rings_ > cap_) return nullptr;
+      s = std::uint32_t(heads_.size() / rings_);
+      heads_.resize(heads_.size() + rings_, kNone);
+    }
+    std::uint32_t& h = heads_[std::size_t(s) * rings_ + std::size_t(r)];
+    if (h == kNone) {
+      if (heads_.size() + values_.size() + n > cap_) return nullptr;
+      h = std::uint32_t(values_.size());
+      values_.resize(values_.size() + n, std::numeric_limits<float>::quiet_NaN());
+    }
+    return values_.data() + h;
+  }
+
+ private:
+  static constexpr std::uint32_t kNone = 0xffffffffu;
+  std::size_t rings_, cap_;
+  std::vector<std::uint32_t> slot_, heads_;
+  std::vector<float> values_;
+};
+
 }  // namespace
 
 SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMethod method, std::size_t max_nodes,
@@ -348,6 +548,7 @@ SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMet
   };
   auto orient_of = [&](std::uint64_t key) { return int(key % O); };
   const bool use_h = method != SearchMethod::dijkstra;
+  const bool bidir = method == SearchMethod::bidirectional;
   const std::size_t goal_index = t.index(to.col, to.row);
   if (from == to) {
     result.found = true;
@@ -364,52 +565,143 @@ SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMet
     best_h = std::min(best_h, h);
     if ((result.expanded & 4095) == 0) step->update(std::clamp(1.0 - best_h / h0, 0.0, 1.0));
   };
+  // Queue keys. A*: g + h(v), h(v) = lower_bound(v, to); Dijkstra: g. Bidirectional A* uses the
+  // balanced potential p(v) = (h_to(v) - h_from(v)) / 2 (Ikeda et al. 1994; Goldberg & Harrelson
+  // 2005): forward key g + p(v), backward key g - p(v). Both heuristics are consistent, so the
+  // reduced arc costs l(u,v) - p(u) + p(v) are >= 0 in both directions and the search may stop as
+  // soon as top_f + top_b >= mu, the best meeting cost (the bidirectional Dijkstra rule on the
+  // reduced costs).
+  auto potential = [&](Cell v) {
+    if (!use_h) return 0.0;
+    if (!bidir) return graph.lower_bound(v, to);
+    return 0.5 * (graph.lower_bound(v, to) - graph.lower_bound(v, from));
+  };
+  auto ring_offset = [&](int r) {
+    const RoadGraph::Ring& ring = graph.rings()[std::size_t(r)];
+    return use_h ? ring.with_heuristic : ring.without_heuristic;
+  };
   const std::vector<RoadGraph::Arc>& arcs = graph.arcs();
-  const int na = int(arcs.size());
 
-  Frontier fw(t.size(), O), bw(method == SearchMethod::bidirectional ? t.size() : 0, O);
+  Frontier fw(t.size(), O), bw(bidir ? t.size() : 0, O);
   ArcCache cache(graph);
+  LongArcCache long_cache(t.size(), graph.rings().size(), std::size_t(1) << 25);  // at most 128 MB
+  // Long arcs are priced as floats in both directions, cached or not, so every search sees the same costs.
+  auto long_cost = [&](Cell from_cell, int a) { return double(float(graph.arc_cost(from_cell, a))); };
   auto check_memory = [&]() {
     if (fw.nodes.size() + bw.nodes.size() + cache.cells() * graph.surface_arcs() / 4 > max_nodes)
       throw processing_error("path: the search stored more than " + std::to_string(max_nodes) +
                              " nodes; use a smaller --k or --angles, or closer end points");
   };
+  double mu = kInfinity;
+  std::uint64_t meet = 0;
+  auto try_meet = [&](std::uint64_t key, double g, const Frontier& other) {
+    if (!bidir) return;
+    const std::uint32_t j = other.find(key);
+    if (j == Frontier::kNone) return;
+    const double total = g + other.nodes[j].g;
+    if (total < mu || (total == mu && key < meet)) {
+      mu = total;
+      meet = key;
+    }
+  };
+  // Forward: the arcs of `slot` (0 surface, r + 1 ring r) out of the node of q.
+  auto expand_forward = [&](const QueueItem& q, int slot) {
+    const Cell c = cell_of(q.key);
+    const int o = orient_of(q.key);
+    const std::span<const int> list = graph.arcs_from(c, o, slot);
+    float* costs = slot == 0 ? cache.row(t.index(c.col, c.row)) : long_cache.ring(t.index(c.col, c.row), slot - 1, list.size());
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const int a = list[i];
+      const RoadGraph::Arc& arc = arcs[std::size_t(a)];
+      const Cell n{c.col + arc.dcol, c.row + arc.drow};
+      if (!t.inside(n.col, n.row)) continue;
+      const double turn = graph.turn_cost(o, a);
+      if (turn == kInfinity) continue;  // long arcs: the lists do not depend on the orientation
+      double e;
+      if (slot == 0) {
+        e = cache.get(c, costs, a);
+      } else if (costs) {
+        if (std::isnan(costs[i])) costs[i] = float(long_cost(c, a));
+        e = costs[i];
+      } else {
+        e = long_cost(c, a);
+      }
+      if (e == kInfinity) continue;
+      const double g = q.g + turn + e;
+      bool improved;
+      const std::uint32_t idx = fw.relax(key_of(n, arc.orientation), g, q.node, a, improved);
+      if (improved) {
+        fw.push({g + potential(n), fw.key(idx), idx, -1, g});
+        try_meet(fw.key(idx), g, bw);
+      }
+    }
+  };
+  // Backward: the arcs of `slot` into the node of q, from every orientation of their source.
+  auto expand_backward = [&](const QueueItem& q, int slot) {
+    const Cell c = cell_of(q.key);
+    const int o = orient_of(q.key);
+    for (int a : graph.arcs_into(c, o, slot)) {
+      const RoadGraph::Arc& arc = arcs[std::size_t(a)];
+      const Cell p{c.col - arc.dcol, c.row - arc.drow};
+      if (!t.inside(p.col, p.row)) continue;
+      const double e = slot == 0 ? cache.get(p, t.index(p.col, p.row), a) : long_cost(p, a);
+      if (e == kInfinity) continue;
+      const double hp = potential(p);
+      for (int po = 0; po < graph.orientations(); ++po) {
+        if (po == graph.start_orientation() && !(p == from)) continue;
+        const double turn = graph.turn_cost(po, a);
+        if (turn == kInfinity) continue;
+        const double g = q.g + turn + e;
+        bool improved;
+        const std::uint32_t idx = bw.relax(key_of(p, po), g, q.node, a, improved);
+        if (improved) {
+          bw.push({g - hp, bw.key(idx), idx, -1, g});
+          try_meet(bw.key(idx), g, fw);
+        }
+      }
+    }
+  };
+  std::uint32_t goal_node = Frontier::kNone;  // A*, Dijkstra: the goal node when it is popped
+  // Pops one entry of a direction and processes it; returns false when it is the goal (A*).
+  auto step_once = [&](bool forward) {
+    Frontier& me = forward ? fw : bw;
+    const QueueItem q = me.pop();
+    if (q.g > me.nodes[q.node].g) return true;  // stale: the node was reached more cheaply since
+    const Cell c = cell_of(q.key);
+    const double node_key = forward ? q.g + potential(c) : q.g - potential(c);
+    if (q.ring >= 0) {
+      forward ? expand_forward(q, q.ring + 1) : expand_backward(q, q.ring + 1);
+      const int next = graph.rings()[std::size_t(q.ring)].next;
+      if (next >= 0) me.push({node_key + ring_offset(next), q.key, q.node, next, q.g});
+      ++result.rings_priced;
+      return true;
+    }
+    if (!bidir && t.index(c.col, c.row) == goal_index) {
+      goal_node = q.node;
+      return false;
+    }
+    ++result.expanded;
+    report(forward ? graph.lower_bound(c, to) : graph.lower_bound(c, from));
+    forward ? expand_forward(q, 0) : expand_backward(q, 0);
+    // Long arcs wait in the queue, one entry per ring, keyed by the node's key plus a lower bound of
+    // what an arc of the ring adds to it: a ring is priced only if that key comes up before the end.
+    for (Structure s : {Structure::bridge, Structure::tunnel}) {
+      if (!forward && graph.structure_of(orient_of(q.key)) != s) continue;  // arcs into the node are of its structure
+      const int r = graph.first_ring(s);
+      if (r >= 0) me.push({node_key + ring_offset(r), q.key, q.node, r, q.g});
+    }
+    check_memory();
+    return true;
+  };
+
   {
     bool imp;
     const std::uint32_t s = fw.relax(key_of(from, graph.start_orientation()), 0.0, Frontier::kNone, -1, imp);
-    fw.push({use_h ? h0 : 0.0, fw.key(s), s, 0.0});
+    fw.push({potential(from), fw.key(s), s, -1, 0.0});
   }
-
-  if (method != SearchMethod::bidirectional) {
-    std::uint32_t goal_node = Frontier::kNone;
-    while (!fw.heap.empty()) {
-      const QueueItem q = fw.pop();
-      if (q.g > fw.nodes[q.node].g) continue;  // stale entry
-      const std::uint64_t key = q.key;
-      const Cell c = cell_of(key);
-      if (t.index(c.col, c.row) == goal_index) {
-        goal_node = q.node;
-        break;
-      }
-      ++result.expanded;
-      report(graph.lower_bound(c, to));
-      const int o = orient_of(key);
-      float* costs = cache.row(t.index(c.col, c.row));
-      for (int a = 0; a < na; ++a) {
-        const RoadGraph::Arc& arc = arcs[std::size_t(a)];
-        if (!t.inside(c.col + arc.dcol, c.row + arc.drow) || !graph.arc_sampled(c, a)) continue;
-        const double turn = graph.turn_cost(o, a);
-        if (turn == kInfinity) continue;
-        const double e = cache.get(c, costs, a);
-        if (e == kInfinity) continue;
-        const Cell n{c.col + arc.dcol, c.row + arc.drow};
-        const double g = q.g + turn + e;
-        bool improved;
-        const std::uint32_t idx = fw.relax(key_of(n, arc.orientation), g, q.node, a, improved);
-        if (improved) fw.push({g + (use_h ? graph.lower_bound(n, to) : 0.0), fw.key(idx), idx, g});
-      }
-      check_memory();
-    }
+  if (!bidir) {
+    while (!fw.heap.empty())
+      if (!step_once(true)) break;
     result.nodes = fw.stored;
     if (goal_node == Frontier::kNone) return result;
     result.found = true;
@@ -423,79 +715,14 @@ SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMet
     return result;
   }
 
-  // Bidirectional A*: the backward search runs on reversed arcs from every orientation at the goal.
-  // It stops when the best meeting cost mu <= max(top_f, top_b) (Pohl 1971): any cheaper path would
-  // cross both open lists below mu.
   for (int o = 0; o < graph.start_orientation(); ++o) {
     bool imp;
     const std::uint32_t s = bw.relax(key_of(to, o), 0.0, Frontier::kNone, -1, imp);
-    bw.push({use_h ? h0 : 0.0, bw.key(s), s, 0.0});
+    bw.push({-potential(to), bw.key(s), s, -1, 0.0});
   }
-  double mu = kInfinity;
-  std::uint64_t meet = 0;
-  auto try_meet = [&](std::uint64_t key, double g, const Frontier& other) {
-    const std::uint32_t j = other.find(key);
-    if (j == Frontier::kNone) return;
-    const double total = g + other.nodes[j].g;
-    if (total < mu || (total == mu && key < meet)) {
-      mu = total;
-      meet = key;
-    }
-  };
-  while (!fw.heap.empty() || !bw.heap.empty()) {
-    if (mu <= std::max(fw.top(), bw.top())) break;
-    const bool forward = !fw.heap.empty() && (bw.heap.empty() || fw.heap.size() <= bw.heap.size());
-    Frontier& me = forward ? fw : bw;
-    Frontier& other = forward ? bw : fw;
-    const QueueItem q = me.pop();
-    if (q.g > me.nodes[q.node].g) continue;
-    ++result.expanded;
-    const Cell c = cell_of(q.key);
-    const int o = orient_of(q.key);
-    report(forward ? graph.lower_bound(c, to) : graph.lower_bound(c, from));
-    if (forward) {
-      float* costs = cache.row(t.index(c.col, c.row));
-      for (int a = 0; a < na; ++a) {
-        const RoadGraph::Arc& arc = arcs[std::size_t(a)];
-        if (!t.inside(c.col + arc.dcol, c.row + arc.drow) || !graph.arc_sampled(c, a)) continue;
-        const double turn = graph.turn_cost(o, a);
-        if (turn == kInfinity) continue;
-        const double e = cache.get(c, costs, a);
-        if (e == kInfinity) continue;
-        const Cell n{c.col + arc.dcol, c.row + arc.drow};
-        const double g = q.g + turn + e;
-        bool improved;
-        const std::uint32_t idx = me.relax(key_of(n, arc.orientation), g, q.node, a, improved);
-        if (improved) {
-          me.push({g + (use_h ? graph.lower_bound(n, to) : 0.0), me.key(idx), idx, g});
-          try_meet(me.key(idx), g, other);
-        }
-      }
-    } else {
-      // Node (c, o) was reached by an arc of orientation o: its predecessors are c - arc, with
-      // any orientation (the start orientation only at the start cell).
-      for (int a : graph.arcs_into(o)) {
-        const RoadGraph::Arc& arc = arcs[std::size_t(a)];
-        const Cell p{c.col - arc.dcol, c.row - arc.drow};
-        if (!t.inside(p.col, p.row) || !graph.arc_sampled(p, a)) continue;
-        const double e = cache.get(p, t.index(p.col, p.row), a);
-        if (e == kInfinity) continue;
-        const double hp = use_h ? graph.lower_bound(p, from) : 0.0;
-        for (int po = 0; po < graph.orientations(); ++po) {
-          if (po == graph.start_orientation() && !(p == from)) continue;
-          const double turn = graph.turn_cost(po, a);
-          if (turn == kInfinity) continue;
-          const double g = q.g + turn + e;
-          bool improved;
-          const std::uint32_t idx = me.relax(key_of(p, po), g, q.node, a, improved);
-          if (improved) {
-            me.push({g + hp, me.key(idx), idx, g});
-            try_meet(me.key(idx), g, other);
-          }
-        }
-      }
-    }
-    check_memory();
+  while (!fw.heap.empty() && !bw.heap.empty()) {
+    if (fw.top() + bw.top() >= mu) break;
+    step_once(fw.top() <= bw.top());
   }
   result.nodes = fw.stored + bw.stored;
   if (mu == kInfinity) return result;

@@ -2,6 +2,7 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "core/progress.hpp"
@@ -21,7 +22,7 @@ struct Cell {
 enum class SearchMethod {
   dijkstra,       ///< plain Dijkstra, kept as the reference for tests
   astar,          ///< A* with h = straight-line distance x cheapest cost per metre (Peytavie §4.1.2.2)
-  bidirectional,  ///< bidirectional A*, Pohl's symmetric stopping rule (Peytavie §4.1.2.3)
+  bidirectional,  ///< bidirectional A* with balanced potentials (Ikeda et al. 1994; Goldberg & Harrelson 2005)
 };
 
 struct GraphOptions {
@@ -34,8 +35,9 @@ struct GraphOptions {
 /// orientation), where the orientation is the structure and angle sector of the arc that reached
 /// the cell; arcs are the segment mask M_k (surface roads) and, when enabled, long bridge and tunnel
 /// arcs r_i..r_e long (annulus masks) of which each unordered cell pair is kept with probability
-/// s / |annulus| by a hash of (seed, structure, pair): a fixed pseudo-random graph, so results do not
-/// depend on the search order and the backward search sees exactly the forward arcs.
+/// s / |annulus| by a hash of (seed, structure, offset, position modulo 32; see arc_sampled): a
+/// fixed pseudo-random graph, so results do not depend on the search order and the backward search
+/// sees exactly the forward arcs.
 /// Arc cost = integral of the per-metre cost sampled every `sample_step_m` along the segment
 /// (midpoint rule) + the curvature cost of the turn from the previous arc. Infinite-cost arcs are
 /// never used. Reentrant: const methods may run concurrently.
@@ -61,10 +63,34 @@ class RoadGraph {
   double arc_cost(Cell from, int arc) const;
   /// Curvature cost of taking `arc` from a node of orientation `orientation`.
   double turn_cost(int orientation, int arc) const { return turn_[std::size_t(orientation) * arcs_.size() + std::size_t(arc)]; }
-  /// True when the long arc `arc` from `from` exists in the sampled graph (always true for surface arcs).
+  /// True when the long arc `arc` from `from` exists in the sampled graph (always true for surface
+  /// arcs). Each unordered cell pair {p, p + d} is kept with probability s / |annulus| by a hash of
+  /// (seed, structure, d, position of its first cell modulo kSamplePeriod): a fixed pseudo-random
+  /// graph, periodic in space, so the sampled arcs of a cell come from precomputed lists (no test
+  /// per arc during the search) and the backward search sees exactly the forward arcs.
   bool arc_sampled(Cell from, int arc) const;
-  /// Arcs that reach a node of orientation `o`.
-  const std::vector<int>& arcs_into(int orientation) const { return into_[std::size_t(orientation)]; }
+  static constexpr int kSamplePeriod = 32;
+  /// Long arcs are grouped in rings of similar length per structure (Peytavie §4.3.3 annuli cut
+  /// into bands), so that the search can price a band only when its cheapest arc could still lie on
+  /// a shortest path (lazy evaluation; see shortest_path).
+  struct Ring {
+    Structure structure = Structure::bridge;
+    double min_length_m = 0;  ///< no arc of the ring is shorter, on any row
+    /// Lower bound of arc cost + heuristic(target) - heuristic(source) over the ring's arcs, for the
+    /// A* heuristic (`with_heuristic`) and for none (Dijkstra).
+    double with_heuristic = 0, without_heuristic = 0;
+    int next = -1;            ///< next (longer) ring of the same structure, or -1
+  };
+  const std::vector<Ring>& rings() const { return rings_; }
+  /// First ring of a structure, or -1 when it has no long arcs.
+  int first_ring(Structure s) const { return first_ring_[int(s)]; }
+  /// Surface arcs with a finite turn cost (slot 0) or the sampled arcs of ring r (slot r + 1, any
+  /// turn: the caller checks it) that leave cell `c` in orientation `o`.
+  std::span<const int> arcs_from(Cell c, int orientation, int slot) const;
+  /// Surface arcs (slot 0) or the sampled arcs of ring r (slot r + 1) that reach cell `c` in orientation `o`.
+  std::span<const int> arcs_into(Cell c, int orientation, int slot) const;
+  /// Structure of the arcs that reach a node of orientation `o` (road for the start orientation).
+  Structure structure_of(int orientation) const { return orientation_structure_[std::size_t(orientation)]; }
   /// A lower bound of the cost from a to b: the cheapest way to cover the straight-line distance D
   /// and the height difference Z, min over L >= D of L g(Z/L), where g is the lower convex envelope
   /// of the per-metre cost against the grade (Z = 0 gives the paper's D x cheapest cost per metre).
@@ -88,7 +114,20 @@ class RoadGraph {
   double road_slope_cost(double grade) const;
   std::vector<double> hull_t_, hull_c_;  ///< lower convex envelope of cost per metre vs grade
   double kappa_ = 0, best_grade_ = 0;    ///< cheapest cost per metre of climb, and its grade
-  std::vector<std::vector<int>> into_;
+  void build_rings();
+  double envelope(double grade) const;   ///< the lower convex envelope g at a grade
+  std::vector<int> ring_of_;             ///< ring of each long arc (index - surface_arcs_)
+  std::vector<Ring> rings_;
+  int first_ring_[3] = {-1, -1, -1};
+  int period_[3] = {1, 1, 1};  ///< sampling period per structure (1 when every arc is kept)
+  int sample_class(Structure s, int col, int row) const;
+  bool pair_sampled(int arc, int from_col, int from_row) const;
+  std::vector<std::vector<int>> from_, into_;  ///< surface arcs per orientation
+  /// Sampled long arcs out of a cell per (class, ring), into a cell per (class, orientation, ring),
+  /// flattened: [start[i], start[i + 1]).
+  std::vector<std::size_t> long_from_start_, long_into_start_;
+  std::vector<int> long_from_, long_into_;
+  std::vector<Structure> orientation_structure_;
 };
 
 struct SearchResult {
@@ -98,10 +137,14 @@ struct SearchResult {
   std::vector<Structure> structures;   ///< structure of each arc (cells.size() - 1)
   std::size_t expanded = 0;            ///< nodes expanded (both directions)
   std::size_t nodes = 0;               ///< nodes stored (memory is about 80 bytes per node)
+  std::size_t rings_priced = 0;        ///< rings of long arcs priced (the others were never needed)
 };
 
-/// Shortest path from `from` to `to` (any final orientation). Nodes are kept in hash maps so memory
-/// grows with the explored region only; throws processing_error when more than `max_nodes` would be
+/// Shortest path from `from` to `to` (any final orientation). Nodes are stored per touched cell so
+/// memory grows with the explored region only. Long arcs are priced lazily: expanding a node queues
+/// one entry per ring keyed by a lower bound of what its arcs could reach, and the ring is priced only
+/// if that entry comes to the top of the queue (an exact search: the key never exceeds the key of a
+/// node the ring would reach). Throws processing_error when more than `max_nodes` would be
 /// stored. Returns found = false when no finite-cost path exists.
 SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMethod method,
                            std::size_t max_nodes = 60'000'000, Progress* progress = nullptr);

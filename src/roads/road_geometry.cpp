@@ -1,4 +1,4 @@
-// G1 smoothing of grid paths, deck profiles and road/bridge/tunnel sections.
+// Clothoid smoothing of grid paths, deck profiles and road/bridge/tunnel sections.
 // SPDX-License-Identifier: MIT
 #include "roads/road_geometry.hpp"
 
@@ -39,9 +39,72 @@ void densify(std::vector<GridPoint>& out, const TerrainField& terrain, GridPoint
   for (int i = 1; i <= n; ++i) out.push_back(lerp(a, b, double(i) / n));
 }
 
-/// Smooths one surface run (the ends fixed) into a G1 spline with checked deviation and grade.
+/// Points of the unit clothoid of half-deflection phi at arc lengths i / n, i = 0..n: tangent angle
+/// phi s^2, so curvature 2 phi s (linear); the Fresnel integrals by Simpson's rule, 8 intervals per
+/// step (the integrands are smooth: the error is far below a millimetre per kilometre).
+std::vector<PlanePoint> unit_spiral(double phi, int n) {
+  constexpr int m = 8;
+  std::vector<PlanePoint> out(std::size_t(n) + 1);
+  const double h = 1.0 / (double(n) * m);
+  double x = 0, y = 0;
+  for (int i = 1; i <= n; ++i) {
+    double sx = 0, sy = 0;
+    for (int j = 0; j <= m; ++j) {
+      const double t = (double(i - 1) * m + j) * h, w = (j == 0 || j == m) ? 1 : (j % 2 ? 4 : 2);
+      sx += w * std::cos(phi * t * t);
+      sy += w * std::sin(phi * t * t);
+    }
+    x += sx * h / 3;
+    y += sy * h / 3;
+    out[std::size_t(i)] = {x, y};
+  }
+  return out;
+}
+
+}  // namespace
+
+ClothoidShape clothoid_shape(double turn_rad) {
+  const double phi = 0.5 * turn_rad;
+  const PlanePoint e = unit_spiral(phi, 32).back();
+  ClothoidShape c;
+  c.tangent_per_m = e.x + e.y * std::tan(phi);
+  c.apex_per_m = std::hypot(c.tangent_per_m - e.x, e.y);
+  return c;
+}
+
+std::vector<PlanePoint> clothoid_corner(PlanePoint a, PlanePoint v, PlanePoint b, double tangent_m, int samples) {
+  const double la = std::hypot(v.x - a.x, v.y - a.y), lb = std::hypot(b.x - v.x, b.y - v.y);
+  const PlanePoint da{(v.x - a.x) / la, (v.y - a.y) / la}, db{(b.x - v.x) / lb, (b.y - v.y) / lb};
+  const double cross = da.x * db.y - da.y * db.x;
+  const double turn = std::acos(std::clamp(da.x * db.x + da.y * db.y, -1.0, 1.0));
+  const double sign = cross >= 0 ? 1.0 : -1.0;
+  const ClothoidShape shape = clothoid_shape(turn);
+  const double ls = tangent_m / shape.tangent_per_m;  // spiral length
+  const PlanePoint t1{v.x - tangent_m * da.x, v.y - tangent_m * da.y}, t2{v.x + tangent_m * db.x, v.y + tangent_m * db.y};
+  const PlanePoint na{-da.y, da.x}, nb{-db.y, db.x};
+  std::vector<PlanePoint> out(std::size_t(2 * samples + 1));
+  // First spiral from t1 along a-v bending towards b; the second is its mirror image, run back from t2.
+  const std::vector<PlanePoint> spiral = unit_spiral(0.5 * turn, samples);
+  for (int i = 0; i <= samples; ++i) {
+    const PlanePoint& p = spiral[std::size_t(i)];
+    const PlanePoint first{t1.x + ls * (p.x * da.x + sign * p.y * na.x), t1.y + ls * (p.x * da.y + sign * p.y * na.y)};
+    const PlanePoint second{t2.x + ls * (-p.x * db.x + sign * p.y * nb.x), t2.y + ls * (-p.x * db.y + sign * p.y * nb.y)};
+    if (i < samples) {
+      out[std::size_t(i)] = first;
+      out[std::size_t(2 * samples - i)] = second;
+    } else {
+      out[std::size_t(i)] = {0.5 * (first.x + second.x), 0.5 * (first.y + second.y)};  // the apex, met from both sides
+    }
+  }
+  return out;
+}
+
+namespace {
+
+/// Smooths one surface run (the ends fixed): clothoid pairs at the corners, with checked
+/// deviation and grade (Peytavie §4.4.1), a G1 quadratic Bézier where no clothoid passes.
 std::vector<GridPoint> smooth_run(const TerrainField& terrain, const CostModel& model, const std::vector<GridPoint>& run,
-                                  double step) {
+                                  double step, RoadGeometry& counts) {
   std::vector<GridPoint> out{run.front()};
   if (run.size() < 3) {
     for (std::size_t i = 1; i < run.size(); ++i) densify(out, terrain, out.back(), run[i], step);
@@ -53,32 +116,62 @@ std::vector<GridPoint> smooth_run(const TerrainField& terrain, const CostModel& 
   for (std::size_t i = 1; i + 1 < run.size(); ++i) {
     const GridPoint a = run[i - 1], v = run[i], b = run[i + 1];
     const double la = terrain.length_m(a, v), lb = terrain.length_m(v, b);
-    double u = 0;
+    // The corner in a local metric plane centred on v.
+    const double mx = terrain.metres_x(v.row), my = terrain.metres_y(v.row);
+    auto plane = [&](GridPoint p) { return PlanePoint{(p.col - v.col) * mx, (p.row - v.row) * my}; };
+    auto grid = [&](PlanePoint p) { return GridPoint{v.col + p.x / mx, v.row + p.y / my}; };
+    double theta = 0;
     if (la > 0 && lb > 0) {
-      // Turn angle theta; a cut of u metres on both legs puts the curve's apex 0.5 u sin(theta/2)
-      // from the vertex, the farthest it gets from the grid path.
-      const double ax = (v.col - a.col) * terrain.metres_x(v.row) / la, ay = (v.row - a.row) * terrain.metres_y(v.row) / la;
-      const double bx = (b.col - v.col) * terrain.metres_x(v.row) / lb, by = (b.row - v.row) * terrain.metres_y(v.row) / lb;
-      const double theta = std::acos(std::clamp(ax * bx + ay * by, -1.0, 1.0));
-      const double s = 0.5 * std::sin(0.5 * theta);
-      u = std::min(0.5 * la, 0.5 * lb);
-      if (s > 1e-9) u = std::min(u, tol_m / s);
+      const PlanePoint pa = plane(a), pb = plane(b);
+      theta = std::acos(std::clamp((-pa.x * pb.x - pa.y * pb.y) / (la * lb), -1.0, 1.0));
     }
-    for (int attempt = 0; attempt < 6 && u > 0; ++attempt) {
-      std::vector<GridPoint> curve{lerp(v, a, u / la)};
-      quad(curve, curve.front(), v, lerp(v, b, u / lb), 8);
-      if (steepest(terrain, curve) <= max_slope) break;
-      u = attempt == 5 ? 0 : 0.5 * u;
-    }
-    if (u <= 0) {
+    if (theta < 1e-6 || theta > std::numbers::pi - 1e-6) {  // straight on, or a U-turn that no curve can round
       densify(out, terrain, cursor, v, step);
       cursor = v;
       continue;
     }
-    const GridPoint in = lerp(v, a, u / la), outp = lerp(v, b, u / lb);
-    densify(out, terrain, cursor, in, step);
-    quad(out, in, v, outp, std::max(4, int(std::ceil(2 * u / step))));
-    cursor = outp;
+    // Clothoid pair: tangent length u, apex u * apex/tangent from the vertex, within the tolerance.
+    std::vector<GridPoint> curve;
+    const ClothoidShape shape = clothoid_shape(theta);
+    double u = std::min(0.5 * la, 0.5 * lb);
+    if (shape.apex_per_m > 1e-12) u = std::min(u, tol_m * shape.tangent_per_m / shape.apex_per_m);
+    // A curve must keep under the slope threshold and, since it cuts across the slope, must not be
+    // more than 1 degree steeper than the corner of the grid path it replaces.
+    auto grade_ok = [&](const std::vector<GridPoint>& c, double cut_m) {
+      std::vector<GridPoint> corner{lerp(v, a, cut_m / la)};
+      densify(corner, terrain, corner.front(), v, step);
+      densify(corner, terrain, v, lerp(v, b, cut_m / lb), step);
+      return steepest(terrain, c) <= std::min(max_slope, steepest(terrain, corner) + 1.0);
+    };
+    for (int attempt = 0; attempt < 6 && u > 0; ++attempt, u *= 0.5) {
+      const double spiral = u / shape.tangent_per_m;
+      const auto pts = clothoid_corner(plane(a), {0, 0}, plane(b), u, std::max(8, int(std::ceil(spiral / step))));
+      curve.clear();
+      for (const PlanePoint& p : pts) curve.push_back(grid(p));
+      if (grade_ok(curve, u)) break;
+      curve.clear();
+    }
+    if (!curve.empty()) ++counts.clothoid_corners;
+    if (curve.empty()) {
+      // G1 fallback: a quadratic Bézier whose apex lies 0.5 u sin(theta/2) from the vertex.
+      double uq = std::min({0.5 * la, 0.5 * lb, tol_m / (0.5 * std::sin(0.5 * theta))});
+      for (int attempt = 0; attempt < 6 && uq > 0; ++attempt, uq *= 0.5) {
+        curve = {lerp(v, a, uq / la)};
+        quad(curve, curve.front(), v, lerp(v, b, uq / lb), std::max(4, int(std::ceil(2 * uq / step))));
+        if (grade_ok(curve, uq)) break;
+        curve.clear();
+      }
+      if (!curve.empty()) ++counts.g1_corners;
+    }
+    if (curve.empty()) {
+      ++counts.sharp_corners;
+      densify(out, terrain, cursor, v, step);
+      cursor = v;
+      continue;
+    }
+    densify(out, terrain, cursor, curve.front(), step);
+    out.insert(out.end(), curve.begin() + 1, curve.end());
+    cursor = curve.back();
   }
   densify(out, terrain, cursor, run.back(), step);
   return out;
@@ -115,7 +208,7 @@ RoadGeometry build_road_geometry(const TerrainField& terrain, const CostModel& m
       std::vector<GridPoint> run{gp(path.cells[i])};
       std::size_t j = i;
       while (j + 1 < path.cells.size() && path.structures[j] == Structure::road) run.push_back(gp(path.cells[++j]));
-      const auto pts = smooth_run(terrain, model, run, step);
+      const auto pts = smooth_run(terrain, model, run, step, road);
       for (std::size_t p = 1; p < pts.size(); ++p) {
         road.points.push_back(pts[p]);
         road.z.push_back(terrain.surface_at(pts[p].col, pts[p].row));

@@ -1,4 +1,4 @@
-// From a grid path to a road: G1 smoothing in the corridor, 3-D profile, sections, statistics.
+// From a grid path to a road: clothoid smoothing in the corridor, 3-D profile, sections, statistics.
 // SPDX-License-Identifier: MIT
 #pragma once
 #include <string>
@@ -16,13 +16,39 @@ struct RoadGeometry {
   std::vector<GridPoint> points;
   std::vector<double> z;
   std::vector<Structure> segments;
+  /// How the corners of the surface runs were rounded: clothoid pairs, G1 fallback, left sharp.
+  int clothoid_corners = 0, g1_corners = 0, sharp_corners = 0;
 };
 
+/// A point of a local metric plane (metres).
+struct PlanePoint {
+  double x = 0, y = 0;
+};
+
+/// The corner a-v-b rounded by a symmetric pair of clothoids (Euler spirals: curvature linear in
+/// arc length, from 0 at the tangent points to its maximum at the apex, then back to 0), as road
+/// engineers join two straights (Peytavie 2010 §4.4.1; Galin et al. 2010; McCrae & Singh 2009).
+/// The spirals start `tangent_m` before v on a-v and end `tangent_m` after v on v-b, tangent to
+/// both legs, so the road is G2 (continuous curvature) with the straights. Returns
+/// 2 * samples + 1 points evenly spaced in arc length, the tangent points first and last.
+/// `tangent_m` > 0, a != v != b, the turn below 180 degrees.
+std::vector<PlanePoint> clothoid_corner(PlanePoint a, PlanePoint v, PlanePoint b, double tangent_m, int samples);
+
+/// For a turn of `turn_rad` (0..pi) rounded by clothoid_corner: the tangent length and the
+/// distance from the vertex to the apex (the curve's farthest point from the corner), both per
+/// metre of spiral length.
+struct ClothoidShape {
+  double tangent_per_m = 1, apex_per_m = 0;
+};
+ClothoidShape clothoid_shape(double turn_rad);
+
 /// Smooths the grid path of `path` and builds its profile (Peytavie 2010 §4.4.1-4.4.2).
-/// Surface runs between structure ends become a G1 spline: straight legs joined at each vertex by
-/// a quadratic Bézier whose tangent points are cut back so that the curve stays within
-/// `model.smoothing_tolerance_cells` of the vertex (a corridor around the grid path) and its grade
-/// does not exceed the road slope threshold; clothoids (curvature linear in arc length) are not fitted.
+/// Surface runs between structure ends become straight legs joined at each vertex by a clothoid
+/// pair (clothoid_corner) whose tangent length is cut back so that the curve stays within
+/// `model.smoothing_tolerance_cells` of the vertex (a corridor around the grid path), the legs are
+/// shared with the neighbouring corners, and its grade does not exceed the road slope threshold.
+/// Where no clothoid passes the grade check, a quadratic Bézier (G1) is tried the same way, and
+/// failing that the corner stays sharp.
 /// Bridges and tunnels stay straight, their deck linear between the terrain at their ends, sampled
 /// at the integration step. Each segment is then classified by the height of the deck above the
 /// surface: above `structure_min_m` bridge, below -structure_min_m tunnel, otherwise road.

@@ -78,6 +78,7 @@ std::optional<Road> route_road(const TerrainField& t, const RoadGraph& graph, Ce
   if (options.router == Router::galin) {
     const SearchResult s = shortest_path(graph, *a, *b, options.search, options.max_nodes, progress);
     road.expanded = s.expanded;
+    road.rings_priced = s.rings_priced;
     road.nodes = s.nodes;
     if (!s.found) {
       if (apart) return ferry();

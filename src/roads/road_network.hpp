@@ -34,6 +34,7 @@ struct Road {
   RoadGeometry geometry;
   RoadStats stats;
   std::size_t expanded = 0, nodes = 0;
+  std::size_t rings_priced = 0;  ///< rings of long bridge/tunnel arcs priced by the search
   bool ferry = false;
   std::vector<GridPoint> ferry_line;  ///< for maritime links: the straight crossing
 };

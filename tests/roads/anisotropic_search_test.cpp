@@ -241,3 +241,46 @@ TEST(AnisotropicSearch, DenseVegetationIsWalkedAround) {
   EXPECT_GT(r1.cost, r0.cost);
   for (const Cell& c : r1.cells) EXPECT_FALSE(c.col > 15 && c.col < 24 && c.row > 10 && c.row < 29) << c.col << "," << c.row;
 }
+
+TEST(AnisotropicSearch, SampledLongArcsAreSymmetricAndListedBothWays) {
+  // The precomputed out- and in-lists hold exactly the sampled arcs, and a pair is sampled (or not)
+  // whichever end the search stands on; about s / |annulus| of the pairs are kept.
+  const Dem dem = test::make_dem(70, 70, 10.0, [](int c, int r) { return 50.0 + 0.1 * c + 0.05 * r; });
+  const TerrainField terrain(dem, 0.0, 10.0, 0.0);
+  CostModel m = default_cost_model();
+  for (StructureCosts* sc : {&m.bridge, &m.tunnel}) {
+    sc->min_length_cells = 2;
+    sc->max_length_cells = 6;
+    sc->samples = 10;
+  }
+  const double expected = 10.0 / double(annulus_mask(2, 6).size());
+  const RoadGraph g(terrain, m, {3, 8, 99});
+  const auto& arcs = g.arcs();
+  std::size_t kept = 0, total = 0;
+  for (int r = 0; r < 70; r += 2)
+    for (int c = 0; c < 70; c += 2)
+      for (std::size_t a = g.surface_arcs(); a < arcs.size(); ++a) {
+        const Cell from{c, r}, to{c + arcs[a].dcol, r + arcs[a].drow};
+        if (!terrain.inside(to.col, to.row)) continue;
+        int back = -1;
+        for (std::size_t b = g.surface_arcs(); b < arcs.size(); ++b)
+          if (arcs[b].dcol == -arcs[a].dcol && arcs[b].drow == -arcs[a].drow && arcs[b].structure == arcs[a].structure) back = int(b);
+        ASSERT_GE(back, 0);
+        const bool s = g.arc_sampled(from, int(a));
+        EXPECT_EQ(s, g.arc_sampled(to, back));
+        int ring = -1;
+        for (std::size_t i = 0; i < g.rings().size() && ring < 0; ++i)
+          for (int x : g.arcs_from(from, g.start_orientation(), int(i) + 1))
+            if (x == int(a)) ring = int(i);
+        EXPECT_EQ(s, ring >= 0);
+        bool into = false;
+        for (std::size_t i = 0; i < g.rings().size(); ++i)
+          for (int x : g.arcs_into(to, arcs[a].orientation, int(i) + 1)) into = into || x == int(a);
+        EXPECT_EQ(s, into);
+        kept += s;
+        ++total;
+      }
+  const double rate = double(kept) / double(total);
+  EXPECT_GT(rate, 0.7 * expected);
+  EXPECT_LT(rate, 1.3 * expected);
+}
