@@ -62,7 +62,8 @@ RoadGraph::RoadGraph(const TerrainField& terrain, const CostModel& model, const 
     if (!sc.enabled) continue;
     const double rmin = sc.min_length_m ? *sc.min_length_m / cell : sc.min_length_cells;
     // Long arcs start beyond the surface mask: shorter crossings are surface arcs.
-    const double rmax = sc.max_length_m ? *sc.max_length_m / cell : sc.max_length_cells;
+    double rmax = sc.max_length_m ? *sc.max_length_m / cell : sc.max_length_cells;
+    if (sc.longest_m) rmax = std::min(rmax, *sc.longest_m / cell);
     const auto ring = annulus_mask(std::max(rmin, 1.0), rmax);
     const double keep = ring.empty() ? 0.0 : std::min(1.0, double(sc.samples) / double(ring.size()));
     const std::uint64_t threshold = keep >= 1.0 ? ~std::uint64_t(0) : std::uint64_t(keep * 18446744073709551615.0);

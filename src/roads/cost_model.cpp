@@ -70,12 +70,14 @@ CostModel default_cost_model() {
   m.bridge.water_depth_m = {{{0, 0}, {50, 10}}, 50};
   m.bridge.curvature_deg = {{{0, 0}, {20, 4}, {50, 40}}, 50};
   m.bridge.height_m = {{{0, 8}, {150, 30}}, 150};
+  m.bridge.longest_m = 3000;  // beyond the paper: long road bridges and viaducts are 1-3 km
   // Tunnels: slope and curvature as roads (70 deg), cost linear to 15 m depth then constant,
   // much dearer under water, at most 1000 m deep.
   m.tunnel.slope_deg = m.road.slope_deg;
   m.tunnel.water_depth_m = {{{0, 0}, {0.01, 40}, {50, 80}}, kInfinity};
   m.tunnel.curvature_deg = {{{0, 0}, {20, 2}, {45, 12}, {70, 40}}, 70};
   m.tunnel.depth_m = {{{0, 10}, {15, 25}}, 1000};
+  m.tunnel.longest_m = 5000;  // beyond the paper: most road tunnels are under 5 km
   return m;
 }
 
@@ -134,6 +136,11 @@ void read_structure(const json& j, StructureCosts& s, const std::string& origin,
     else if (name == "enabled" && long_arcs) {
       if (!it->is_boolean()) fail(origin, k, "expected true or false");
       s.enabled = it->get<bool>();
+    } else if (long_arcs && name == "longest_m") {
+      std::optional<double> v;
+      if (!it->is_null()) v = number(*it, origin, k);
+      if (v && !(*v > 0)) fail(origin, k, "must be > 0");
+      s.longest_m = v;
     } else if (long_arcs && (name == "min_length_m" || name == "max_length_m")) {
       std::optional<double> v;
       if (!it->is_null()) v = number(*it, origin, k);
@@ -166,6 +173,7 @@ json structure_json(const StructureCosts& s, bool bridge, bool tunnel) {
     j["max_length_m"] = s.max_length_m ? json(*s.max_length_m) : json(nullptr);
     j["min_length_cells"] = s.min_length_cells;
     j["max_length_cells"] = s.max_length_cells;
+    j["longest_m"] = s.longest_m ? json(*s.longest_m) : json(nullptr);
     j["samples"] = s.samples;
   }
   return j;

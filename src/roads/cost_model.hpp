@@ -40,6 +40,9 @@ struct StructureCosts {
   /// grid scaled to the DEM's cell size, i.e. 5..30 cells.
   std::optional<double> min_length_m, max_length_m;
   double min_length_cells = 5, max_length_cells = 30;
+  /// Bridges/tunnels: a cap (m) on the cell-scaled range, so coarse grids do not build 30 km
+  /// crossings (on a 1 km grid, 5..30 cells); a range entirely above it disables the structure.
+  std::optional<double> longest_m;
   /// Bridges/tunnels: expected number s of long arcs tried per expansion (Peytavie §4.3.4).
   int samples = 100;
 };

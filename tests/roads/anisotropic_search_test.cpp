@@ -284,3 +284,23 @@ TEST(AnisotropicSearch, SampledLongArcsAreSymmetricAndListedBothWays) {
   EXPECT_GT(rate, 0.7 * expected);
   EXPECT_LT(rate, 1.3 * expected);
 }
+
+// Long arcs scale with the cell (the paper's 50..300 m on a 10 m grid) but never exceed the
+// structure's longest_m: 3 km bridges and 5 km tunnels by default.
+TEST(AnisotropicSearch, LongArcsStayUnderTheirLongestLength) {
+  auto longest = [](double cell, Structure s) {
+    const Dem dem = test::make_dem(64, 64, cell, [](int, int) { return 100.0; });
+    const TerrainField terrain(dem, 0, 10, 10);
+    const RoadGraph graph(terrain, default_cost_model(), {3, 8, 1});
+    double metres = 0;
+    for (const auto& a : graph.arcs())
+      if (a.structure == s) metres = std::max(metres, std::hypot(a.dcol, a.drow) * cell);
+    return metres;
+  };
+  EXPECT_NEAR(longest(10, Structure::bridge), 300, 10);     // 30 cells: the paper's range
+  EXPECT_NEAR(longest(90, Structure::bridge), 2700, 90);    // 30 cells of an SRTM 3" grid
+  EXPECT_LE(longest(460, Structure::bridge), 3000);         // capped on GEBCO 15"
+  EXPECT_GT(longest(460, Structure::bridge), 2000);
+  EXPECT_EQ(longest(1000, Structure::bridge), 0);           // 5 cells already exceed 3 km: no bridges
+  EXPECT_LE(longest(1000, Structure::tunnel), 5000);
+}
