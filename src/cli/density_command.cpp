@@ -16,6 +16,7 @@
 #include "cli/dem_input.hpp"
 #include "cli/plugin_options.hpp"
 #include "core/error.hpp"
+#include "core/text.hpp"
 #include "density/density.hpp"
 #include "hydro/hydrometry.hpp"
 #include "io/raster_io.hpp"
@@ -26,17 +27,11 @@ namespace {
 
 namespace fs = std::filesystem;
 
-double parse_number(const std::string& option, const std::string& text) {
-  std::size_t used = 0;
-  double v = 0;
-  try {
-    v = std::stod(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used == 0 || used != text.size() || !std::isfinite(v)) throw bad_input(option + ": '" + text + "' is not a number");
-  return v;
+double number_option(const std::string& option, const std::string& text) {
+  if (const auto v = parse_number(text)) return *v;
+  throw bad_input(option + ": '" + text + "' is not a number");
 }
+
 
 /// The hydrometry the density model uses, on the DEM's grid, and whether it is worth writing.
 /// This is the ONE place that decides where hydrometry comes from: a file given with --hydrometry
@@ -175,18 +170,18 @@ class DensityCommand final : public Command {
       std::stringstream ss(weights_);
       std::string part;
       std::vector<double> w;
-      while (std::getline(ss, part, ',')) w.push_back(parse_number("--weights", part));
+      while (std::getline(ss, part, ',')) w.push_back(number_option("--weights", part));
       if (w.size() != 4) throw bad_input("--weights: expected 4 numbers C,H,P,L but got '" + weights_ + "'");
       for (int i = 0; i < 4; ++i) options.weights[std::size_t(i)] = w[std::size_t(i)];
     }
     for (const std::string& l : layers_) {
       const auto colon = l.rfind(':');
       if (colon == std::string::npos || colon == 0) throw bad_input("--layer: expected FILE:WEIGHT but got '" + l + "'");
-      options.layers.emplace_back(l.substr(0, colon), parse_number("--layer " + l.substr(0, colon), l.substr(colon + 1)));
+      options.layers.emplace_back(l.substr(0, colon), number_option("--layer " + l.substr(0, colon), l.substr(colon + 1)));
     }
     options.exclusions = exclusions_;
-    if (!max_slope_.empty()) options.max_slope_deg = parse_number("--max-slope", max_slope_);
-    if (!river_bed_cap_.empty()) options.river_bed_cap = parse_number("--river-bed-cap", river_bed_cap_);
+    if (!max_slope_.empty()) options.max_slope_deg = number_option("--max-slope", max_slope_);
+    if (!river_bed_cap_.empty()) options.river_bed_cap = number_option("--river-bed-cap", river_bed_cap_);
   }
 
   std::vector<std::pair<std::string, std::string>> provenance(const density::DensityOptions& o) const {

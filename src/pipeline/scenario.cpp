@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "core/text.hpp"
 
 namespace terrapolis::pipeline {
 namespace {
@@ -48,18 +49,6 @@ json with_defaults(const json& doc, const json& defaults) {
   return out;
 }
 
-std::string pointer_of(const std::vector<std::string>& context) {
-  std::string p;
-  for (const auto& c : context) {
-    if (c == "<root>") continue;
-    std::string_view token = c;
-    if (token.size() >= 2 && token.front() == '[' && token.back() == ']') token = token.substr(1, token.size() - 2);
-    if (token.size() >= 2 && token.front() == '"' && token.back() == '"') token = token.substr(1, token.size() - 2);
-    p.push_back('/');
-    p.append(token);
-  }
-  return p.empty() ? "/" : p;
-}
 
 void apply_set(json& doc, const std::string& set) {
   const auto eq = set.find('=');
@@ -121,7 +110,7 @@ std::string validate_scenario(const json& scenario) {
   valijson::ValidationResults::Error best;
   for (const auto& e : results)
     if (e.context.size() > best.context.size()) best = e;
-  return pointer_of(best.context) + ": " + best.description;
+  return json_pointer_of(best.context) + ": " + best.description;
 }
 
 Scenario load_scenario(const std::string& file, const std::vector<std::string>& sets, std::optional<std::uint64_t> seed) {

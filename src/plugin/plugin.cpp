@@ -19,6 +19,7 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "core/text.hpp"
 #include "core/geodesy.hpp"
 #include "plugin/terrapolis_plugin.h"
 
@@ -50,18 +51,6 @@ bool valid_id(const std::string& id) {
   return !id.empty() && std::all_of(id.begin(), id.end(), [](char c) { return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_'; });
 }
 
-std::string pointer_of(const std::vector<std::string>& context) {
-  std::string p;
-  for (const auto& c : context) {
-    if (c == "<root>") continue;
-    std::string_view token = c;
-    if (token.size() >= 2 && token.front() == '[' && token.back() == ']') token = token.substr(1, token.size() - 2);
-    if (token.size() >= 2 && token.front() == '"' && token.back() == '"') token = token.substr(1, token.size() - 2);
-    p.push_back('/');
-    p.append(token);
-  }
-  return p.empty() ? "/" : p;
-}
 
 /// Parses `schema` with valijson; throws (std::exception) when it is not a valid schema.
 void parse_schema(const json& schema, valijson::Schema& out) {
@@ -70,17 +59,6 @@ void parse_schema(const json& schema, valijson::Schema& out) {
   parser.populateSchema(adapter, out);
 }
 
-double parse_weight(const std::string& text, const std::string& option) {
-  std::size_t used = 0;
-  double v = 0;
-  try {
-    v = std::stod(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used == 0 || used != text.size() || !std::isfinite(v)) throw bad_input(option + ": weight '" + text + "' is not a number");
-  return v;
-}
 
 bool is_number(const std::string& text) {
   try {
@@ -191,7 +169,9 @@ PluginSpec parse_plugin_option(const std::string& text) {
   const auto next = rest.find(':');
   const std::string first = rest.substr(0, next);
   if (is_number(first)) {
-    s.weight = parse_weight(first, option);
+    const auto weight = parse_number(first);
+    if (!weight) throw bad_input(option + ": weight '" + first + "' is not a number");
+    s.weight = *weight;
     rest = next == std::string::npos ? "" : rest.substr(next + 1);
   }
   if (rest.empty()) return s;
@@ -297,7 +277,7 @@ void validate_params(const LoadedPlugin& plugin, const json& params) {
   valijson::ValidationResults::Error best;
   for (const auto& e : results)
     if (e.context.size() > best.context.size()) best = e;
-  const std::string pointer = pointer_of(best.context);
+  const std::string pointer = json_pointer_of(best.context);
   throw bad_input(where(plugin) + ": params" + (pointer == "/" ? "" : pointer) + ": " + best.description);
 }
 
