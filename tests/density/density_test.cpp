@@ -15,26 +15,15 @@
 #include "density/disc_sums.hpp"
 #include "core/geodesy.hpp"
 #include "io/raster_io.hpp"
+#include "support/georefs.hpp"
 
 namespace terrapolis::density {
 namespace {
 
+using test::geographic;
+using test::projected;
+
 constexpr float nan_f = std::numeric_limits<float>::quiet_NaN();
-
-Georef projected(double cell) {
-  Georef g;
-  g.transform = {500000, cell, 0, 4000000, 0, -cell};
-  g.crs.wkt = "projected";
-  return g;
-}
-
-Georef geographic(double lat_north, double cell_deg) {
-  Georef g;
-  g.transform = {9.0, cell_deg, 0, lat_north, 0, -cell_deg};
-  g.crs.wkt = "geographic";
-  g.crs.geographic = true;
-  return g;
-}
 
 struct Feature {
   int col, row;

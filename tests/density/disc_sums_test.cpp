@@ -8,24 +8,13 @@
 
 #include "core/geodesy.hpp"
 #include "density/disc_sums.hpp"
+#include "support/georefs.hpp"
 
 namespace terrapolis::density {
 namespace {
 
-Georef projected(double cell_w, double cell_h) {
-  Georef g;
-  g.transform = {500000, cell_w, 0, 4000000, 0, -cell_h};
-  g.crs.wkt = "projected";
-  return g;
-}
-
-Georef geographic(double lat_north, double cell_deg) {
-  Georef g;
-  g.transform = {9.0, cell_deg, 0, lat_north, 0, -cell_deg};
-  g.crs.wkt = "geographic";
-  g.crs.geographic = true;
-  return g;
-}
+using test::geographic;
+using test::projected;
 
 std::vector<double> random_values(int cols, int rows, std::uint64_t seed, bool binary) {
   std::mt19937_64 rng(seed);
