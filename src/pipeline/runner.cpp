@@ -74,20 +74,23 @@ json read_manifest(const std::filesystem::path& folder) {
   }
 }
 
-/// A saved stage can be reused only for the same DEM and the same parameters of it and of every
-/// stage before it; otherwise its results would not be what the new scenario asks.
+/// A saved stage is read back only for the same DEM and the same parameters of its own (those of
+/// the stages before it are checked too when they are read back; a rerun one makes it stale).
 void check_reusable(const std::filesystem::path& folder, const json& saved, const Scenario& scenario, const std::string& dem_sha256,
                     const std::vector<Action>& plan) {
   if (saved["input"].value("sha256", "") != dem_sha256)
     throw bad_input(folder.string() + ": the saved run was made from another DEM; run the whole scenario");
-  for (std::size_t i = 0; i < plan.size() && plan[i] == Action::load; ++i)
-    for (const auto& key : stages()[i].sections)
+  for (std::size_t i = 0; i < plan.size(); ++i) {
+    const StageDef& stage = stages()[i];
+    if (plan[i] == Action::run) continue;
+    if (!saved["summary"].contains(stage.name))
+      throw bad_input(folder.string() + ": the saved run has no " + stage.name + " stage; rerun from it");
+    if (plan[i] != Action::load) continue;
+    for (const auto& key : stage.sections)
       if (!saved["scenario"].contains(key) || saved["scenario"][key] != scenario.resolved[key])
-        throw bad_input(folder.string() + ": the saved run used other '" + key + "' parameters; rerun from " + stages()[i].name +
-                        " (--from " + stages()[i].name + ")");
-  for (std::size_t i = 0; i < plan.size(); ++i)
-    if (plan[i] != Action::run && !saved["summary"].contains(stages()[i].name) && std::string(stages()[i].name) != "terrain")
-      throw bad_input(folder.string() + ": the saved run has no " + stages()[i].name + " stage; rerun from it");
+        throw bad_input(folder.string() + ": the saved run used other '" + key + "' parameters; rerun from " + stage.name +
+                        " (--from " + stage.name + ")");
+  }
 }
 
 /// Records a saved stage's files (vector layers read back for the preview), figures and timing.
@@ -161,7 +164,8 @@ json run_scenario(const Scenario& scenario, const RunOptions& options, Progress&
         // A saved stage: its files, figures and timing come from the saved run.
         reuse_saved(state, saved, stage.name, timings);
         if (plan[i] == Action::load) stage.load(state);
-        (plan[i] == Action::load ? reused : stale).push_back(stage.name);
+        if (plan[i] == Action::load) reused.push_back(stage.name);
+        if (!ran.empty()) stale.push_back(stage.name);  // made before a stage upstream of it was rerun
         continue;
       }
       const auto start = std::chrono::steady_clock::now();

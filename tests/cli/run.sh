@@ -49,6 +49,12 @@ fi
 echo "run: ok"
 
 # Reruns from saved results: --from reads the earlier stages back, --only reruns just some.
+# Read back exactly: an unchanged rerun from the network rewrites the network and roads byte for byte.
+cp -r run1 same
+"$TP" --quiet run -o same --from network --set outputs.preview_width=400
+for f in network.geojson roads.geojson road_sections.geojson; do
+  cmp -s "run1/$f" "same/$f" || fail "--from network with nothing changed rewrote $f differently"
+done
 cp -r run1 rerun
 "$TP" --quiet run -o rerun --from network --set network.k=1.3
 /usr/bin/python3 - run1/run.json rerun/run.json <<'PY' || fail "--from network"
@@ -67,6 +73,7 @@ cmp -s run1/cities.geojson rerun/cities.geojson || fail "--from network rewrote 
 /usr/bin/python3 -c "import json; r=json.load(open('rerun/run.json'))['rerun']; assert r['stale']==['sites','network','roads'], r" || fail "--only"
 cmp -s run1/density.tif rerun/density.tif && fail "--only density did not change density.tif"
 expect_fail 2 "other 'density' parameters; rerun from density" "$TP" run -o rerun --from sites --set density.r_max_m=6000
+expect_fail 2 "other 'density' parameters" "$TP" run -o rerun --only hydro roads --set density.r_max_m=6000
 expect_fail 2 "dunes" "$TP" run -o rerun --from dunes
 expect_fail 2 "nosuch: no saved run to rerun from" "$TP" run -o nosuch --from roads
 no_leftovers "$WORK"
