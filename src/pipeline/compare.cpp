@@ -24,9 +24,26 @@ void flatten(const json& j, const std::string& prefix, std::vector<std::pair<std
   }
 }
 
-std::vector<std::pair<std::string, json>> flat(const json& j) {
-  std::vector<std::pair<std::string, json>> out;
-  flatten(j, "", out);
+struct Pair {
+  std::string key;
+  json a, b;  ///< null where a run does not have the key
+};
+
+/// The leaves of two objects side by side: a's keys in order, then those only b has.
+std::vector<Pair> paired(const json& a, const json& b) {
+  std::vector<std::pair<std::string, json>> fa, fb;
+  flatten(a, "", fa);
+  flatten(b, "", fb);
+  const std::map<std::string, json> mb(fb.begin(), fb.end());
+  std::set<std::string> seen;
+  std::vector<Pair> out;
+  for (const auto& [k, v] : fa) {
+    seen.insert(k);
+    const auto it = mb.find(k);
+    out.push_back({k, v, it == mb.end() ? json(nullptr) : it->second});
+  }
+  for (const auto& [k, v] : fb)
+    if (!seen.count(k)) out.push_back({k, nullptr, v});
   return out;
 }
 
@@ -55,40 +72,18 @@ json load_manifest(const std::string& run_folder) {
 }
 
 json compare_runs(const json& a, const json& b) {
-  json out;
-  json params = json::array();
-  auto pa = a["scenario"], pb = b["scenario"];
-  pa.erase("output");
+  json pa = a["scenario"], pb = b["scenario"];
+  pa.erase("output");  // where, not what
   pb.erase("output");
-  const auto fa = flat(pa), fb = flat(pb);
-  std::map<std::string, json> mb(fb.begin(), fb.end());
-  std::set<std::string> seen;
-  for (const auto& [k, v] : fa) {
-    seen.insert(k);
-    const json other = mb.count(k) ? mb[k] : json(nullptr);
-    if (other != v) params.push_back({{"parameter", k}, {"a", v}, {"b", other}});
-  }
-  for (const auto& [k, v] : fb)
-    if (!seen.count(k)) params.push_back({{"parameter", k}, {"a", nullptr}, {"b", v}});
-  out["parameters"] = params;
-
-  json figures = json::array();
-  const auto sa = flat(a["summary"]), sb = flat(b["summary"]);
-  std::map<std::string, json> msb(sb.begin(), sb.end());
-  std::set<std::string> seen_figures;
-  auto add = [&](const std::string& k, const json& va, const json& vb) {
-    json row = {{"figure", k}, {"a", va}, {"b", vb}};
-    if (va.is_number() && vb.is_number()) row["change"] = vb.get<double>() - va.get<double>();
+  json params = json::array(), figures = json::array();
+  for (const auto& p : paired(pa, pb))
+    if (p.a != p.b) params.push_back({{"parameter", p.key}, {"a", p.a}, {"b", p.b}});
+  for (const auto& p : paired(a["summary"], b["summary"])) {
+    json row = {{"figure", p.key}, {"a", p.a}, {"b", p.b}};
+    if (p.a.is_number() && p.b.is_number()) row["change"] = p.b.get<double>() - p.a.get<double>();
     figures.push_back(row);
-  };
-  for (const auto& [k, v] : sa) {
-    seen_figures.insert(k);
-    add(k, v, msb.count(k) ? msb[k] : json(nullptr));
   }
-  for (const auto& [k, v] : sb)
-    if (!seen_figures.count(k)) add(k, nullptr, v);
-  out["figures"] = figures;
-  return out;
+  return {{"parameters", params}, {"figures", figures}};
 }
 
 std::string format_comparison(const json& c) {

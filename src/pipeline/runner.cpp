@@ -13,6 +13,7 @@
 #include "core/error.hpp"
 #include "io/checksum.hpp"
 #include "io/raster_io.hpp"
+#include "pipeline/compare.hpp"
 #include "pipeline/publish.hpp"
 #include "pipeline/run_state.hpp"
 #include "pipeline/stages.hpp"
@@ -62,16 +63,6 @@ std::vector<Action> plan_stages(const RunOptions& options) {
     for (std::size_t i = 0; i < n; ++i) plan[i] = only[i] ? Action::run : i < last ? Action::load : Action::keep;
   }
   return plan;
-}
-
-json read_manifest(const std::filesystem::path& folder) {
-  std::ifstream in(folder / "run.json");
-  if (!in) throw bad_input(folder.string() + ": no saved run to rerun from (run.json missing; run the whole scenario first)");
-  try {
-    return json::parse(in);
-  } catch (const json::exception&) {
-    throw bad_input((folder / "run.json").string() + ": not a valid run record");
-  }
 }
 
 /// A saved stage is read back only for the same DEM and the same parameters of its own (those of
@@ -127,7 +118,7 @@ json run_scenario(const Scenario& scenario, const RunOptions& options, Progress&
   std::error_code ec;
   json saved;
   if (rerun) {
-    saved = read_manifest(output);
+    saved = load_manifest(output.string());
   } else if (fs::exists(output, ec) && !options.overwrite) {
     throw bad_input(output.string() + ": run folder exists (use --overwrite to replace it)");
   }

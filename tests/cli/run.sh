@@ -75,7 +75,7 @@ cmp -s run1/density.tif rerun/density.tif && fail "--only density did not change
 expect_fail 2 "other 'density' parameters; rerun from density" "$TP" run -o rerun --from sites --set density.r_max_m=6000
 expect_fail 2 "other 'density' parameters" "$TP" run -o rerun --only hydro roads --set density.r_max_m=6000
 expect_fail 2 "dunes" "$TP" run -o rerun --from dunes
-expect_fail 2 "nosuch: no saved run to rerun from" "$TP" run -o nosuch --from roads
+expect_fail 2 "nosuch: not a run folder" "$TP" run -o nosuch --from roads
 no_leftovers "$WORK"
 echo "rerun: ok"
 
