@@ -11,6 +11,7 @@
 #include "cli/commands_list.hpp"
 #include "core/error.hpp"
 #include "hydro/hydro.hpp"
+#include "hydro/option_names.hpp"
 #include "io/raster_io.hpp"
 #include "io/vector_io.hpp"
 #include "terrapolis/version.hpp"
@@ -20,13 +21,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using namespace terrapolis::hydro;
-
-template <class E>
-E pick(const std::string& option, const std::string& value, const std::map<std::string, E>& choices) {
-  const auto it = choices.find(value);
-  if (it == choices.end()) throw bad_input(option + ": unknown value '" + value + "'");
-  return it->second;
-}
 
 std::string number(double v) {
   char buf[64];
@@ -45,20 +39,20 @@ class HydroCommand final : public Command {
     app.add_option("DEM", dem_path_, "Elevation model (any GDAL raster)")->required();
     app.add_option("OUTDIR", out_dir_, "Output folder (created if missing)")->required();
     app.add_option("--fill", fill_, "Depression handling: priority-flood, epsilon, breach, none")
-        ->check(CLI::IsMember({"priority-flood", "epsilon", "breach", "none"}))->capture_default_str();
+        ->check(CLI::IsMember(kFillMethods))->capture_default_str();
     app.add_option("--flow", flow_, "Routing for the accumulation: d8, dinf, mfd")
-        ->check(CLI::IsMember({"d8", "dinf", "mfd"}))->capture_default_str();
+        ->check(CLI::IsMember(kFlowMethods))->capture_default_str();
     app.add_option("--mfd-exponent", mfd_exponent_, "MFD slope exponent p (> 0; Freeman 1.1, Holmgren 4-6)")->capture_default_str();
     app.add_option("--d8-codes", codes_, "Code convention of flowdir.tif: esri, grass, taudem")
-        ->check(CLI::IsMember({"esri", "grass", "taudem"}))->capture_default_str();
+        ->check(CLI::IsMember(kD8Codes))->capture_default_str();
     app.add_option("--hydrometry", hydrometry_, "Hydrometry method: belhadj, accumulation")
-        ->check(CLI::IsMember({"belhadj", "accumulation"}))->capture_default_str();
+        ->check(CLI::IsMember(kHydrometryMethods))->capture_default_str();
     app.add_option("--iterations", iterations_, "Belhadj: iterations (0: until convergence)")->capture_default_str();
     app.add_option("--threshold", threshold_, "Belhadj: stop when the mean quantity is below this (> 0)")->capture_default_str();
     app.add_option("--vertical", vertical_, "Belhadj: vertical scale, metres or normalised16 (the thesis's z/65535)")
-        ->check(CLI::IsMember({"metres", "normalised16"}))->capture_default_str();
+        ->check(CLI::IsMember(kVerticalScales))->capture_default_str();
     app.add_option("--belhadj-share", share_, "Belhadj: share denominator over all 8 neighbours (as printed) or fed ones")
-        ->check(CLI::IsMember({"all", "fed"}))->capture_default_str();
+        ->check(CLI::IsMember(kBelhadjShares))->capture_default_str();
     app.add_option("--sea-level", sea_level_, "Cells at or below this elevation (m) are outlets (default: off)");
     app.add_option("--streams-threshold", streams_km2_, "Upstream area (km2) from which a cell is on a stream")->capture_default_str();
     app.add_option("--area-units", units_, "Unit of accumulation.tif: m2, km2 or cells")
@@ -73,21 +67,20 @@ class HydroCommand final : public Command {
 
   void run(Context& context) override {
     HydroOptions o;
-    o.fill = pick<FillMethod>("--fill", fill_, {{"priority-flood", FillMethod::priority_flood}, {"epsilon", FillMethod::epsilon},
-                                                {"breach", FillMethod::breach}, {"none", FillMethod::none}});
-    o.flow = pick<FlowMethod>("--flow", flow_, {{"d8", FlowMethod::d8}, {"dinf", FlowMethod::dinf}, {"mfd", FlowMethod::mfd}});
+    // The values were checked against the same tables when the options were parsed.
+    o.fill = kFillMethods.at(fill_);
+    o.flow = kFlowMethods.at(flow_);
     o.mfd_exponent = mfd_exponent_;
     if (!(mfd_exponent_ > 0) || !std::isfinite(mfd_exponent_)) throw bad_input("--mfd-exponent: must be a positive number");
-    const D8Codes codes = pick<D8Codes>("--d8-codes", codes_, {{"esri", D8Codes::esri}, {"grass", D8Codes::grass}, {"taudem", D8Codes::taudem}});
-    o.hydrometry.method = pick<HydrometryMethod>("--hydrometry", hydrometry_,
-                                                 {{"belhadj", HydrometryMethod::belhadj}, {"accumulation", HydrometryMethod::accumulation}});
+    const D8Codes codes = kD8Codes.at(codes_);
+    o.hydrometry.method = kHydrometryMethods.at(hydrometry_);
     if (iterations_ < 0) throw bad_input("--iterations: must be 0 (until convergence) or positive");
     if (!(threshold_ > 0)) throw bad_input("--threshold: must be a positive number");
     if (!(streams_km2_ > 0) || !std::isfinite(streams_km2_)) throw bad_input("--streams-threshold: must be a positive number of km2");
     o.hydrometry.max_iterations = iterations_;
     o.hydrometry.threshold = threshold_;
-    o.hydrometry.vertical = vertical_ == "metres" ? VerticalScale::metres : VerticalScale::normalised16;
-    o.hydrometry.share = share_ == "all" ? BelhadjShare::all_neighbours : BelhadjShare::fed_neighbours;
+    o.hydrometry.vertical = kVerticalScales.at(vertical_);
+    o.hydrometry.share = kBelhadjShares.at(share_);
     if (!std::isnan(sea_level_)) o.sea_level = sea_level_;
     o.unit = units_ == "cells" ? AccumulationUnit::cells : AccumulationUnit::area_m2;
     o.streams.threshold_km2 = streams_km2_;

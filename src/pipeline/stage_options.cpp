@@ -4,6 +4,8 @@
 
 #include <map>
 
+#include "hydro/option_names.hpp"
+
 namespace terrapolis::pipeline {
 namespace {
 
@@ -21,18 +23,14 @@ hydro::HydroOptions hydro_options(const Scenario& scenario) {
   using namespace hydro;
   const json& h = scenario.resolved["hydro"];
   HydroOptions o;
-  o.fill = choice<FillMethod>(h["fill"], {{"priority-flood", FillMethod::priority_flood}, {"epsilon", FillMethod::epsilon},
-                                          {"breach", FillMethod::breach}, {"none", FillMethod::none}});
-  o.flow = choice<FlowMethod>(h["flow"], {{"d8", FlowMethod::d8}, {"dinf", FlowMethod::dinf}, {"mfd", FlowMethod::mfd}});
+  o.fill = choice(h["fill"], kFillMethods);
+  o.flow = choice(h["flow"], kFlowMethods);
   o.mfd_exponent = h["mfd_exponent"].get<double>();
-  o.hydrometry.method = choice<HydrometryMethod>(
-      h["hydrometry"], {{"belhadj", HydrometryMethod::belhadj}, {"accumulation", HydrometryMethod::accumulation}});
+  o.hydrometry.method = choice(h["hydrometry"], kHydrometryMethods);
   o.hydrometry.max_iterations = h["iterations"].get<int>();
   o.hydrometry.threshold = h["threshold"].get<double>();
-  o.hydrometry.vertical =
-      choice<VerticalScale>(h["vertical"], {{"metres", VerticalScale::metres}, {"normalised16", VerticalScale::normalised16}});
-  o.hydrometry.share =
-      choice<BelhadjShare>(h["belhadj_share"], {{"all", BelhadjShare::all_neighbours}, {"fed", BelhadjShare::fed_neighbours}});
+  o.hydrometry.vertical = choice(h["vertical"], kVerticalScales);
+  o.hydrometry.share = choice(h["belhadj_share"], kBelhadjShares);
   o.streams.threshold_km2 = h["streams_threshold_km2"].get<double>();
   // The sea drains the land: its cells are outlets for every step (density treats them as water).
   o.sea_level = scenario.resolved["water"]["sea_level_m"].get<double>();
@@ -40,9 +38,7 @@ hydro::HydroOptions hydro_options(const Scenario& scenario) {
 }
 
 hydro::D8Codes d8_codes(const Scenario& scenario) {
-  using hydro::D8Codes;
-  return choice<D8Codes>(scenario.resolved["hydro"]["d8_codes"],
-                         {{"esri", D8Codes::esri}, {"grass", D8Codes::grass}, {"taudem", D8Codes::taudem}});
+  return choice(scenario.resolved["hydro"]["d8_codes"], hydro::kD8Codes);
 }
 
 density::DensityOptions density_options(const Scenario& scenario) {

@@ -2,6 +2,9 @@
 // SPDX-License-Identifier: MIT
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
+#include "hydro/option_names.hpp"
 #include "pipeline/stage_options.hpp"
 
 using namespace terrapolis;
@@ -97,4 +100,25 @@ TEST(StageOptions, ScenarioValuesReachTheStages) {
   EXPECT_TRUE(r.model.tunnel.enabled);
   EXPECT_EQ(r.routing.router, roads::Router::bezier);
   EXPECT_EQ(r.routing.graph.seed, 7u);
+}
+
+// The schema offers exactly the names the hydrology module knows (the command line checks the same tables).
+TEST(StageOptions, HydroSchemaChoicesAreTheModuleNames) {
+  const auto schema = nlohmann::json::parse(scenario_schema_text())["properties"]["hydro"]["properties"];
+  auto names = [&](const char* field) { return schema[field]["enum"].get<std::vector<std::string>>(); };
+  auto keys = [](const auto& table) {
+    std::vector<std::string> k;
+    for (const auto& [name, value] : table) k.push_back(name);
+    return k;
+  };
+  auto sorted = [](std::vector<std::string> v) {
+    std::sort(v.begin(), v.end());
+    return v;
+  };
+  EXPECT_EQ(sorted(names("fill")), keys(hydro::kFillMethods));
+  EXPECT_EQ(sorted(names("flow")), keys(hydro::kFlowMethods));
+  EXPECT_EQ(sorted(names("d8_codes")), keys(hydro::kD8Codes));
+  EXPECT_EQ(sorted(names("hydrometry")), keys(hydro::kHydrometryMethods));
+  EXPECT_EQ(sorted(names("vertical")), keys(hydro::kVerticalScales));
+  EXPECT_EQ(sorted(names("belhadj_share")), keys(hydro::kBelhadjShares));
 }
