@@ -67,6 +67,15 @@ Raster<std::uint8_t> d8_directions(const Dem& filled, const CellMetrics& metrics
   return d8;
 }
 
+std::uint8_t d8_code(int k, D8Codes convention) {
+  switch (convention) {
+    case D8Codes::esri: return std::uint8_t(1u << k);
+    case D8Codes::grass: return std::uint8_t(8 - k);  // k=0 (E) -> 8
+    case D8Codes::taudem: return std::uint8_t((8 - k) % 8 + 1);
+  }
+  return 0;
+}
+
 Raster<std::uint8_t> encode_d8(const Raster<std::uint8_t>& d8, D8Codes convention) {
   Raster<std::uint8_t> out = d8.like<std::uint8_t>(255);
   out.nodata = 255;
@@ -77,11 +86,7 @@ Raster<std::uint8_t> encode_d8(const Raster<std::uint8_t>& d8, D8Codes conventio
       out[i] = 0;
       continue;
     }
-    switch (convention) {
-      case D8Codes::esri: out[i] = std::uint8_t(1u << k); break;
-      case D8Codes::grass: out[i] = std::uint8_t(8 - k); break;  // k=0 (E) -> 8
-      case D8Codes::taudem: out[i] = std::uint8_t((8 - k) % 8 + 1); break;
-    }
+    out[i] = d8_code(k, convention);
   }
   return out;
 }

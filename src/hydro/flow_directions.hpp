@@ -37,6 +37,8 @@ Raster<std::uint8_t> d8_directions(const Dem& filled, const CellMetrics& metrics
 
 /// File codes of `d8` in `convention` (uint8, nodata 255).
 Raster<std::uint8_t> encode_d8(const Raster<std::uint8_t>& d8, D8Codes convention);
+/// The file code of neighbour k (neighbours.hpp order: 0 = E, then clockwise) in a convention.
+std::uint8_t d8_code(int k, D8Codes convention);
 /// Inverse of encode_d8 (for reading rasters written by other tools); throws bad_input on a bad code.
 Raster<std::uint8_t> decode_d8(const Raster<std::uint8_t>& codes, D8Codes convention);
 /// One-line statement of a convention, stored in the flowdir file's metadata.

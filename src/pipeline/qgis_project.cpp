@@ -2,6 +2,8 @@
 // SPDX-License-Identifier: MIT
 #include "pipeline/qgis_project.hpp"
 
+#include "hydro/option_names.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -168,8 +170,15 @@ std::string qgis_style_body(const OutputFile& o, const RunState& state) {
                          "INTERPOLATED", 0.7);
     case Style::mask: return paletted({{0, "#000000", "not buildable"}, {1, "#4daf4a", "buildable"}}, 0.4);
     case Style::flow_direction:
-      return paletted({{1, "#e41a1c", "E"}, {2, "#377eb8", "SE"}, {4, "#4daf4a", "S"}, {8, "#984ea3", "SW"},
-                       {16, "#ff7f00", "W"}, {32, "#ffff33", "NW"}, {64, "#a65628", "N"}, {128, "#f781bf", "NE"}});
+    {
+      // The codes of the run's convention (hydro.d8_codes), one colour per direction.
+      const hydro::D8Codes codes = hydro::kD8Codes.at(state.scenario.resolved["hydro"]["d8_codes"].get<std::string>());
+      const char* colours[8] = {"#e41a1c", "#377eb8", "#4daf4a", "#984ea3", "#ff7f00", "#ffff33", "#a65628", "#f781bf"};
+      const char* names[8] = {"E", "SE", "S", "SW", "W", "NW", "N", "NE"};
+      std::vector<Stop> entries;
+      for (int k = 0; k < 8; ++k) entries.push_back({double(hydro::d8_code(k, codes)), colours[k], names[k]});
+      return paletted(entries);
+    }
     case Style::accumulation:
       // accumulation.tif of a run is in km2 (the hydro stage writes km2).
       return pseudocolor({{0, "#f7fbff", "0"}, {0.1, "#c6dbef", ""}, {1, "#6baed6", "1 km2"}, {10, "#2171b5", ""}, {100, "#08306b", "100 km2"}});

@@ -73,6 +73,10 @@ cmp -s run1/cities.geojson rerun/cities.geojson || fail "--from network rewrote 
 /usr/bin/python3 -c "import json; r=json.load(open('rerun/run.json'))['rerun']; assert r['stale']==['sites','network','roads'], r" || fail "--only"
 cmp -s run1/density.tif rerun/density.tif && fail "--only density did not change density.tif"
 expect_fail 2 "other 'density' parameters; rerun from density" "$TP" run -o rerun --from sites --set density.r_max_m=6000
+# The flow-direction style follows the run's code convention (GRASS: east is 8).
+cp -r run1 grass
+"$TP" --quiet run -o grass --only hydro --set hydro.d8_codes=grass
+grep -q 'value="8" color="#e41a1c" alpha="255" label="E"' grass/flowdir.qml || fail "flowdir.qml does not use the GRASS codes"
 expect_fail 2 "other 'density' parameters" "$TP" run -o rerun --only hydro roads --set density.r_max_m=6000
 expect_fail 2 "dunes" "$TP" run -o rerun --from dunes
 expect_fail 2 "nosuch: not a run folder" "$TP" run -o nosuch --from roads
