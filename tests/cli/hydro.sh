@@ -1,10 +1,8 @@
 #!/usr/bin/env bash
 # `terrapolis hydro` on the sample DEMs, and its refusals (exit 2, nothing left behind).
 # SPDX-License-Identifier: MIT
-set -euo pipefail
-bin=$1 samples=$2
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+source "$(dirname "$0")/lib.sh" "$@"
+bin=$TP samples=$SAMPLES work=$WORK
 outputs="filled.tif flowdir.tif accumulation.tif hydrometry.tif streams.geojson"
 
 check_outputs() {
@@ -36,35 +34,25 @@ check_outputs "$work/zion"
 "$bin" -q hydro "$samples/stars_olinda_dem_utm25s.tif" "$work/olinda" --sea-level 0 --streams-threshold 0.5
 check_outputs "$work/olinda"
 
-expect_fail() {  # expect_fail CODE MESSAGE-PATTERN args...
-  local code=$1 pattern=$2; shift 2
-  set +e
-  "$bin" -q "$@" 2>"$work/err"
-  local got=$?
-  set -e
-  [[ $got -eq $code ]] || { echo "expected exit $code, got $got for: $*"; cat "$work/err"; exit 1; }
-  grep -q -- "$pattern" "$work/err" || { echo "message '$pattern' missing for: $*"; cat "$work/err"; exit 1; }
-}
-
 # Existing outputs are refused and left untouched; --overwrite replaces them.
 before=$(md5sum "$work/corsica/filled.tif")
-expect_fail 2 "exists" hydro "$samples/gebco2022_15s_north_corsica_capcorse.asc" "$work/corsica"
+expect_fail 2 "exists" "$bin" -q hydro "$samples/gebco2022_15s_north_corsica_capcorse.asc" "$work/corsica"
 [[ $(md5sum "$work/corsica/filled.tif") == "$before" ]]
 "$bin" -q hydro "$samples/gebco2022_15s_north_corsica_capcorse.asc" "$work/corsica" --overwrite --hydrometry accumulation
 
 # Bad inputs: exit 2, one line naming the problem, no output folder left.
-expect_fail 2 "missing.tif" hydro "$work/missing.tif" "$work/bad1"
+expect_fail 2 "missing.tif" "$bin" -q hydro "$work/missing.tif" "$work/bad1"
 [[ ! -e $work/bad1 ]]
-expect_fail 2 "--fill" hydro "$samples/whiteboxR_DEM_vermont.tif" "$work/bad2" --fill magic
+expect_fail 2 "--fill" "$bin" -q hydro "$samples/whiteboxR_DEM_vermont.tif" "$work/bad2" --fill magic
 [[ ! -e $work/bad2 ]]
-expect_fail 2 "--threshold" hydro "$samples/whiteboxR_DEM_vermont.tif" "$work/bad3" --threshold 0
+expect_fail 2 "--threshold" "$bin" -q hydro "$samples/whiteboxR_DEM_vermont.tif" "$work/bad3" --threshold 0
 [[ ! -e $work/bad3 ]]
-expect_fail 2 "--mfd-exponent" hydro "$samples/whiteboxR_DEM_vermont.tif" "$work/bad4" --mfd-exponent -1
+expect_fail 2 "--mfd-exponent" "$bin" -q hydro "$samples/whiteboxR_DEM_vermont.tif" "$work/bad4" --mfd-exponent -1
 [[ ! -e $work/bad4 ]]
-expect_fail 2 "nope.tif" hydro "$samples/whiteboxR_DEM_vermont.tif" "$work/bad5" --weights "$work/nope.tif"
+expect_fail 2 "nope.tif" "$bin" -q hydro "$samples/whiteboxR_DEM_vermont.tif" "$work/bad5" --weights "$work/nope.tif"
 [[ ! -e $work/bad5 ]]
-expect_fail 2 "streams-threshold" hydro "$samples/whiteboxR_DEM_vermont.tif" "$work/bad6" --streams-threshold 0
+expect_fail 2 "streams-threshold" "$bin" -q hydro "$samples/whiteboxR_DEM_vermont.tif" "$work/bad6" --streams-threshold 0
 [[ ! -e $work/bad6 ]]
-expect_fail 2 "no land" hydro "$samples/whiteboxR_DEM_vermont.tif" "$work/bad7" --sea-level 5000
+expect_fail 2 "no land" "$bin" -q hydro "$samples/whiteboxR_DEM_vermont.tif" "$work/bad7" --sea-level 5000
 [[ ! -e $work/bad7 ]]
 echo ok

@@ -15,7 +15,7 @@ expect_fail() {
   local rc=0
   "$@" >"$WORK/stdout" 2>"$WORK/stderr" || rc=$?
   [[ $rc -eq $code ]] || fail "expected exit $code, got $rc: $* ($(cat "$WORK/stderr"))"
-  grep -Eq "$pattern" "$WORK/stderr" || fail "stderr of '$*' does not match '$pattern': $(cat "$WORK/stderr")"
+  grep -Eq -- "$pattern" "$WORK/stderr" || fail "stderr of '$*' does not match '$pattern': $(cat "$WORK/stderr")"
   [[ $(grep -c . "$WORK/stderr") -ge 1 ]] || fail "no error message"
 }
 

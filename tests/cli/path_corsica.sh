@@ -1,9 +1,8 @@
 #!/usr/bin/env bash
 # `terrapolis path` on the Corsica sample: a road, and clean failures on bad points.
-set -euo pipefail
-bin=$1; samples=$2
+source "$(dirname "$0")/lib.sh" "$@"
+bin=$TP samples=$SAMPLES out=$WORK
 dem=$samples/gebco2022_15s_north_corsica_capcorse.asc
-out=$(mktemp -d); trap 'rm -rf "$out"' EXIT
 
 "$bin" -q path "$dem" --from 9.30,42.68 --to 9.42,42.70 "$out/road.geojson" --sections "$out/sections.geojson"
 grep -q '"router": "galin"' "$out/road.geojson"
@@ -15,19 +14,13 @@ c1=$(grep -o '"cost": [0-9.]*' "$out/road.geojson"); c2=$(grep -o '"cost": [0-9.
 # Existing output without --overwrite is refused.
 if "$bin" -q path "$dem" --from 9.30,42.68 --to 9.42,42.70 "$out/road.geojson"; then exit 1; fi
 
-expect_fail() {  # expected message, then arguments; exit code 2 and no output left
-  local msg=$1; shift
-  set +e; err=$("$bin" -q path "$dem" "$@" "$out/bad.geojson" 2>&1); rc=$?; set -e
-  [[ $rc -eq 2 ]] || { echo "exit $rc for $*: $err"; exit 1; }
-  grep -q "$msg" <<<"$err" || { echo "message '$err' lacks '$msg'"; exit 1; }
-  [[ ! -e "$out/bad.geojson" ]] || { echo "output left behind"; exit 1; }
-}
-expect_fail "outside" --from 2.0,42.7 --to 9.42,42.70
-expect_fail "same cell" --from 9.30,42.68 --to 9.30,42.68
-expect_fail "in the sea" --from 9.0,43.15 --to 9.42,42.70
-expect_fail "latitude" --from 42.68,95 --to 9.42,42.70
-expect_fail "not a number" --from 9.3,abc --to 9.42,42.70
-expect_fail "k" --from 9.30,42.68 --to 9.42,42.70 --k 0
+refuse() { expect_refused "$out/bad.geojson" "$1" "$bin" -q path "$dem" "${@:2}" "$out/bad.geojson"; }
+refuse "outside" --from 2.0,42.7 --to 9.42,42.70
+refuse "same cell" --from 9.30,42.68 --to 9.30,42.68
+refuse "in the sea" --from 9.0,43.15 --to 9.42,42.70
+refuse "latitude" --from 42.68,95 --to 9.42,42.70
+refuse "not a number" --from 9.3,abc --to 9.42,42.70
+refuse "k" --from 9.30,42.68 --to 9.42,42.70 --k 0
 # Coordinates in the DEM's CRS (UTM 25S, no nodata tag) and negative lon/lat typed as is.
 "$bin" -q path "$samples/stars_olinda_dem_utm25s.tif" --crs dem --from 292000,9112000 --to 296000,9117000 "$out/olinda.geojson" --no-bridges --no-tunnels
 grep -q LineString "$out/olinda.geojson"
