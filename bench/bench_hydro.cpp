@@ -49,9 +49,9 @@ int bench_threads() {
   return env ? std::atoi(env) : 2;
 }
 
-void BM_Belhadj256x20(benchmark::State& state) {
+/// 20 Belhadj iterations on `dem`, with the cell-iterations rate.
+void belhadj_x20(benchmark::State& state, const Dem& dem) {
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(bench_threads()));
-  const Dem dem = corner(256);
   const CellMetrics m = cell_metrics(dem.georef(), dem.cols(), dem.rows());
   SilentProgress p;
   BelhadjOptions o;
@@ -63,6 +63,8 @@ void BM_Belhadj256x20(benchmark::State& state) {
   state.counters["cell_it_per_s"] =
       benchmark::Counter(double(dem.size()) * 20, benchmark::Counter::kIsIterationInvariantRate);
 }
+
+void BM_Belhadj256x20(benchmark::State& state) { belhadj_x20(state, corner(256)); }
 BENCHMARK(BM_Belhadj256x20)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_BelhadjStep256(benchmark::State& state) {
@@ -75,20 +77,7 @@ void BM_BelhadjStep256(benchmark::State& state) {
 }
 BENCHMARK(BM_BelhadjStep256)->Unit(benchmark::kMicrosecond)->UseRealTime();
 
-void BM_BelhadjFullx20(benchmark::State& state) {
-  tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(bench_threads()));
-  const Dem& dem = full_dem();
-  const CellMetrics m = cell_metrics(dem.georef(), dem.cols(), dem.rows());
-  SilentProgress p;
-  BelhadjOptions o;
-  o.max_iterations = 20;
-  for (auto _ : state) {
-    BelhadjRun run = belhadj_hydrometry(dem, m, o, p);
-    benchmark::DoNotOptimize(run.hydrometry.values().data());
-  }
-  state.counters["cell_it_per_s"] =
-      benchmark::Counter(double(dem.size()) * 20, benchmark::Counter::kIsIterationInvariantRate);
-}
+void BM_BelhadjFullx20(benchmark::State& state) { belhadj_x20(state, full_dem()); }
 BENCHMARK(BM_BelhadjFullx20)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_FillD8Accumulation(benchmark::State& state) {
