@@ -29,16 +29,23 @@ BelhadjModel::BelhadjModel(const Dem& dem, const CellMetrics& metrics, VerticalS
     }
   if (!(lo <= hi)) throw bad_input("hydrometry: the DEM has no land cell (all nodata or below sea level)");
   z_out_ = vertical == VerticalScale::normalised16 ? -1.0 : lo - std::max(hi - lo, 1.0);
-  z_.assign(padded, z_out_);
-  valid_.assign(padded, 0.0);
+  block_.assign(11 * padded, 0.0);  // F = 0, Q = 0, Acc = 0, valid = 0 everywhere to begin with
+  double* arrays[11];
+  for (std::size_t a = 0; a < 11; ++a) arrays[a] = block_.data() + a * padded;
+  z_ = arrays[0], valid_ = arrays[1], fx_ = arrays[2], fy_ = arrays[3], fz_ = arrays[4], q_ = arrays[5];
+  acc_ = arrays[6], fx2_ = arrays[7], fy2_ = arrays[8], fz2_ = arrays[9], q2_ = arrays[10];
+  std::fill(z_, z_ + padded, z_out_);
   for (int r = 0; r < rows_; ++r)
     for (int c = 0; c < cols_; ++c) {
       const float v = dem(c, r);
       if (std::isnan(v) || is_sea(v, sea_level)) continue;
       double z = v;
       if (vertical == VerticalScale::normalised16) z = double(v) / 65535.0;  // 16-bit metres / (2^16-1)
-      z_[at(c, r)] = z;
-      valid_[at(c, r)] = 1.0;
+      const std::size_t i = at(c, r);
+      z_[i] = z;
+      valid_[i] = 1.0;
+      fz_[i] = -1.0;
+      q_[i] = 1.0;
       ++valid_count_;
     }
   hx_.assign(std::size_t(rows_ + 2) * 8, 0.0);
@@ -59,20 +66,6 @@ BelhadjModel::BelhadjModel(const Dem& dem, const CellMetrics& metrics, VerticalS
       hy_[std::size_t(pr) * 8 + std::size_t(k)] = y;
     }
   }
-  fx_.assign(padded, 0.0);
-  fy_.assign(padded, 0.0);
-  fz_.assign(padded, 0.0);
-  q_.assign(padded, 0.0);
-  acc_.assign(padded, 0.0);
-  for (std::size_t i = 0; i < padded; ++i)
-    if (valid_[i] != 0) {
-      fz_[i] = -1.0;
-      q_[i] = 1.0;
-    }
-  fx2_ = fx_;
-  fy2_ = fy_;
-  fz2_ = fz_;
-  q2_ = q_;
   row_sum_.assign(std::size_t(rows_), 0.0);
 }
 
@@ -83,7 +76,7 @@ namespace {
 // operations and per-cell sums in a fixed order are used (no contraction into FMA), so every ISA
 // variant (target_clones) gives the same bits.
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-#define TP_KERNEL __attribute__((target_clones("avx2", "default")))
+#define TP_KERNEL __attribute__((target_clones("avx512f", "avx2", "default")))
 #else
 #define TP_KERNEL
 #endif
@@ -202,8 +195,7 @@ double BelhadjModel::step() {
   std::ptrdiff_t off[8];
   for (int k = 0; k < 8; ++k) off[k] = std::ptrdiff_t(drow[k]) * stride_ + dcol[k];
   const bool all = share_ == BelhadjShare::all_neighbours;
-  const State st{z_.data(), valid_.data(), fx_.data(), fy_.data(), fz_.data(), q_.data(), acc_.data(),
-                 fx2_.data(), fy2_.data(), fz2_.data(), q2_.data()};
+  const State st{z_, valid_, fx_, fy_, fz_, q_, acc_, fx2_, fy2_, fz2_, q2_};
   // Bands of rows, each computing what its rows and the rows just outside it send (the edge rows
   // are computed twice), then gathering row by row. Every value is a function of the previous
   // state alone, summed in a fixed order: bit-identical whatever the bands and threads.
@@ -249,10 +241,10 @@ double BelhadjModel::step() {
         }
       },
       tbb::simple_partitioner());
-  fx_.swap(fx2_);
-  fy_.swap(fy2_);
-  fz_.swap(fz2_);
-  q_.swap(q2_);
+  std::swap(fx_, fx2_);
+  std::swap(fy_, fy2_);
+  std::swap(fz_, fz2_);
+  std::swap(q_, q2_);
   double total = 0;
   for (double s : row_sum_) total += s;  // fixed order: deterministic
   return valid_count_ ? total / double(valid_count_) : 0.0;
