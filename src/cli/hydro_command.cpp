@@ -4,8 +4,12 @@
 
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <string>
+#include <vector>
+
+#include <tbb/parallel_for.h>
 
 #include "cli/command.hpp"
 #include "cli/commands_list.hpp"
@@ -150,15 +154,29 @@ class HydroCommand final : public Command {
         written.push_back((fs::path(out_dir_) / names[i]).string());
         return written.back();
       };
-      if (wanted[0]) write_raster(path(0), result.filled, opts("Conditioned elevation (m), " + fill_ + " depression handling"));
-      if (wanted[1]) write_raster(path(1), encode_d8(result.d8, codes),
-                   opts("D8 flow direction, " + describe(codes), {{"D8_CODES", codes_}, {"D8_CODES_DESCRIPTION", describe(codes)}}));
-      if (wanted[2]) write_raster(path(2), acc,
-                   opts("Upstream " + std::string(units_ == "cells" ? "cell count" : "area (" + acc_unit + ")") + ", " + flow_ +
-                            " routing" + (weights_.empty() ? "" : ", weighted"),
-                        {{"UNIT", acc_unit}}));
-      if (wanted[3]) write_raster(path(3), result.hydrometry, opts("Hydrometry in [0,1] (" + hydrometry_ + ")"));
-      if (wanted[4]) write_vector(path(4), result.streams, overwrite_);
+      // The files are written concurrently: GDAL compresses each on one thread, and on 13 M-cell
+      // tiles writing was a fifth of the command's time.
+      std::vector<std::function<void()>> writes;
+      if (wanted[0])
+        writes.push_back([&, p = path(0)] {
+          write_raster(p, result.filled, opts("Conditioned elevation (m), " + fill_ + " depression handling"));
+        });
+      if (wanted[1])
+        writes.push_back([&, p = path(1)] {
+          write_raster(p, encode_d8(result.d8, codes),
+                       opts("D8 flow direction, " + describe(codes), {{"D8_CODES", codes_}, {"D8_CODES_DESCRIPTION", describe(codes)}}));
+        });
+      if (wanted[2])
+        writes.push_back([&, p = path(2)] {
+          write_raster(p, acc,
+                       opts("Upstream " + std::string(units_ == "cells" ? "cell count" : "area (" + acc_unit + ")") + ", " +
+                                flow_ + " routing" + (weights_.empty() ? "" : ", weighted"),
+                            {{"UNIT", acc_unit}}));
+        });
+      if (wanted[3])
+        writes.push_back([&, p = path(3)] { write_raster(p, result.hydrometry, opts("Hydrometry in [0,1] (" + hydrometry_ + ")")); });
+      if (wanted[4]) writes.push_back([&, p = path(4)] { write_vector(p, result.streams, overwrite_); });
+      tbb::parallel_for(std::size_t(0), writes.size(), [&](std::size_t i) { writes[i](); });
     } catch (...) {
       // No partial result: new files go, and the folder if this run made it.
       if (!overwrite_ || created)

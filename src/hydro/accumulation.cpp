@@ -42,12 +42,18 @@ Raster<double> accumulate(const Dem& filled, const FlowRouter& router,
       }
     }
   });
-  for (int r = 0; r < rows; ++r)
-    for (int c = 0; c < cols; ++c) {
-      const std::uint8_t bits = receivers[acc.index(c, r)];
-      for (int k = 0; k < 8; ++k)
-        if (bits & (1u << k)) ++indegree[acc.index(c + dcol[k], r + drow[k])];
-    }
+  // In-degrees gathered (each cell counts the neighbours that send to it): parallel, no atomics.
+  tbb::parallel_for(tbb::blocked_range<int>(0, rows), [&](const tbb::blocked_range<int>& rr) {
+    for (int r = rr.begin(); r < rr.end(); ++r)
+      for (int c = 0; c < cols; ++c) {
+        std::uint8_t n = 0;
+        for (int k = 0; k < 8; ++k) {
+          const int cn = c + dcol[k], rn = r + drow[k];
+          if (cn >= 0 && rn >= 0 && cn < cols && rn < rows && (receivers[acc.index(cn, rn)] & (1u << opposite(k)))) ++n;
+        }
+        indegree[acc.index(c, r)] = n;
+      }
+  });
   step.update(0.3);
   std::vector<std::uint32_t> stack;
   FlowSplit split;
