@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <cstdlib>
@@ -13,6 +14,8 @@
 #include <queue>
 #include <vector>
 
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include "hydro/grid.hpp"
@@ -135,6 +138,33 @@ void priority_flood(Dem& z, const std::optional<double>& sea_level, bool epsilon
   }
 }
 
+
+/// Breadth-first rings: `expand(cell, ring, next)` for every cell of `front` (ring `first`), then
+/// of what it pushed to `next` (ring first + 1), and so on. Rings of many cells are split between
+/// threads, each pushing to its own list; the next ring is their concatenation.
+template <class Cell, class Expand>
+void ring_by_ring(std::vector<Cell>& front, std::int32_t first, Expand&& expand) {
+  constexpr std::size_t kSplit = 4096;  // below this a ring costs less than sharing it out
+  std::vector<Cell> next;
+  tbb::enumerable_thread_specific<std::vector<Cell>> pushed;
+  for (std::int32_t ring = first; !front.empty(); ++ring) {
+    next.clear();
+    if (front.size() < kSplit) {
+      for (const Cell c : front) expand(c, ring, next);
+    } else {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, front.size(), kSplit / 4), [&](const auto& range) {
+        std::vector<Cell>& out = pushed.local();
+        for (std::size_t i = range.begin(); i < range.end(); ++i) expand(front[i], ring, out);
+      });
+      for (std::vector<Cell>& out : pushed) {
+        next.insert(next.end(), out.begin(), out.end());
+        out.clear();
+      }
+    }
+    std::swap(front, next);
+  }
+}
+
 }  // namespace
 
 Dem fill_depressions(const Dem& dem, const FillOptions& options, Progress& progress) {
@@ -254,73 +284,72 @@ void drain_flats(const Dem& filled, Raster<std::uint8_t>& d8) {
     std::int32_t mask;
   };
   BigVector<Slot> cell(padded, Slot{0, 0});
+  // The waves are run ring by ring, the large rings (the sea, a lake) split between threads. What
+  // a wave writes in a cell depends only on its ring and on what earlier waves wrote, never on the
+  // order of the cells in a ring, so two threads reaching one cell write the same values: the
+  // accesses are relaxed atomics (plain moves on x86), and such a cell is then queued twice, which
+  // costs a little work and changes nothing.
+  auto load = [](std::int32_t& v) { return std::atomic_ref<std::int32_t>(v).load(std::memory_order_relaxed); };
+  auto store = [](std::int32_t& v, std::int32_t x) { std::atomic_ref<std::int32_t>(v).store(x, std::memory_order_relaxed); };
   std::int32_t next_label = 1;
-  std::vector<std::uint64_t> front, next;  // padded index << 32 | unpadded index
+  std::vector<std::uint64_t> front;  // padded index << 32 | unpadded index
   for (std::uint32_t seed : low) {
     if (cell[seed].label != 0) continue;
     const std::size_t useed = unpadded(seed);
     const float zf = filled[useed];
-    cell[seed].label = -next_label;
+    const std::int32_t label = next_label++;
+    cell[seed].label = -label;
     front.assign(1, std::uint64_t(seed) << 32 | useed);
-    // Breadth first, ring by ring: rings stay compact in memory, where a depth-first flood wanders
-    // across rows. The partition into flats is the same either way.
-    while (!front.empty()) {
-      next.clear();
-      for (const std::uint64_t top : front) {
-        const std::size_t p = std::size_t(top >> 32), u = std::size_t(top & 0xffffffffu);
-        for (int k = 0; k < 8; ++k) {
-          const std::size_t pn = std::size_t(std::ptrdiff_t(p) + poff[k]);
-          const std::uint8_t kn = kind[pn] & 3;
-          if (kn == kOut || cell[pn].label != 0) continue;
-          const std::size_t un = std::size_t(std::ptrdiff_t(u) + uoff[k]);
-          if (filled[un] != zf) continue;
-          cell[pn].label = kn == kFlat ? next_label : -next_label;
-          next.push_back(std::uint64_t(pn) << 32 | un);
-        }
+    // Breadth first: rings stay compact in memory, where a depth-first flood wanders across rows.
+    // The partition into flats is the same either way.
+    ring_by_ring(front, 1, [&](std::uint64_t top, std::int32_t, std::vector<std::uint64_t>& next) {
+      const std::size_t p = std::size_t(top >> 32), u = std::size_t(top & 0xffffffffu);
+      for (int k = 0; k < 8; ++k) {
+        const std::size_t pn = std::size_t(std::ptrdiff_t(p) + poff[k]);
+        const std::uint8_t kn = kind[pn] & 3;
+        if (kn == kOut || load(cell[pn].label) != 0) continue;
+        const std::size_t un = std::size_t(std::ptrdiff_t(u) + uoff[k]);
+        if (filled[un] != zf) continue;
+        store(cell[pn].label, kn == kFlat ? label : -label);
+        next.push_back(std::uint64_t(pn) << 32 | un);
       }
-      std::swap(front, next);
-    }
-    ++next_label;
+    });
   }
   std::vector<std::int32_t> flat_height(std::size_t(next_label), 0);
   // Breadth-first wave over undrained cells of the same flat, one ring per loop. A cell is
-  // marked (mask > 0 after `set`) when it is first reached, so each is queued once.
+  // marked (mask > 0 after `set`) when it is first reached.
   auto wave = [&](const std::vector<std::uint32_t>& seeds, auto&& set) {
-    std::vector<std::uint32_t> front, next;
+    std::vector<std::uint32_t> front;
     for (std::uint32_t p : seeds)
       if (cell[p].mask <= 0) {
         set(p, 1);
         front.push_back(p);
       }
-    for (std::int32_t loops = 2; !front.empty(); ++loops) {
-      next.clear();
-      for (std::uint32_t p : front) {
-        const std::int32_t label = std::abs(cell[p].label);
-        for (int k = 0; k < 8; ++k) {
-          const std::size_t pn = std::size_t(std::ptrdiff_t(p) + poff[k]);
-          const Slot s = cell[pn];
-          if (s.label != label || s.mask > 0) continue;  // not an undrained cell of this flat, or seen
-          set(pn, loops);
-          next.push_back(std::uint32_t(pn));
-        }
+    ring_by_ring(front, 2, [&](std::uint32_t p, std::int32_t ring, std::vector<std::uint32_t>& next) {
+      const std::int32_t label = std::abs(cell[p].label);
+      for (int k = 0; k < 8; ++k) {
+        const std::size_t pn = std::size_t(std::ptrdiff_t(p) + poff[k]);
+        // Not an undrained cell of this flat, or seen.
+        if (cell[pn].label != label || load(cell[pn].mask) > 0) continue;
+        set(pn, ring);
+        next.push_back(std::uint32_t(pn));
       }
-      std::swap(front, next);
-    }
+    });
   };
   // Gradient away from higher terrain (only high edges of labelled, i.e. drainable, flats).
   std::vector<std::uint32_t> high_labelled;
   for (std::uint32_t p : high)
     if (cell[p].label != 0) high_labelled.push_back(p);
-  wave(high_labelled, [&](std::size_t p, std::int32_t loops) {
-    cell[p].mask = loops;
-    flat_height[std::size_t(cell[p].label)] = loops;
+  wave(high_labelled, [&](std::size_t p, std::int32_t ring) {
+    store(cell[p].mask, ring);
+    store(flat_height[std::size_t(cell[p].label)], ring);
   });
   // Gradient towards lower terrain, combined: 2*towards + (height - away), always > 0.
   for (auto& s : cell) s.mask = -s.mask;
-  wave(low, [&](std::size_t p, std::int32_t loops) {
-    Slot& s = cell[p];
-    if (s.mask < 0) s.mask = flat_height[std::size_t(std::abs(s.label))] + s.mask + 2 * loops;
-    else s.mask = 2 * loops;
+  wave(low, [&](std::size_t p, std::int32_t ring) {
+    const std::int32_t away = load(cell[p].mask);  // -away, or 0 where the first wave did not reach
+    if (away < 0) store(cell[p].mask, flat_height[std::size_t(std::abs(cell[p].label))] + away + 2 * ring);
+    else if (away == 0) store(cell[p].mask, 2 * ring);
   });
   // Directions (Barnes 2014b, D8FlowFlats): towards the same-flat neighbour of smallest gradient,
   // the first in neighbour order on ties; none smaller than the cell itself: terminal.
