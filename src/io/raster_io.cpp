@@ -6,6 +6,7 @@
 #include <cpl_error.h>
 #include <gdal_priv.h>
 #include <gdalwarper.h>
+#include <tbb/global_control.h>
 
 #include <algorithm>
 #include <cmath>
@@ -285,6 +286,9 @@ void write_raster(const std::string& path, const Raster<T>& raster, const WriteO
   if (options.deflate_level != 6)  // the COG driver calls it LEVEL, GTiff ZLEVEL
     co.SetNameValue(options.cog ? "LEVEL" : "ZLEVEL", std::to_string(std::clamp(options.deflate_level, 1, 9)).c_str());
   co.SetNameValue("BIGTIFF", "IF_SAFER");
+  // Blocks compressed on the threads --threads allows; GDAL writes them in order: same bytes.
+  co.SetNameValue("NUM_THREADS",
+                  std::to_string(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism)).c_str());
   GDALDriver* driver = nullptr;
   if (options.cog) {
     driver = GetGDALDriverManager()->GetDriverByName("COG");
