@@ -17,6 +17,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include "hydro/grid.hpp"
 
@@ -139,31 +140,39 @@ void priority_flood(Dem& z, const std::optional<double>& sea_level, bool epsilon
 }
 
 
-/// Breadth-first rings: `expand(cell, ring, next)` for every cell of `front` (ring `first`), then
-/// of what it pushed to `next` (ring first + 1), and so on. Rings of many cells are split between
-/// threads, each pushing to its own list; the next ring is their concatenation.
-template <class Cell, class Expand>
-void ring_by_ring(std::vector<Cell>& front, std::int32_t first, Expand&& expand) {
-  constexpr std::size_t kSplit = 4096;  // below this a ring costs less than sharing it out
-  std::vector<Cell> next;
-  tbb::enumerable_thread_specific<std::vector<Cell>> pushed;
-  for (std::int32_t ring = first; !front.empty(); ++ring) {
-    next.clear();
-    if (front.size() < kSplit) {
-      for (const Cell c : front) expand(c, ring, next);
-    } else {
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, front.size(), kSplit / 4), [&](const auto& range) {
-        std::vector<Cell>& out = pushed.local();
-        for (std::size_t i = range.begin(); i < range.end(); ++i) expand(front[i], ring, out);
-      });
-      for (std::vector<Cell>& out : pushed) {
-        next.insert(next.end(), out.begin(), out.end());
-        out.clear();
+/// Breadth-first rings: `run(front, first, expand)` calls `expand(cell, ring, next)` for every cell
+/// of `front` (ring `first`), then of what it pushed to `next` (ring first + 1), and so on. Rings
+/// of many cells are split between threads, each pushing to its own list; the next ring is their
+/// concatenation. The lists are kept from one run to the next (flats are many and mostly small).
+template <class Cell>
+class Rings {
+ public:
+  template <class Expand>
+  void run(std::vector<Cell>& front, std::int32_t first, Expand&& expand) {
+    constexpr std::size_t kSplit = 4096;  // below this a ring costs less than sharing it out
+    for (std::int32_t ring = first; !front.empty(); ++ring) {
+      next_.clear();
+      if (front.size() < kSplit || !parallel_) {
+        for (const Cell c : front) expand(c, ring, next_);
+      } else {
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, front.size(), kSplit / 4), [&](const auto& range) {
+          std::vector<Cell>& out = pushed_.local();
+          for (std::size_t i = range.begin(); i < range.end(); ++i) expand(front[i], ring, out);
+        });
+        for (std::vector<Cell>& out : pushed_) {
+          next_.insert(next_.end(), out.begin(), out.end());
+          out.clear();
+        }
       }
+      std::swap(front, next_);
     }
-    std::swap(front, next);
   }
-}
+
+ private:
+  bool parallel_ = tbb::this_task_arena::max_concurrency() > 1;
+  std::vector<Cell> next_;
+  tbb::enumerable_thread_specific<std::vector<Cell>> pushed_;
+};
 
 }  // namespace
 
@@ -293,6 +302,7 @@ void drain_flats(const Dem& filled, Raster<std::uint8_t>& d8) {
   auto store = [](std::int32_t& v, std::int32_t x) { std::atomic_ref<std::int32_t>(v).store(x, std::memory_order_relaxed); };
   std::int32_t next_label = 1;
   std::vector<std::uint64_t> front;  // padded index << 32 | unpadded index
+  Rings<std::uint64_t> label_rings;
   for (std::uint32_t seed : low) {
     if (cell[seed].label != 0) continue;
     const std::size_t useed = unpadded(seed);
@@ -302,7 +312,7 @@ void drain_flats(const Dem& filled, Raster<std::uint8_t>& d8) {
     front.assign(1, std::uint64_t(seed) << 32 | useed);
     // Breadth first: rings stay compact in memory, where a depth-first flood wanders across rows.
     // The partition into flats is the same either way.
-    ring_by_ring(front, 1, [&](std::uint64_t top, std::int32_t, std::vector<std::uint64_t>& next) {
+    label_rings.run(front, 1, [&](std::uint64_t top, std::int32_t, std::vector<std::uint64_t>& next) {
       const std::size_t p = std::size_t(top >> 32), u = std::size_t(top & 0xffffffffu);
       for (int k = 0; k < 8; ++k) {
         const std::size_t pn = std::size_t(std::ptrdiff_t(p) + poff[k]);
@@ -318,6 +328,7 @@ void drain_flats(const Dem& filled, Raster<std::uint8_t>& d8) {
   std::vector<std::int32_t> flat_height(std::size_t(next_label), 0);
   // Breadth-first wave over undrained cells of the same flat, one ring per loop. A cell is
   // marked (mask > 0 after `set`) when it is first reached.
+  Rings<std::uint32_t> wave_rings;
   auto wave = [&](const std::vector<std::uint32_t>& seeds, auto&& set) {
     std::vector<std::uint32_t> front;
     for (std::uint32_t p : seeds)
@@ -325,7 +336,7 @@ void drain_flats(const Dem& filled, Raster<std::uint8_t>& d8) {
         set(p, 1);
         front.push_back(p);
       }
-    ring_by_ring(front, 2, [&](std::uint32_t p, std::int32_t ring, std::vector<std::uint32_t>& next) {
+    wave_rings.run(front, 2, [&](std::uint32_t p, std::int32_t ring, std::vector<std::uint32_t>& next) {
       const std::int32_t label = std::abs(cell[p].label);
       for (int k = 0; k < 8; ++k) {
         const std::size_t pn = std::size_t(std::ptrdiff_t(p) + poff[k]);
