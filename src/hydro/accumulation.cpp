@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "hydro/grid.hpp"
 
 namespace terrapolis::hydro {
 
@@ -21,8 +22,8 @@ Raster<double> accumulate(const Dem& filled, const FlowRouter& router,
     throw bad_input("weights: raster is not on the DEM's grid");
   Raster<double> acc = filled.like<double>(0.0);
   // Own contributions; in-degrees of the receivers that lie inside the grid.
-  std::vector<std::uint8_t> indegree(filled.size(), 0);
-  std::vector<std::uint8_t> receivers(filled.size(), 0);  // bit k: neighbour k receives
+  BigVector<std::uint8_t> indegree(filled.size(), 0);
+  BigVector<std::uint8_t> receivers(filled.size(), 0);  // bit k: neighbour k receives
   tbb::parallel_for(tbb::blocked_range<int>(0, rows), [&](const tbb::blocked_range<int>& rr) {
     for (int r = rr.begin(); r < rr.end(); ++r) {
       const double own = options.unit == AccumulationUnit::area_m2 ? metrics.area_m2[std::size_t(r)] : 1.0;
