@@ -50,6 +50,12 @@ for dem in "${dems[@]}"; do
   printf "%-14s %10s | %-34s %8ss %8ss %8ss | %.2f\n" "$name" "$cells" "fill+D8+accumulation, CPU (mean)" "$t" "$g" "$s" \
     "$(python3 -c "print(min($g,$s)/$t)")"
 
+  # The same pair timed in alternation (per-pair ratios, steadier on a shared machine).
+  read -r ta ga wr tc gc cr < <("$(dirname "$0")/paired.py" "$runs" \
+    "$bin -q --threads 2 hydro $dem $work/tp_$name --outputs flowdir,accumulation --overwrite --area-units cells" \
+    "grass $work/loc/PERMANENT --exec r.watershed -s --overwrite elevation=$name accumulation=acc_$name drainage=dir_$name memory=4000")
+  printf "%-14s %10s | %-34s %8ss %8ss %9s | %s (CPU %ss / %ss: %s)\n" "$name" "$cells" "fill+D8+acc, paired wall (median)" "$ta" "$ga" "-" "$wr" "$tc" "$gc" "$cr"
+
   # 2. MFD against r.watershed's default MFD.
   hyperfine -N -w 1 -r "$runs" --export-json "$work/tp_mfd.json" \
     "$bin -q --threads 2 hydro $dem $work/tpm_$name --flow mfd --outputs accumulation --overwrite --area-units cells" >/dev/null 2>&1
@@ -59,6 +65,10 @@ for dem in "${dems[@]}"; do
   printf "%-14s %10s | %-34s %8ss %8ss %9s | %.2f\n" "$name" "$cells" "MFD accumulation, wall (median)" "$t" "$g" "-" "$(python3 -c "print($g/$t)")"
   t=$(cpu "$work/tp_mfd.json"); g=$(cpu "$work/grass_mfd.json")
   printf "%-14s %10s | %-34s %8ss %8ss %9s | %.2f\n" "$name" "$cells" "MFD accumulation, CPU (mean)" "$t" "$g" "-" "$(python3 -c "print($g/$t)")"
+  read -r ta ga wr tc gc cr < <("$(dirname "$0")/paired.py" "$runs" \
+    "$bin -q --threads 2 hydro $dem $work/tpm_$name --flow mfd --outputs accumulation --overwrite --area-units cells" \
+    "grass $work/loc/PERMANENT --exec r.watershed --overwrite elevation=$name accumulation=macc_$name memory=4000")
+  printf "%-14s %10s | %-34s %8ss %8ss %9s | %s (CPU %ss / %ss: %s)\n" "$name" "$cells" "MFD, paired wall (median)" "$ta" "$ga" "-" "$wr" "$tc" "$gc" "$cr"
 
   fi
 
