@@ -38,14 +38,8 @@ HydroResult run_hydro(const Dem& dem, const HydroOptions& options, Progress& pro
           if (is_sea(dem[i], h.sea_level)) a[i] = 0;
       out.hydrometry = hydrometry_from_accumulation(a);
     } else {
-      BelhadjOptions b;
-      b.max_iterations = h.max_iterations;
-      b.threshold = h.threshold;
-      b.vertical = h.vertical;
-      b.sea_level = h.sea_level;
-      b.share = h.share;
       const auto t0 = std::chrono::steady_clock::now();
-      BelhadjRun run = belhadj_hydrometry(dem, metrics, b, progress);
+      BelhadjRun run = belhadj_hydrometry(dem, metrics, belhadj_options(h), progress);
       out.hydrometry_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       out.hydrometry_iterations = run.iterations;
       out.hydrometry = std::move(run.hydrometry);

@@ -28,17 +28,20 @@ Raster<float> hydrometry_from_accumulation(const Raster<double>& area) {
   return out;
 }
 
+BelhadjOptions belhadj_options(const HydrometryOptions& options) {
+  BelhadjOptions b;
+  b.max_iterations = options.max_iterations;
+  b.threshold = options.threshold;
+  b.vertical = options.vertical;
+  b.sea_level = options.sea_level;
+  b.share = options.share;
+  return b;
+}
+
 Raster<float> compute_hydrometry(const Dem& dem, const HydrometryOptions& options, Progress& progress) {
   const CellMetrics metrics = cell_metrics(dem.georef(), dem.cols(), dem.rows());
-  if (options.method == HydrometryMethod::belhadj) {
-    BelhadjOptions b;
-    b.max_iterations = options.max_iterations;
-    b.threshold = options.threshold;
-    b.vertical = options.vertical;
-    b.sea_level = options.sea_level;
-    b.share = options.share;
-    return belhadj_hydrometry(dem, metrics, b, progress).hydrometry;
-  }
+  if (options.method == HydrometryMethod::belhadj)
+    return belhadj_hydrometry(dem, metrics, belhadj_options(options), progress).hydrometry;
   const Dem filled = fill_depressions(dem, {FillMethod::priority_flood, options.sea_level}, progress);
   const auto d8 = d8_directions(filled, metrics, options.sea_level, progress);
   const FlowRouter router(filled, d8, metrics, FlowMethod::d8);

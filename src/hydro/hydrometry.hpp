@@ -27,6 +27,9 @@ struct HydrometryOptions {
 /// `sea_level` is set). Throws bad_input for invalid options or a DEM without land.
 Raster<float> compute_hydrometry(const Dem& dem, const HydrometryOptions& options, Progress& progress);
 
+/// The Belhadj part of `options`.
+BelhadjOptions belhadj_options(const HydrometryOptions& options);
+
 /// Log rescale of an upstream area (m², > 0 on valid cells) to [0,1]:
 /// (ln a - ln min) / (ln max - ln min) over valid cells; NaN stays NaN; `sea` cells (optional) get 0.
 Raster<float> hydrometry_from_accumulation(const Raster<double>& area_m2);
