@@ -32,3 +32,11 @@ no_leftovers() {
   found=$(find "$1" -name '*.tmp-*' -o -name '*.aux.xml' | head -1)
   [[ -z $found ]] || fail "left behind: $found"
 }
+
+# stand_in_density DEM DIR: the density stage's two outputs made from the DEM alone (buildable =
+# land below 1000 m, density = exp(-z / 400 m)), for cases that test what comes after it.
+stand_in_density() {
+  mkdir -p "$2"
+  gdal_calc.py --quiet -A "$1" --outfile "$2/buildable.tif" --type Byte --calc "(A>0)*(A<1000)" --NoDataValue 255
+  gdal_calc.py --quiet -A "$1" --outfile "$2/density.tif" --type Float32 --calc "(A>0)*(A<1000)*exp(-maximum(A,0)/400.0)"
+}

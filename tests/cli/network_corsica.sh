@@ -3,9 +3,7 @@ source "$(dirname "$0")/lib.sh" "$@"
 BIN=$TP
 T=$WORK
 DEM=$SAMPLES/gebco2022_15s_north_corsica_capcorse.asc
-mkdir "$T/in"
-gdal_calc.py --quiet -A "$DEM" --outfile "$T/in/buildable.tif" --type Byte --calc "(A>0)*(A<1000)" --NoDataValue 255
-gdal_calc.py --quiet -A "$DEM" --outfile "$T/in/density.tif" --type Float32 --calc "(A>0)*(A<1000)*exp(-maximum(A,0)/400.0)"
+stand_in_density "$DEM" "$T/in"
 "$BIN" --quiet sites "$T/in" "$T/s" --seed 5
 
 "$BIN" --quiet network "$T/s/cities.geojson" "$T/n" | tee "$T/out.txt"
