@@ -19,6 +19,14 @@ Raster<std::uint8_t> d8_of(const Dem& dem) {
   const CellMetrics m = cell_metrics(dem.georef(), dem.cols(), dem.rows());
   return d8_directions(dem, m, std::nullopt, p);
 }
+
+/// 3 x 3 plane z = -(2c + r) on 1 m cells, falling east and, less, south.
+Dem tilted_plane() {
+  std::vector<float> v;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) v.push_back(float(-(2 * c + r)));
+  return grid(3, 3, v);
+}
 }  // namespace
 
 TEST(FlowDirections, RampFlowsEast) {
@@ -91,10 +99,7 @@ TEST(FlowDirections, NodataHoleIsAnOutletOnlyWithoutLowerNeighbour) {
 
 TEST(FlowDirections, DinfSplitsOnTheSteepestFacet) {
   // Plane z = -(2c + r) on 1 m cells: facet E/SE, angle atan(1/2) out of 45 degrees.
-  std::vector<float> v;
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) v.push_back(float(-(2 * c + r)));
-  Dem dem = grid(3, 3, v);
+  const Dem dem = tilted_plane();
   const auto d8 = d8_of(dem);
   const CellMetrics m = cell_metrics(dem.georef(), 3, 3);
   const FlowRouter dinf(dem, d8, m, FlowMethod::dinf);
@@ -117,10 +122,7 @@ TEST(FlowDirections, DinfSplitsOnTheSteepestFacet) {
 }
 
 TEST(FlowDirections, MfdSharesFollowSlopePower) {
-  std::vector<float> v;
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) v.push_back(float(-(2 * c + r)));
-  Dem dem = grid(3, 3, v);
+  const Dem dem = tilted_plane();
   const auto d8 = d8_of(dem);
   const CellMetrics m = cell_metrics(dem.georef(), 3, 3);
   const double diag = std::hypot(1.0, 1.0);
