@@ -11,6 +11,9 @@
 #include <cstring>
 #include <deque>
 #include <functional>
+#include <limits>
+#include <mutex>
+#include <new>
 #include <queue>
 #include <vector>
 
@@ -20,6 +23,10 @@
 #include <tbb/task_arena.h>
 
 #include "hydro/grid.hpp"
+
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
 
 namespace terrapolis::hydro {
 namespace {
@@ -140,6 +147,252 @@ void priority_flood(Dem& z, const std::optional<double>& sea_level, bool epsilon
 }
 
 
+/// Open-addressing map from a pair of watershed labels to the lowest spill elevation seen between
+/// them (the spillover graph's edges of one strip).
+class SpillEdges {
+ public:
+  SpillEdges() : keys_(1024, 0), spill_(1024, 0.0f) {}
+  void lower(std::uint32_t a, std::uint32_t b, float spill) {
+    const std::uint64_t k = a < b ? (std::uint64_t(a) << 32 | b) : (std::uint64_t(b) << 32 | a);  // never 0: a != b
+    std::size_t mask = keys_.size() - 1, h = std::size_t((k * 0x9e3779b97f4a7c15ull) >> 20) & mask;
+    while (keys_[h] != 0 && keys_[h] != k) h = (h + 1) & mask;
+    if (keys_[h] == k) {
+      spill_[h] = std::min(spill_[h], spill);
+      return;
+    }
+    keys_[h] = k;
+    spill_[h] = spill;
+    if (++size_ * 2 > keys_.size()) grow();
+  }
+  template <class F>
+  void for_each(F&& f) const {
+    for (std::size_t h = 0; h < keys_.size(); ++h)
+      if (keys_[h] != 0) f(std::uint32_t(keys_[h] >> 32), std::uint32_t(keys_[h]), spill_[h]);
+  }
+
+ private:
+  void grow() {
+    std::vector<std::uint64_t> keys(keys_.size() * 2, 0);
+    std::vector<float> spill(keys.size());
+    keys.swap(keys_);
+    spill.swap(spill_);
+    size_ = 0;
+    for (std::size_t h = 0; h < keys.size(); ++h)
+      if (keys[h] != 0) lower(std::uint32_t(keys[h] >> 32), std::uint32_t(keys[h]), spill[h]);
+  }
+  std::vector<std::uint64_t> keys_;
+  std::vector<float> spill_;
+  std::size_t size_ = 0;
+};
+
+/// Plain Priority-Flood filling on row strips filled in parallel, after Barnes 2016 ("Parallel
+/// priority-flood depression filling for trillion cell digital elevation models", Environmental
+/// Modelling & Software 86): each strip is filled on its own with the rows it shares with its
+/// neighbours as extra outlets, every cell labelled with the seed it was flooded from (label 0 for
+/// all true outlets, one label per cut-row seed); the labels form a small spillover graph (edge
+/// between two labels: the lowest max(filled a, filled b) over 8-adjacent cells a, b, within a strip
+/// or across a cut), whose Priority-Flood from label 0 gives each label its water level; each cell
+/// then ends at max(strip-filled value, its label's level). That is the lowest spill elevation of
+/// any path to a true outlet, the unique plain filling, whatever the number of strips or threads.
+template <class Label>
+void fill_strips(Dem& z, const std::optional<double>& sea_level, int strips, Progress& progress) {
+  constexpr Label kOpen = std::numeric_limits<Label>::max(), kVoid = kOpen - 1;  // not reached, nodata
+  const int cols = z.cols(), rows = z.rows();
+  strips = std::clamp(strips, 1, std::max(rows, 1));
+  auto first_row = [&](int s) { return int(std::int64_t(rows) * s / strips); };
+  // The labels, one per cell, left uninitialised (each strip writes its own rows). Mapped apart
+  // from the heap so that their pages go back to the system when the fill ends, whatever the
+  // allocator's thresholds: the later steps of `hydro` need more memory than this one.
+  struct Buffer {
+    explicit Buffer(std::size_t n) : bytes(std::max<std::size_t>(n, 1) * sizeof(Label)) {
+#if defined(__linux__)
+      void* p = mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+      if (p == MAP_FAILED) throw std::bad_alloc();
+#if defined(MADV_HUGEPAGE)
+      madvise(p, bytes, MADV_HUGEPAGE);
+#endif
+      data = static_cast<Label*>(p);
+#else
+      data = new Label[std::max<std::size_t>(n, 1)];
+#endif
+    }
+    ~Buffer() {
+#if defined(__linux__)
+      munmap(data, bytes);
+#else
+      delete[] data;
+#endif
+    }
+    Buffer(const Buffer&) = delete;
+    Buffer& operator=(const Buffer&) = delete;
+    std::size_t bytes;
+    Label* data;
+  } buffer(z.size());
+  Label* const label = buffer.data;
+  std::vector<SpillEdges> edges(static_cast<std::size_t>(strips));
+  std::vector<std::uint32_t> labels_used(static_cast<std::size_t>(strips), 1);
+  ProgressStep step(progress, "fill");
+  std::mutex progress_mutex;
+  std::atomic<std::size_t> done{0};
+  const std::size_t report = std::max<std::size_t>(z.size() / 50, 1);
+  tbb::parallel_for(tbb::blocked_range<int>(0, strips, 1), [&](const tbb::blocked_range<int>& range) {
+    for (int s = range.begin(); s < range.end(); ++s) {
+      const int r0 = first_row(s), r1 = first_row(s + 1);
+      RadixQueue open;
+      std::deque<std::uint32_t> pit;
+      Label next = 1;
+      auto row_has_nodata = [&](int r) {
+        if (r < 0 || r >= rows) return false;
+        bool nodata = false;
+        for (int c = 0; c < cols; ++c) nodata |= std::isnan(z(c, r));
+        return nodata;
+      };
+      bool above = row_has_nodata(r0 - 1), here = row_has_nodata(r0);
+      for (int r = r0; r < r1; ++r) {
+        const bool below = row_has_nodata(r + 1);
+        const bool near_nodata = above || here || below, edge_row = r == 0 || r == rows - 1;
+        above = here;
+        here = below;
+        const bool cut = (r == r0 && s > 0) || (r == r1 - 1 && s < strips - 1);
+        for (int c = 0; c < cols; ++c) {
+          const std::size_t i = z.index(c, r);
+          if (std::isnan(z[i])) {
+            label[i] = kVoid;
+          } else if (edge_row || c == 0 || c == cols - 1 || (near_nodata && touches_outside(z, c, r)) ||
+                     is_sea(z[i], sea_level)) {
+            label[i] = 0;
+            open.push(key(z[i], std::uint32_t(i)));
+          } else if (cut) {
+            label[i] = next++;
+            open.push(key(z[i], std::uint32_t(i)));
+          } else {
+            label[i] = kOpen;
+          }
+        }
+      }
+      labels_used[std::size_t(s)] = next;
+      SpillEdges& spill = edges[std::size_t(s)];
+      std::size_t local = 0;
+      while (!open.empty() || !pit.empty()) {
+        std::uint32_t i;
+        if (!pit.empty()) {
+          i = pit.front();
+          pit.pop_front();
+        } else {
+          i = std::uint32_t(open.pop());
+        }
+        if (++local == 4096) {
+          if ((done += local) / report != (done - local) / report) {
+            std::unique_lock lock(progress_mutex, std::try_to_lock);
+            if (lock) step.update(double(done) / double(z.size()));
+          }
+          local = 0;
+        }
+        const int c = int(i % std::uint32_t(cols)), r = int(i / std::uint32_t(cols));
+        const float zc = z[i];
+        const Label lc = label[i];
+        for (int k = 0; k < 8; ++k) {
+          const int nc = c + dcol[k], nr = r + drow[k];
+          if (nc < 0 || nr < r0 || nc >= cols || nr >= r1) continue;
+          const std::size_t n = z.index(nc, nr);
+          const Label ln = label[n];
+          if (ln == kOpen) {
+            label[n] = lc;
+            if (z[n] <= zc) {
+              z[n] = zc;
+              pit.push_back(std::uint32_t(n));
+            } else {
+              open.push(key(z[n], std::uint32_t(n)));
+            }
+          } else if (ln != lc && ln != kVoid) {
+            // Two watersheds meet. Both values are final (a cell is raised when it is reached),
+            // and every adjacent pair of the strip passes here once its later cell is popped.
+            spill.lower(lc, ln, std::max(zc, z[n]));
+          }
+        }
+      }
+    }
+  }, tbb::simple_partitioner());
+  if (strips == 1) return;
+  // Global labels: 0 for the true outlets, then each strip's cut-row seeds.
+  std::vector<std::uint32_t> base(static_cast<std::size_t>(strips), 0);
+  std::uint32_t nodes = 1;
+  for (int s = 0; s < strips; ++s) {
+    base[std::size_t(s)] = nodes - 1;
+    nodes += labels_used[std::size_t(s)] - 1;
+  }
+  auto global = [&](int s, Label l) { return l == 0 ? 0u : base[std::size_t(s)] + l; };
+  struct Edge {
+    std::uint32_t a, b;
+    float spill;
+  };
+  std::vector<Edge> list;
+  for (int s = 0; s < strips; ++s)
+    edges[std::size_t(s)].for_each(
+        [&](std::uint32_t a, std::uint32_t b, float w) { list.push_back({global(s, Label(a)), global(s, Label(b)), w}); });
+  edges.clear();
+  edges.shrink_to_fit();
+  for (int s = 0; s + 1 < strips; ++s) {  // across the cut between the last row of s and the first of s + 1
+    const int r = first_row(s + 1) - 1;
+    for (int c = 0; c < cols; ++c) {
+      const std::size_t a = z.index(c, r);
+      if (label[a] == kVoid) continue;
+      for (int dc = -1; dc <= 1; ++dc) {
+        if (c + dc < 0 || c + dc >= cols) continue;
+        const std::size_t b = z.index(c + dc, r + 1);
+        if (label[b] == kVoid) continue;
+        const std::uint32_t ga = global(s, label[a]), gb = global(s + 1, label[b]);
+        if (ga != gb) list.push_back({ga, gb, std::max(z[a], z[b])});
+      }
+    }
+  }
+  // Adjacency in compressed rows, then the graph's Priority-Flood from label 0.
+  std::vector<std::uint32_t> start(std::size_t(nodes) + 1, 0);
+  for (const Edge& e : list) {
+    ++start[e.a + 1];
+    ++start[e.b + 1];
+  }
+  for (std::size_t v = 0; v < nodes; ++v) start[v + 1] += start[v];
+  std::vector<std::pair<std::uint32_t, float>> adjacent(start[nodes]);
+  {
+    std::vector<std::uint32_t> fill_at(start.begin(), start.end() - 1);
+    for (const Edge& e : list) {
+      adjacent[fill_at[e.a]++] = {e.b, e.spill};
+      adjacent[fill_at[e.b]++] = {e.a, e.spill};
+    }
+  }
+  list = {};
+  std::vector<float> level(nodes, INFINITY);
+  std::vector<std::uint8_t> settled(nodes, 0);
+  std::priority_queue<std::pair<float, std::uint32_t>, std::vector<std::pair<float, std::uint32_t>>, std::greater<>> queue;
+  level[0] = -INFINITY;
+  queue.push({-INFINITY, 0});
+  while (!queue.empty()) {
+    const auto [w, v] = queue.top();
+    queue.pop();
+    if (settled[v]) continue;
+    settled[v] = 1;
+    for (std::uint32_t e = start[v]; e < start[v + 1]; ++e) {
+      const auto [u, spill] = adjacent[e];
+      const float l = std::max(w, spill);
+      if (l < level[u]) {
+        level[u] = l;
+        queue.push({l, u});
+      }
+    }
+  }
+  // Every valid cell is connected to a true outlet, so every label has a finite level.
+  tbb::parallel_for(tbb::blocked_range<int>(0, strips, 1), [&](const tbb::blocked_range<int>& range) {
+    for (int s = range.begin(); s < range.end(); ++s) {
+      const std::size_t i0 = std::size_t(first_row(s)) * std::size_t(cols), i1 = std::size_t(first_row(s + 1)) * std::size_t(cols);
+      for (std::size_t i = i0; i < i1; ++i) {
+        const Label l = label[i];
+        if (l != 0 && l != kVoid) z[i] = std::max(z[i], level[global(s, l)]);
+      }
+    }
+  }, tbb::simple_partitioner());
+}
+
 /// Breadth-first rings: `run(front, first, expand)` calls `expand(cell, ring, next)` for every cell
 /// of `front` (ring `first`), then of what it pushed to `next` (ring first + 1), and so on. Rings
 /// of many cells are split between threads, each pushing to its own list; the next ring is their
@@ -174,7 +427,24 @@ class Rings {
   tbb::enumerable_thread_specific<std::vector<Cell>> pushed_;
 };
 
+void fill_in_strips(Dem& z, const std::optional<double>& sea_level, int strips, Progress& progress) {
+  if (z.cols() <= 32000) fill_strips<std::uint16_t>(z, sea_level, strips, progress);  // 2 * cols + 1 labels a strip
+  else fill_strips<std::uint32_t>(z, sea_level, strips, progress);
+}
+
+/// Plain filling of DEMs of at least this many cells runs on kFillStrips strips when threads are
+/// allowed (below, the joining costs more than the second thread saves). The strip count is fixed,
+/// not taken from the thread count; the result does not depend on it anyway.
+constexpr std::size_t kStripFillCells = std::size_t(1) << 20;
+constexpr int kFillStrips = 4;
+
 }  // namespace
+
+Dem fill_depressions_in_strips(const Dem& dem, std::optional<double> sea_level, int strips, Progress& progress) {
+  Dem z = dem;
+  fill_in_strips(z, sea_level, strips, progress);
+  return z;
+}
 
 Dem fill_depressions(const Dem& dem, const FillOptions& options, Progress& progress) {
   Dem z = dem;
@@ -185,6 +455,8 @@ Dem fill_depressions(const Dem& dem, const FillOptions& options, Progress& progr
     case FillMethod::epsilon:
       if (options.method == FillMethod::epsilon)
         priority_flood<HeapQueue>(z, options.sea_level, true, true, progress, [](std::size_t, int) {});
+      else if (z.size() >= kStripFillCells && tbb::this_task_arena::max_concurrency() > 1)
+        fill_in_strips(z, options.sea_level, kFillStrips, progress);
       else
         priority_flood<RadixQueue>(z, options.sea_level, false, true, progress, [](std::size_t, int) {});
       return z;

@@ -38,8 +38,15 @@ struct FillOptions {
 ///   grid border, next to nodata, or at or below `sea_level`.
 /// @post breach: no cell is raised; the same non-increasing path exists.
 /// Deterministic: queue ties are broken by cell index. O(n log n) time; 1 byte/cell beside the output
-/// (breach: 6 bytes/cell).
+/// (breach: 6 bytes/cell). Plain filling of large DEMs runs on row strips in parallel when more
+/// than one thread is allowed (see fill_depressions_in_strips): same result, 2 bytes/cell.
 Dem fill_depressions(const Dem& dem, const FillOptions& options, Progress& progress);
+
+/// Plain Priority-Flood filling (FillMethod::priority_flood) of `strips` row strips in parallel,
+/// joined through their spillover graph (Barnes 2016); the same result as the serial flood for
+/// any strip count (clamped to 1..rows) and thread count. fill_depressions uses it on large DEMs
+/// when more than one thread is allowed. 2 bytes/cell beside the output (4 beyond 32000 columns).
+Dem fill_depressions_in_strips(const Dem& dem, std::optional<double> sea_level, int strips, Progress& progress);
 
 /// Drains flats (Barnes, Lehman, Mulla 2014, "An efficient assignment of drainage direction over
 /// flat surfaces in raster digital elevation models", Computers & Geosciences 62): every kNoFlow

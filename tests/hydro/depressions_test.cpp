@@ -4,6 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <random>
+
+#include <tbb/global_control.h>
 
 #include "core/geodesy.hpp"
 #include "hydro/depressions.hpp"
@@ -58,6 +62,34 @@ bool every_cell_drains(const Raster<std::uint8_t>& d8) {
       }
     }
   return true;
+}
+
+/// True when both DEMs hold the same bits in every cell (NaN nodata included).
+bool same_bits(const Dem& a, const Dem& b, std::size_t* first_difference) {
+  for (std::size_t i = 0; i < a.size(); ++i)
+    if (std::memcmp(&a[i], &b[i], sizeof(float)) != 0) {
+      *first_difference = i;
+      return false;
+    }
+  return true;
+}
+
+/// Smooth random terrain with integer ties: valleys and basins many rows tall, so that depressions
+/// and their spill paths cross the strip cuts; optional nodata holes.
+Dem basin_dem(int cols, int rows, std::uint64_t seed, bool holes) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> phase(0, 6.3), noise(0, 3);
+  const double a = phase(rng), b = phase(rng);
+  std::vector<float> v(std::size_t(cols) * std::size_t(rows));
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c)
+      v[std::size_t(r) * std::size_t(cols) + std::size_t(c)] =
+          std::floor(float(20 + 8 * std::sin(c / 3.0 + a) * std::cos(r / 4.0 + b) + noise(rng)));
+  if (holes) {
+    std::uniform_int_distribution<int> pick(0, int(v.size()) - 1);
+    for (int h = 0; h < int(v.size()) / 40; ++h) v[std::size_t(pick(rng))] = NAN;
+  }
+  return grid(cols, rows, std::move(v), 30.0);
 }
 
 }  // namespace
@@ -153,4 +185,51 @@ TEST(Depressions, FlatDrainsTowardsLowerAndAwayFromHigher) {
   EXPECT_EQ(d8(5, 2), 0);  // the low edge flows east, steepest
   for (int c = 1; c <= 4; ++c) EXPECT_EQ(dcol[d8(c, 2)], 1) << c;  // towards the outlet
   EXPECT_EQ(drow[d8(1, 1)], 1);  // next to the north wall: away from it (south-east)
+}
+
+TEST(Depressions, StripFillEqualsSerialFill) {
+  // The parallel plain fill (strips joined through their spillover graph) against the serial flood
+  // and the slow fixed point: nodata holes, sea-level outlets, depressions across the cuts, grids
+  // with fewer rows than strips, 1 and 2 threads.
+  SilentProgress p;
+  for (int threads : {1, 2}) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
+    for (std::uint64_t seed = 1; seed <= 120; ++seed) {
+      std::mt19937_64 rng(seed * 7919);
+      const int cols = 1 + int(rng() % 30), rows = 1 + int(rng() % 40);
+      const bool holes = seed % 3 != 0;
+      const Dem dem = seed % 2 == 0 ? random_dem(cols, rows, seed, holes) : basin_dem(cols, rows, seed, holes);
+      for (std::optional<double> sea : {std::optional<double>(), std::optional<double>(seed % 2 == 0 ? 2.0 : 17.0)}) {
+        const Dem serial = fill_depressions(dem, {FillMethod::priority_flood, sea}, p);
+        const Dem slow = slow_fill(dem, sea);
+        std::size_t i = 0;
+        ASSERT_TRUE(same_bits(serial, slow, &i)) << "seed " << seed << " cell " << i;
+        for (int strips : {1, 2, 3, 4, 7, 64}) {
+          const Dem strip = fill_depressions_in_strips(dem, sea, strips, p);
+          ASSERT_TRUE(same_bits(strip, serial, &i))
+              << "seed " << seed << " " << cols << "x" << rows << " strips " << strips << " threads " << threads
+              << " sea " << sea.has_value() << " cell " << i << ": " << strip[i] << " != " << serial[i];
+        }
+      }
+    }
+  }
+}
+
+TEST(Depressions, LargeDemFillIsTheSameWithOneAndTwoThreads) {
+  // Above the size where fill_depressions switches to strips when two threads are allowed.
+  const Dem dem = basin_dem(1100, 1000, 99, true);
+  SilentProgress p;
+  for (std::optional<double> sea : {std::optional<double>(), std::optional<double>(18.0)}) {
+    Dem one, two;
+    {
+      tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+      one = fill_depressions(dem, {FillMethod::priority_flood, sea}, p);
+    }
+    {
+      tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
+      two = fill_depressions(dem, {FillMethod::priority_flood, sea}, p);
+    }
+    std::size_t i = 0;
+    EXPECT_TRUE(same_bits(one, two, &i)) << "cell " << i;
+  }
 }
