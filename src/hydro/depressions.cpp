@@ -515,6 +515,10 @@ void drain_flats(const Dem& filled, Raster<std::uint8_t>& d8) {
             v == kNoData || v == kTerminal ? kOut : v == kNoFlow ? kFlat : kDrains;
       }
   });
+  auto unpadded = [&](std::size_t p) {
+    const std::size_t r = p / width - 1;
+    return r * std::size_t(cols) + (p - (r + 1) * width - 1);
+  };
   // Edges (Barnes 2014b, Algorithm 3): a low edge drains and has a same-elevation undrained
   // neighbour; a high edge is undrained with a higher neighbour.
   std::vector<std::vector<std::uint32_t>> band_low(static_cast<std::size_t>(bands)),
@@ -554,73 +558,13 @@ void drain_flats(const Dem& filled, Raster<std::uint8_t>& d8) {
       if (v == kNoFlow) v = kTerminal;
     return;
   }
-  // Label each flat that has a low edge (a flat: 8-connected cells of equal elevation, undrained or
-  // draining): +label on undrained cells, -label on draining ones, 0 elsewhere, so that a wave step
-  // tests membership with one comparison.
+  // Label each flat from its low edges (8-connected cells of equal elevation): +label on undrained
+  // cells, -label on draining ones, so that a wave step tests membership with one comparison.
   struct Slot {
     std::int32_t label;
     std::int32_t mask;
   };
   BigVector<Slot> cell(padded, Slot{0, 0});
-  // Connected components in raster scans with union-find (the partition is that of a flood from
-  // each low edge, at a fraction of the cost: the scans read memory in order). During the scans
-  // the label field holds the parent's padded index; a root is always the smallest index of its
-  // tree, so one ascending pass points every cell at its root.
-  auto parent = [&](std::size_t p) -> std::int32_t& { return cell[p].label; };
-  auto root = [&](std::size_t p) {
-    while (std::size_t(parent(p)) != p) {
-      parent(p) = parent(std::size_t(parent(p)));  // path halving
-      p = std::size_t(parent(p));
-    }
-    return p;
-  };
-  // Unions with the earlier neighbours (west, north-west, north, north-east), band by band in
-  // parallel (a band's trees stay inside it), then across the bands' first rows.
-  auto unite = [&](int c, int r, std::size_t p, std::size_t a, const int* ks, int n) {
-    const float zc = filled(c, r);
-    for (int i = 0; i < n; ++i) {
-      const int k = ks[i];
-      const std::size_t pn = std::size_t(std::ptrdiff_t(p) + poff[k]);
-      if ((kind[pn] & 3) == kOut || filled(c + dcol[k], r + drow[k]) != zc) continue;
-      const std::size_t b = root(pn);
-      if (b == a) continue;
-      parent(std::max(a, b)) = std::int32_t(std::min(a, b));
-      a = std::min(a, b);
-    }
-  };
-  constexpr int kEarlier[4] = {4, 5, 6, 7}, kAbove[3] = {5, 6, 7};
-  for_bands([&](int, int r0, int r1) {
-    for (int r = r0; r < r1; ++r)
-      for (int c = 0; c < cols; ++c) {
-        const std::size_t p = std::size_t(r + 1) * width + std::size_t(c) + 1;
-        if ((kind[p] & 3) == kOut) continue;
-        parent(p) = std::int32_t(p);
-        unite(c, r, p, p, kEarlier, r == r0 ? 1 : 4);  // west only on the band's first row
-      }
-  });
-  for (int b = 1; b < bands; ++b) {
-    const int r = int(std::int64_t(rows) * b / bands);
-    for (int c = 0; c < cols; ++c) {
-      const std::size_t p = std::size_t(r + 1) * width + std::size_t(c) + 1;
-      if ((kind[p] & 3) != kOut) unite(c, r, p, root(p), kAbove, 3);
-    }
-  }
-  for (std::size_t p = 0; p < padded; ++p)
-    if ((kind[p] & 3) != kOut) parent(p) = parent(std::size_t(parent(p)));
-  for (std::uint32_t seed : low) cell[std::size_t(parent(seed))].mask = -1;  // the flat can drain
-  std::int32_t next_label = 1;
-  std::vector<std::uint32_t> roots;
-  for (std::size_t p = 0; p < padded; ++p) {
-    if ((kind[p] & 3) == kOut) continue;
-    const std::size_t r = std::size_t(parent(p));
-    if (r == p) {  // first cell of its flat in scan order: the root, its label kept in its mask
-      cell[p].mask = cell[p].mask == -1 ? next_label++ : 0;
-      roots.push_back(std::uint32_t(p));
-    }
-    const std::int32_t label = cell[r].mask;
-    cell[p].label = (kind[p] & 3) == kFlat ? label : -label;
-  }
-  for (std::uint32_t p : roots) cell[p].mask = 0;
   // The waves are run ring by ring, the large rings (the sea, a lake) split between threads. What
   // a wave writes in a cell depends only on its ring and on what earlier waves wrote, never on the
   // order of the cells in a ring, so two threads reaching one cell write the same values: the
@@ -628,6 +572,31 @@ void drain_flats(const Dem& filled, Raster<std::uint8_t>& d8) {
   // costs a little work and changes nothing.
   auto load = [](std::int32_t& v) { return std::atomic_ref<std::int32_t>(v).load(std::memory_order_relaxed); };
   auto store = [](std::int32_t& v, std::int32_t x) { std::atomic_ref<std::int32_t>(v).store(x, std::memory_order_relaxed); };
+  std::int32_t next_label = 1;
+  std::vector<std::uint64_t> front;  // padded index << 32 | unpadded index
+  Rings<std::uint64_t> label_rings;
+  for (std::uint32_t seed : low) {
+    if (cell[seed].label != 0) continue;
+    const std::size_t useed = unpadded(seed);
+    const float zf = filled[useed];
+    const std::int32_t label = next_label++;
+    cell[seed].label = -label;
+    front.assign(1, std::uint64_t(seed) << 32 | useed);
+    // Breadth first: rings stay compact in memory, where a depth-first flood wanders across rows.
+    // The partition into flats is the same either way.
+    label_rings.run(front, 1, [&](std::uint64_t top, std::int32_t, std::vector<std::uint64_t>& next) {
+      const std::size_t p = std::size_t(top >> 32), u = std::size_t(top & 0xffffffffu);
+      for (int k = 0; k < 8; ++k) {
+        const std::size_t pn = std::size_t(std::ptrdiff_t(p) + poff[k]);
+        const std::uint8_t kn = kind[pn] & 3;
+        if (kn == kOut || load(cell[pn].label) != 0) continue;
+        const std::size_t un = std::size_t(std::ptrdiff_t(u) + uoff[k]);
+        if (filled[un] != zf) continue;
+        store(cell[pn].label, kn == kFlat ? label : -label);
+        next.push_back(std::uint64_t(pn) << 32 | un);
+      }
+    });
+  }
   std::vector<std::int32_t> flat_height(std::size_t(next_label), 0);
   // Breadth-first wave over undrained cells of the same flat, one ring per loop. A cell is
   // marked (mask > 0 after `set`) when it is first reached.
