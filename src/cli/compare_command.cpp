@@ -6,6 +6,7 @@
 
 #include "cli/command.hpp"
 #include "cli/commands_list.hpp"
+#include "io/text_io.hpp"
 #include "pipeline/compare.hpp"
 
 namespace terrapolis::cli {
@@ -19,16 +20,20 @@ class CompareCommand final : public Command {
     app.add_option("RUN_A", a_, "First run folder (holds run.json)")->required();
     app.add_option("RUN_B", b_, "Second run folder")->required();
     app.add_flag("--json", json_, "Machine-readable output");
+    app.add_option("--save", save_, "Also write the comparison to this file (text, or JSON with --json)");
+    app.add_flag("--overwrite", overwrite_, "Replace the --save file if it exists");
   }
   void run(Context&) override {
     const auto c = pipeline::compare_runs(pipeline::load_manifest(a_), pipeline::load_manifest(b_));
-    if (json_) std::printf("%s\n", c.dump(2).c_str());
-    else std::printf("A: %s\nB: %s\n\n%s", a_.c_str(), b_.c_str(), pipeline::format_comparison(c).c_str());
+    const std::string text =
+        json_ ? c.dump(2) + "\n" : "A: " + a_ + "\nB: " + b_ + "\n\n" + pipeline::format_comparison(c);
+    if (!save_.empty()) write_text_file(save_, text, overwrite_);
+    std::fputs(text.c_str(), stdout);
   }
 
  private:
-  std::string a_, b_;
-  bool json_ = false;
+  std::string a_, b_, save_;
+  bool json_ = false, overwrite_ = false;
 };
 
 }  // namespace

@@ -90,4 +90,10 @@ cp -r run1 run3
 grep -Eq "outputs.preview_width +400 +500" cmp.txt || fail "compare does not show the changed parameter: $(cat cmp.txt)"
 "$TP" compare --json run1 run1 | /usr/bin/python3 -c "import json,sys; c=json.load(sys.stdin); assert c['parameters']==[], c" || fail "compare of a run with itself"
 expect_fail 2 "nowhere: not a run folder" "$TP" compare run1 nowhere
+# --save: the same text in a file, written whole; an existing file is refused without --overwrite.
+"$TP" compare run1 run3 --save saved.txt > shown.txt
+cmp -s saved.txt shown.txt || fail "compare --save wrote something else than it printed"
+expect_fail 2 "saved.txt: output exists" "$TP" compare run1 run3 --save saved.txt
+"$TP" compare --json run1 run3 --save saved.txt --overwrite > /dev/null
+/usr/bin/python3 -c "import json; json.load(open('saved.txt'))" || fail "compare --json --save did not write JSON"
 echo "compare: ok"

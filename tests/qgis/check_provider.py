@@ -27,7 +27,7 @@ from terrapolis_provider.provider import TerrapolisProvider  # noqa: E402
 provider = TerrapolisProvider()
 assert QgsApplication.processingRegistry().addProvider(provider), "the provider does not register"
 ids = sorted(a.id() for a in provider.algorithms())
-for name in ("info", "hydro", "density", "sites", "network", "path", "roads", "fill", "generate", "run"):
+for name in ("info", "hydro", "density", "sites", "network", "path", "roads", "fill", "generate", "run", "compare"):
     assert "terrapolis:" + name in ids, (name, ids)
 
 # Typed parameters, straight from --describe-json.
@@ -87,6 +87,12 @@ assert any(p.endswith("roads.geojson") for p in run_layers) and any(p.endswith("
 assert os.path.exists(os.path.join(run_dir, "project.qgs")), "no project.qgs in the run folder"
 for path_ in run_layers:
     assert load_layer(path_).isValid(), path_
+# compare: the run against itself, the table shown in the log and saved to a file.
+report = os.path.join(work, "compare.txt")
+result = processing.run("terrapolis:compare", {"RUN_A": run_dir, "RUN_B": run_dir, "save": report}, feedback=Recorder())
+assert result["save"] == report, result
+with open(report) as f:
+    assert "Parameters that differ:\n  (none)" in f.read(), open(report).read()
 
 # Cancel: the process is killed, the algorithm fails, nothing is written.
 cancelled_dir = os.path.join(work, "cancelled")

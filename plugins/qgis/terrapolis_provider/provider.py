@@ -5,9 +5,6 @@ from qgis.core import QgsMessageLog, QgsProcessingProvider, Qgis
 from . import cli
 from .algorithm import TerrapolisAlgorithm
 
-# Commands whose result a Processing dialog cannot show (a comparison printed as a table).
-SKIPPED = {"compare"}
-
 
 class TerrapolisProvider(QgsProcessingProvider):
     def __init__(self):
@@ -31,5 +28,4 @@ class TerrapolisProvider(QgsProcessingProvider):
             QgsMessageLog.logMessage("Terrapolis: %s" % e, "Processing", Qgis.Warning)
             return
         for command in self._description["commands"]:
-            if command["name"] not in SKIPPED:
-                self.addAlgorithm(TerrapolisAlgorithm(command, self._description["global_options"]))
+            self.addAlgorithm(TerrapolisAlgorithm(command, self._description["global_options"]))
