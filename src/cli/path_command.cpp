@@ -74,10 +74,12 @@ class PathCommand final : public Command {
     if (!sections_.empty()) write_vector(sections_, sections, options_.overwrite);
     options_.write_earthworks(levelled);
     const auto& s = road->stats;
+    char cost[64] = "none (it breaks a threshold of the cost model)";  // Bézier roads may
+    if (road->cost) std::snprintf(cost, sizeof cost, "%.1f", *road->cost);
     char line[512];
     std::snprintf(line, sizeof line,
-                  "%s: %.0f m, cost %.1f, max grade %.1f %%, mean grade %.1f %%, bridges %.0f m, tunnels %.0f m; %zu nodes expanded, %zu rings of long arcs priced, %zu stored, %.2f s",
-                  road->router.c_str(), s.length_m, road->cost.value_or(NAN), s.max_grade_pct, s.mean_grade_pct, s.bridge_m, s.tunnel_m,
+                  "%s: %.0f m, cost %s, max grade %.1f %%, mean grade %.1f %%, bridges %.0f m, tunnels %.0f m; %zu nodes expanded, %zu rings of long arcs priced, %zu stored, %.2f s",
+                  road->router.c_str(), s.length_m, cost, s.max_grade_pct, s.mean_grade_pct, s.bridge_m, s.tunnel_m,
                   road->expanded, road->rings_priced, road->nodes, seconds);
     context.log.info(line);
     const auto& g = road->geometry;

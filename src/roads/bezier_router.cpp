@@ -11,6 +11,8 @@
 namespace terrapolis::roads {
 namespace {
 
+constexpr double kForbiddenCost = 10;  // a position on a cell a cost layer forbids (see discretise)
+
 struct Control {
   GridPoint p;
   double t;  ///< parameter of the curve position the control point was drawn at (ends 0 and 1)
@@ -74,6 +76,11 @@ class Evaluator {
         const double s = std::min(1.0, std::fabs(terrain_.surface(c, r) - terrain_.surface(pc, pr)) / l / tan_max_);
         const double a = (terrain_.surface(c, r) - zmin_) / (zmax_ - zmin_);
         cost = std::sqrt((s + o_.altitude_weight * a) / (1 + o_.altitude_weight));
+        // Cost layers (plugins), beyond the thesis: e per metre against the flat road's 1 per metre
+        // is a share e / (1 + e) of the worst position; a forbidden cell (e infinite) weighs as ten
+        // worst positions, so that refinement works on it first and leaving it always pays.
+        const double e = terrain_.extra_cost_at(Structure::road, c, r);
+        if (e > 0) cost = std::isinf(e) ? kForbiddenCost : std::max(cost, e / (1 + e));
       }
       d.cost[i] = cost;
       d.total += cost;

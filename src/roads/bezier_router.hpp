@@ -31,7 +31,8 @@ struct BezierResult {
 /// Refines a Bézier curve from `from` to `to` (Belhadj 2007, Algorithm 16): discretise it on the
 /// grid (De Casteljau), cost each position from the slope from the previous position and its
 /// altitude, each rescaled to [0,1] (|slope| / tan(max_slope), (z - zmin) / (zmax - zmin); water
-/// costs 1), mixed by `altitude_weight` and filtered by sqrt; take the worst position, draw a control
+/// costs 1), mixed by `altitude_weight` and filtered by sqrt (cost layers of plugins: at least
+/// e / (1 + e) for e per metre; 10 on a forbidden cell); take the worst position, draw a control
 /// point along the curve's normal there (normal law, deviation sigma_fraction x length), insert it
 /// at that position's parameter and keep the curve if its total cost drops; else retry (`tries`),
 /// then the next worst position. Deterministic for a seed (own Box-Muller on mt19937_64).

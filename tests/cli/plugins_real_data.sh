@@ -46,6 +46,8 @@ cat > protected.geojson <<'JSON'
 JSON
 PROTECT='{"vector":"protected.geojson","density":{"exclude_within_m":0},"road":{"forbidden_within_m":0,"structures":["road","bridge","tunnel"]}}'
 "$TP" -q path "$DEM" --from 9.30,42.68 --to 9.42,42.70 skirt.geojson --plugin "distance:$PROTECT"
+"$TP" -q path "$DEM" --from 9.30,42.68 --to 9.42,42.70 bezier_free.geojson --router bezier
+"$TP" -q path "$DEM" --from 9.30,42.68 --to 9.42,42.70 bezier_skirt.geojson --router bezier --plugin "distance:$PROTECT"
 "$TP" -q density "$DEM" protected --hydrometry hydro/hydrometry.tif --plugin "distance:$PROTECT"
 $PY - <<'PY' || fail "protected area"
 from osgeo import gdal, ogr
@@ -56,6 +58,8 @@ def line(path):  # the first geometry of a file (the dataset must outlive the fe
 reserve = line("protected.geojson")
 assert line("free.geojson").Intersects(reserve), "the free road should cross the reserve (test set-up)"
 assert not line("skirt.geojson").Intersects(reserve), "the road enters the protected area"
+assert line("bezier_free.geojson").Intersects(reserve), "the free Bezier road should cross the reserve (test set-up)"
+assert not line("bezier_skirt.geojson").Intersects(reserve), "the Bezier road enters the protected area"
 b = gdal.Open("protected/buildable.tif"); gt = b.GetGeoTransform(); a = b.ReadAsArray()
 col, row = int((9.37 - gt[0]) / gt[1]), int((42.69 - gt[3]) / gt[5])
 assert a[row, col] == 0, "a cell inside the reserve is buildable"

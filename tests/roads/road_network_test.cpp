@@ -106,6 +106,32 @@ TEST(RoadNetwork, ClassFromTheMeanRankOfTheEndCities) {
   EXPECT_EQ(r.roads[1].road_class, "departmental");  // classes 1 and 3: mean 2
 }
 
+TEST(BezierRouter, RefinementLeavesCellsACostLayerForbids) {
+  // A flat plain with a forbidden block (a protected area, kappa = +infinity) across the straight
+  // line: every straight position in it costs 10; refined, the curve leaves the block.
+  const Dem dem = test::make_dem(50, 50, 30.0, [](int, int) { return 100.0; });
+  TerrainField terrain(dem, 0.0, 10.0, 0.0);
+  Raster<float> kappa = dem.like<float>(0.0f);
+  for (int r = 20; r <= 30; ++r)
+    for (int c = 22; c <= 28; ++c) kappa(c, r) = std::numeric_limits<float>::infinity();
+  terrain.add_cost_layer("reserve", kappa, {TransferFunction{}, TransferFunction{}, TransferFunction{}}, {true, false, false});
+  auto inside = [&](const BezierResult& b) {
+    int n = 0;
+    for (const GridPoint& p : b.polyline) n += std::isinf(kappa(int(p.col), int(p.row)));
+    return n;
+  };
+  BezierOptions o;
+  o.seed = 3;
+  o.max_evaluations = 1;
+  const BezierResult straight = bezier_route(terrain, {5, 25}, {45, 25}, o);
+  EXPECT_EQ(inside(straight), 7);
+  EXPECT_DOUBLE_EQ(straight.worst, 10.0);
+  o.max_evaluations = 1000;
+  const BezierResult refined = bezier_route(terrain, {5, 25}, {45, 25}, o);
+  EXPECT_EQ(inside(refined), 0);
+  EXPECT_LE(refined.worst, 1.0);
+}
+
 TEST(BezierRouter, DeterministicAndNeverWorseThanTheStraightCurve) {
   const Dem dem = test::make_dem(50, 50, 30.0, [](int c, int r) {
     return 100 + 400 * std::exp(-((c - 25) * (c - 25) + (r - 25) * (r - 25)) / 60.0);  // a hill on the way
