@@ -154,8 +154,8 @@ class HydroCommand final : public Command {
         written.push_back((fs::path(out_dir_) / names[i]).string());
         return written.back();
       };
-      // The files are written concurrently: GDAL compresses each on one thread, and on 13 M-cell
-      // tiles writing was a fifth of the command's time.
+      // The files are written concurrently (on 13 M-cell tiles writing was a fifth of the command's
+      // time, and one file's compression does not keep two threads busy).
       std::vector<std::function<void()>> writes;
       if (wanted[0])
         writes.push_back([&, p = path(0)] {
