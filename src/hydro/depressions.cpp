@@ -91,6 +91,16 @@ class RadixQueue {
   std::size_t size_ = 0;
 };
 
+/// The next cell to flood: the depression queue first (cells raised to the current spill), then
+/// the lowest of the priority queue.
+template <class Queue>
+std::uint32_t next_cell(Queue& open, std::deque<std::uint32_t>& pit) {
+  if (pit.empty()) return std::uint32_t(open.pop());
+  const std::uint32_t i = pit.front();
+  pit.pop_front();
+  return i;
+}
+
 /// The Priority-Flood of Barnes et al. 2014, Algorithm 2 (with its plain queue for cells inside
 /// depressions) or 3 (epsilon). `visit(cell, parent_direction)` is told the neighbour index k from
 /// which each non-seed cell was flooded, in flood order (used by breaching).
@@ -118,13 +128,7 @@ void priority_flood(Dem& z, const std::optional<double>& sea_level, bool epsilon
   std::size_t done = 0;
   const std::size_t report = std::max<std::size_t>(z.size() / 50, 1);
   while (!open.empty() || !pit.empty()) {
-    std::uint32_t i;
-    if (!pit.empty()) {
-      i = pit.front();
-      pit.pop_front();
-    } else {
-      i = std::uint32_t(open.pop());
-    }
+    const std::uint32_t i = next_cell(open, pit);
     if (++done % report == 0) step.update(double(done) / double(z.size()));
     const int c = int(i % std::uint32_t(cols)), r = int(i / std::uint32_t(cols));
     const float zc = z[i];
@@ -274,13 +278,7 @@ void fill_strips(Dem& z, const std::optional<double>& sea_level, int strips, Pro
       SpillEdges& spill = edges[std::size_t(s)];
       std::size_t local = 0;
       while (!open.empty() || !pit.empty()) {
-        std::uint32_t i;
-        if (!pit.empty()) {
-          i = pit.front();
-          pit.pop_front();
-        } else {
-          i = std::uint32_t(open.pop());
-        }
+        const std::uint32_t i = next_cell(open, pit);
         if (++local == 4096) {
           if ((done += local) / report != (done - local) / report) {
             std::unique_lock lock(progress_mutex, std::try_to_lock);
