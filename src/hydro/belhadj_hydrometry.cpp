@@ -29,11 +29,13 @@ BelhadjModel::BelhadjModel(const Dem& dem, const CellMetrics& metrics, VerticalS
     }
   if (!(lo <= hi)) throw bad_input("hydrometry: the DEM has no land cell (all nodata or below sea level)");
   z_out_ = vertical == VerticalScale::normalised16 ? -1.0 : lo - std::max(hi - lo, 1.0);
-  block_.assign(11 * padded, 0.0);  // F = 0, Q = 0, Acc = 0, valid = 0 everywhere to begin with
-  double* arrays[11];
-  for (std::size_t a = 0; a < 11; ++a) arrays[a] = block_.data() + a * padded;
-  z_ = arrays[0], valid_ = arrays[1], fx_ = arrays[2], fy_ = arrays[3], fz_ = arrays[4], q_ = arrays[5];
-  acc_ = arrays[6], fx2_ = arrays[7], fy2_ = arrays[8], fz2_ = arrays[9], q2_ = arrays[10];
+  if (vertical == VerticalScale::normalised16 && lo / 65535.0 <= z_out_)  // valid cells must lie above it
+    throw bad_input("hydrometry: elevations at or below -65535 m do not fit the 16-bit normalisation");
+  block_.assign(10 * padded, 0.0);  // F = 0, Q = 0, Acc = 0 everywhere to begin with
+  double* arrays[10];
+  for (std::size_t a = 0; a < 10; ++a) arrays[a] = block_.data() + a * padded;
+  z_ = arrays[0], fx_ = arrays[1], fy_ = arrays[2], fz_ = arrays[3], q_ = arrays[4];
+  acc_ = arrays[5], fx2_ = arrays[6], fy2_ = arrays[7], fz2_ = arrays[8], q2_ = arrays[9];
   std::fill(z_, z_ + padded, z_out_);
   for (int r = 0; r < rows_; ++r)
     for (int c = 0; c < cols_; ++c) {
@@ -43,7 +45,6 @@ BelhadjModel::BelhadjModel(const Dem& dem, const CellMetrics& metrics, VerticalS
       if (vertical == VerticalScale::normalised16) z = double(v) / 65535.0;  // 16-bit metres / (2^16-1)
       const std::size_t i = at(c, r);
       z_[i] = z;
-      valid_[i] = 1.0;
       fz_[i] = -1.0;
       q_[i] = 1.0;
       ++valid_count_;
@@ -83,7 +84,7 @@ namespace {
 
 struct State {
   const double* __restrict z;
-  const double* __restrict valid;
+  double zout;  // the outside altitude: a cell is valid when its altitude is above it
   const double* __restrict fx;
   const double* __restrict fy;
   const double* __restrict fz;
@@ -110,12 +111,12 @@ struct SenderRow {
 };
 
 /// Pass 1 (sender row of `n` cells at padded index i0): N_k, Σn, the factor Q / Σn, Acc += Q.
-/// Outside cells (valid 0) send nothing. `own`: the row is the caller's (not a neighbour band's
+/// Outside cells (altitude zout) send nothing. `own`: the row is the caller's (not a neighbour band's
 /// edge row computed again), so Acc is updated. Returns Σ Q over the row (column order).
 TP_KERNEL double send_row(const State& st, std::size_t i0, int n, const std::ptrdiff_t* off, const double* hx,
                           const double* hy, bool all, bool own, double* const* norms, double* __restrict factor) {
   const double* __restrict z = st.z + i0;
-  const double* __restrict valid = st.valid + i0;
+  const double zout = st.zout;
   const double* __restrict fx = st.fx + i0;
   const double* __restrict fy = st.fy + i0;
   const double* __restrict fz = st.fz + i0;
@@ -125,7 +126,6 @@ TP_KERNEL double send_row(const State& st, std::size_t i0, int n, const std::ptr
   for (int c = 0; c < n; ++c) factor[c] = 0.0;  // Σn, in neighbour order
   for (int k = 0; k < 8; ++k) {
     const double* __restrict zn = z + off[k];
-    const double* __restrict vn = valid + off[k];
     double* __restrict nk = norms[k];
     const double vx = hx[k], vy = hy[k];
     for (int c = 0; c < n; ++c) {
@@ -133,8 +133,8 @@ TP_KERNEL double send_row(const State& st, std::size_t i0, int n, const std::ptr
       const double rx = fx[c] + vx, ry = fy[c] + vy, rz = fz[c] + dz;
       const double s = rx * vx + ry * vy + rz * dz;
       const double norm = std::sqrt(rx * rx + ry * ry + rz * rz);
-      // Both validities loaded unconditionally so the loop has no branch.
-      nk[c] = s > 0 ? vn[c] * valid[c] * norm : 0.0;
+      // Valid cells lie above the outside altitude; both tests are selects, not branches.
+      nk[c] = s > 0 && zn[c] > zout && z[c] > zout ? norm : 0.0;
       factor[c] += s > 0 ? norm : keep * norm;
     }
   }
@@ -195,7 +195,7 @@ double BelhadjModel::step() {
   std::ptrdiff_t off[8];
   for (int k = 0; k < 8; ++k) off[k] = std::ptrdiff_t(drow[k]) * stride_ + dcol[k];
   const bool all = share_ == BelhadjShare::all_neighbours;
-  const State st{z_, valid_, fx_, fy_, fz_, q_, acc_, fx2_, fy2_, fz2_, q2_};
+  const State st{z_, z_out_, fx_, fy_, fz_, q_, acc_, fx2_, fy2_, fz2_, q2_};
   // Bands of rows, each computing what its rows and the rows just outside it send (the edge rows
   // are computed twice), then gathering row by row. Every value is a function of the previous
   // state alone, summed in a fixed order: bit-identical whatever the bands and threads.

@@ -67,7 +67,7 @@ class BelhadjModel {
     const std::size_t i = std::size_t(row + 1) * 8 + std::size_t(k);
     return {hx_[i], hy_[i]};
   }
-  bool valid(int col, int row) const { return valid_[at(col, row)] != 0; }
+  bool valid(int col, int row) const { return z_[at(col, row)] > z_out_; }
 
  private:
   std::size_t at(int col, int row) const { return std::size_t(row + 1) * std::size_t(stride_) + std::size_t(col + 1); }
@@ -75,10 +75,10 @@ class BelhadjModel {
   BelhadjShare share_;
   std::size_t valid_count_ = 0;
   double z_out_ = -1;
-  // The eleven padded per-cell arrays share one block: one allocation, a few huge pages instead of
+  // The ten padded per-cell arrays share one block: one allocation, a few huge pages instead of
   // thousands of page faults (on the thesis's 256 x 256 case, setting up cost as much as 10 steps).
   BigVector<double> block_;
-  double *z_, *valid_;                 // padded altitude, 1 on valid cells
+  double* z_;                          // padded altitude, z_out_ outside
   double *fx_, *fy_, *fz_, *q_, *acc_;  // current state
   double *fx2_, *fy2_, *fz2_, *q2_;     // next state
   std::vector<double> hx_, hy_;        // per padded row, 8 horizontal steps (east, south)
