@@ -13,7 +13,6 @@
 #include <functional>
 #include <limits>
 #include <mutex>
-#include <new>
 #include <queue>
 #include <vector>
 
@@ -23,10 +22,6 @@
 #include <tbb/task_arena.h>
 
 #include "hydro/grid.hpp"
-
-#if defined(__linux__)
-#include <sys/mman.h>
-#endif
 
 namespace terrapolis::hydro {
 namespace {
@@ -204,35 +199,10 @@ void fill_strips(Dem& z, const std::optional<double>& sea_level, int strips, Pro
   const int cols = z.cols(), rows = z.rows();
   strips = std::clamp(strips, 1, std::max(rows, 1));
   auto first_row = [&](int s) { return int(std::int64_t(rows) * s / strips); };
-  // The labels, one per cell, left uninitialised (each strip writes its own rows). Mapped apart
-  // from the heap so that their pages go back to the system when the fill ends, whatever the
-  // allocator's thresholds: the later steps of `hydro` need more memory than this one.
-  struct Buffer {
-    explicit Buffer(std::size_t n) : bytes(std::max<std::size_t>(n, 1) * sizeof(Label)) {
-#if defined(__linux__)
-      void* p = mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-      if (p == MAP_FAILED) throw std::bad_alloc();
-#if defined(MADV_HUGEPAGE)
-      madvise(p, bytes, MADV_HUGEPAGE);
-#endif
-      data = static_cast<Label*>(p);
-#else
-      data = new Label[std::max<std::size_t>(n, 1)];
-#endif
-    }
-    ~Buffer() {
-#if defined(__linux__)
-      munmap(data, bytes);
-#else
-      delete[] data;
-#endif
-    }
-    Buffer(const Buffer&) = delete;
-    Buffer& operator=(const Buffer&) = delete;
-    std::size_t bytes;
-    Label* data;
-  } buffer(z.size());
-  Label* const label = buffer.data;
+  // The labels, one per cell (each strip writes its own rows), on pages that go back to the
+  // system when the fill ends: the later steps of `hydro` need more memory than this one.
+  BigVector<Label> labels(z.size());
+  Label* const label = labels.data();
   std::vector<SpillEdges> edges(static_cast<std::size_t>(strips));
   std::vector<std::uint32_t> labels_used(static_cast<std::size_t>(strips), 1);
   ProgressStep step(progress, "fill");

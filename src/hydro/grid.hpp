@@ -35,8 +35,10 @@ inline bool touches_outside(const Dem& dem, int col, int row) {
 }
 
 /// Allocator for the large per-cell scratch arrays of the kernels: blocks of 4 MiB or more are
-/// 2 MiB-aligned and marked for transparent huge pages (Linux madvise; a hint, ignored elsewhere
-/// or when disabled), which spares the TLB misses of breadth-first waves that touch every row.
+/// mapped on their own (Linux mmap), 2 MiB-aligned and marked for transparent huge pages (a hint,
+/// ignored when disabled), which spares the TLB misses of breadth-first waves that touch every
+/// row; and, not taken from the heap, their pages go back to the system as soon as they are freed,
+/// whatever malloc's thresholds, for the steps that follow. Elsewhere: aligned_alloc.
 template <class T>
 struct HugePageAllocator {
   using value_type = T;
@@ -48,19 +50,39 @@ struct HugePageAllocator {
   T* allocate(std::size_t n) {
     const std::size_t bytes = n * sizeof(T);
     if (bytes < kMinimum) return std::allocator<T>{}.allocate(n);
-    void* p = std::aligned_alloc(kHuge, (bytes + kHuge - 1) / kHuge * kHuge);
-    if (!p) throw std::bad_alloc();
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
-    madvise(p, (bytes + kHuge - 1) / kHuge * kHuge, MADV_HUGEPAGE);
+    const std::size_t size = rounded(bytes);
+#if defined(__linux__)
+    // Map one huge page more than needed, then unmap the unaligned head and the tail.
+    void* p = mmap(nullptr, size + kHuge, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (p == MAP_FAILED) throw std::bad_alloc();
+    const std::uintptr_t base = reinterpret_cast<std::uintptr_t>(p), start = (base + kHuge - 1) / kHuge * kHuge;
+    if (start > base) munmap(p, start - base);
+    if (const std::size_t tail = base + size + kHuge - (start + size); tail > 0)
+      munmap(reinterpret_cast<void*>(start + size), tail);
+#if defined(MADV_HUGEPAGE)
+    madvise(reinterpret_cast<void*>(start), size, MADV_HUGEPAGE);
 #endif
+    return reinterpret_cast<T*>(start);
+#else
+    void* p = std::aligned_alloc(kHuge, size);
+    if (!p) throw std::bad_alloc();
     return static_cast<T*>(p);
+#endif
   }
   void deallocate(T* p, std::size_t n) {
-    if (n * sizeof(T) < kMinimum) std::allocator<T>{}.deallocate(p, n);
-    else std::free(p);
+    const std::size_t bytes = n * sizeof(T);
+    if (bytes < kMinimum) return std::allocator<T>{}.deallocate(p, n);
+#if defined(__linux__)
+    munmap(p, rounded(bytes));
+#else
+    std::free(p);
+#endif
   }
   template <class U>
   bool operator==(const HugePageAllocator<U>&) const { return true; }
+
+ private:
+  static std::size_t rounded(std::size_t bytes) { return (bytes + kHuge - 1) / kHuge * kHuge; }
 };
 
 /// A per-cell scratch array (see HugePageAllocator).
