@@ -2,6 +2,7 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 #include <array>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -32,6 +33,11 @@ class Command {
 
 /// Every command, in the order `terrapolis --help` lists them (the one registration point).
 std::vector<std::unique_ptr<Command>> all_commands();
+
+/// Runs a command's output writes concurrently, on the threads --threads allows: GDAL compresses
+/// each file on few threads, and on large grids writing is a good part of a command's time. Each
+/// write is atomic by itself (temporary file, then rename); the first failure is rethrown.
+void write_concurrently(const std::vector<std::function<void()>>& writes);
 
 /// Parses "X,Y" (either may be negative) into two numbers. Throws bad_input naming `option`.
 std::array<double, 2> parse_pair(const std::string& option, const std::string& text);

@@ -1,7 +1,6 @@
 // `terrapolis density DEM OUTDIR`: the population density model (Belhadj 2007, §4.2) and its rasters.
 // SPDX-License-Identifier: MIT
 #include <CLI/CLI.hpp>
-#include <tbb/parallel_for.h>
 
 #include <chrono>
 #include <cmath>
@@ -127,7 +126,6 @@ class DensityCommand final : public Command {
 
     fs::create_directories(dir);
     const auto metadata = provenance(options);
-    // The files are independent: write them in parallel (each is still written atomically).
     std::vector<std::function<void()>> writes;
     auto write = [&](const std::string& n, const auto& raster) {
       writes.emplace_back([&, n] {
@@ -145,7 +143,7 @@ class DensityCommand final : public Command {
     if (write_hydro) write("hydrometry", result.hydrometry);
     write("buildable", result.buildable);
     write("density", result.density);
-    tbb::parallel_for(std::size_t(0), writes.size(), [&](std::size_t k) { writes[k](); });
+    write_concurrently(writes);
     const auto t3 = clock::now();
     context.log.detail("density: read " + seconds(t0, t1) + " s, model " + seconds(t1, t2) + " s (cpu " +
                        format(double(cpu2 - cpu1) / CLOCKS_PER_SEC, 3) + " s), write " + seconds(t2, t3) + " s");

@@ -9,8 +9,6 @@
 #include <string>
 #include <vector>
 
-#include <tbb/parallel_for.h>
-
 #include "cli/command.hpp"
 #include "cli/commands_list.hpp"
 #include "core/error.hpp"
@@ -154,8 +152,6 @@ class HydroCommand final : public Command {
         written.push_back((fs::path(out_dir_) / names[i]).string());
         return written.back();
       };
-      // The files are written concurrently (on 13 M-cell tiles writing was a fifth of the command's
-      // time, and one file's compression does not keep two threads busy).
       std::vector<std::function<void()>> writes;
       if (wanted[0])
         writes.push_back([&, p = path(0)] {
@@ -176,7 +172,7 @@ class HydroCommand final : public Command {
       if (wanted[3])
         writes.push_back([&, p = path(3)] { write_raster(p, result.hydrometry, opts("Hydrometry in [0,1] (" + hydrometry_ + ")")); });
       if (wanted[4]) writes.push_back([&, p = path(4)] { write_vector(p, result.streams, overwrite_); });
-      tbb::parallel_for(std::size_t(0), writes.size(), [&](std::size_t i) { writes[i](); });
+      write_concurrently(writes);
     } catch (...) {
       // No partial result: new files go, and the folder if this run made it.
       if (!overwrite_ || created)
