@@ -14,7 +14,9 @@
 #include "core/error.hpp"
 #include "hydro/hydro.hpp"
 #include "hydro/option_names.hpp"
+#include "hydro/river_types.hpp"
 #include "io/raster_io.hpp"
+#include "io/text_io.hpp"
 #include "io/vector_io.hpp"
 #include "terrapolis/version.hpp"
 
@@ -63,6 +65,14 @@ class HydroCommand final : public Command {
     app.add_option("--assume-crs", assume_crs_, "CRS for a DEM file that carries none, e.g. EPSG:32611");
     app.add_option("--outputs", outputs_, "Outputs to write, comma-separated: filled,flowdir,accumulation,hydrometry,streams")
         ->capture_default_str();
+    app.add_flag("--classify", classify_,
+                 "Add discharge (m3/s), slope, sinuosity and river type (B, E, D, delta) to every stream reach; writes streams.qml");
+    app.add_option("--braided-discharge", types_.braided_discharge_m3s, "--classify: discharge (m3/s) from which a reach near a mouth is braided (D)")
+        ->capture_default_str();
+    app.add_option("--delta-discharge", types_.delta_discharge_m3s, "--classify: discharge (m3/s) from which a mouth reach is a delta")
+        ->capture_default_str();
+    app.add_option("--coast-distance", types_.coast_distance_km, "--classify: river distance (km) to a mouth within which a reach may be braided")
+        ->capture_default_str();
     app.add_flag("--cog", cog_, "Write Cloud Optimized GeoTIFFs");
     app.add_flag("--overwrite", overwrite_, "Replace existing outputs");
   }
@@ -100,6 +110,8 @@ class HydroCommand final : public Command {
     }
     o.with_hydrometry = wanted[3];
     o.with_streams = wanted[4];
+    if (classify_ && !wanted[4]) throw bad_input("--classify: needs the streams output (--outputs ... ,streams)");
+    const std::string qml_path = (fs::path(out_dir_) / "streams.qml").string();
 
     ReadOptions read;
     if (!assume_crs_.empty()) read.assume_crs = assume_crs_;
@@ -112,8 +124,10 @@ class HydroCommand final : public Command {
     if (!created)
       for (int i = 0; i < 5; ++i)
         if (wanted[i]) check_output_path((fs::path(out_dir_) / names[i]).string(), overwrite_);
+    if (!created && classify_) check_output_path(qml_path, overwrite_);
 
     HydroResult result = run_hydro(dem, o, context.progress);
+    if (classify_) classify_streams(result.streams, result.filled, o.sea_level, types_);
     if (result.hydrometry_iterations > 0) {
       char line[160];
       std::snprintf(line, sizeof line, "belhadj: %d iterations in %.2f ms, %.1f M cell-iterations/s", result.hydrometry_iterations,
@@ -172,6 +186,10 @@ class HydroCommand final : public Command {
       if (wanted[3])
         writes.push_back([&, p = path(3)] { write_raster(p, result.hydrometry, opts("Hydrometry in [0,1] (" + hydrometry_ + ")")); });
       if (wanted[4]) writes.push_back([&, p = path(4)] { write_vector(p, result.streams, overwrite_); });
+      if (classify_) {
+        written.push_back(qml_path);
+        writes.push_back([&] { write_text_file(qml_path, river_types_qml(), overwrite_); });
+      }
       write_concurrently(writes);
     } catch (...) {
       // No partial result: new files go, and the folder if this run made it.
@@ -189,7 +207,8 @@ class HydroCommand final : public Command {
   std::string vertical_ = "metres", share_ = "all", units_ = "m2", weights_, assume_crs_;
   double mfd_exponent_ = 1.1, threshold_ = 1.0 / 1048576, streams_km2_ = 10.0, sea_level_ = NAN;
   int iterations_ = 0;
-  bool cog_ = false, overwrite_ = false;
+  bool cog_ = false, overwrite_ = false, classify_ = false;
+  RiverTypeOptions types_;
 };
 
 }  // namespace
