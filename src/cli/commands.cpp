@@ -11,6 +11,7 @@ std::vector<std::unique_ptr<Command>> all_commands() {
   commands.push_back(make_convert_command());
   commands.push_back(make_hydro_command());
   commands.push_back(make_catchment_command());
+  commands.push_back(make_lake_command());
   commands.push_back(make_density_command());
   commands.push_back(make_sites_command());
   commands.push_back(make_network_command());

@@ -16,9 +16,7 @@
 #include "io/raster_io.hpp"
 
 namespace terrapolis::hydro {
-namespace {
 
-/// Outer ring and holes of the mask's polygons, in CRS coordinates.
 std::vector<Feature> polygonize(const Raster<std::uint8_t>& mask) {
   init_gdal();
   GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");
@@ -61,8 +59,6 @@ std::vector<Feature> polygonize(const Raster<std::uint8_t>& mask) {
   }
   return out;
 }
-
-}  // namespace
 
 Catchment delineate_catchment(const Raster<std::uint8_t>& d8, const Raster<double>& area, const CellMetrics& metrics,
                               double x, double y, double snap_radius_m, Progress& progress) {

@@ -19,6 +19,10 @@ struct Catchment {
   VectorLayer polygon;                 ///< one polygon (8-connected cells, holes kept), DEM CRS
 };
 
+/// Polygons (outer ring, then holes; DEM CRS; 8-connected) of the cells of `mask` equal to 1,
+/// by GDALPolygonize. Fields are left empty. Also the lakes' shorelines.
+std::vector<Feature> polygonize(const Raster<std::uint8_t>& mask);
+
 /// The cells whose D8 path passes through the outlet. The outlet (x, y) in the DEM's CRS is
 /// snapped to the cell of highest upstream area whose centre lies within `snap_radius_m` metres
 /// (geodesic on geographic CRSs) of it; radius 0 takes the cell containing the point.

@@ -37,6 +37,32 @@ hydro::HydroOptions hydro_options(const Scenario& scenario) {
   return o;
 }
 
+std::optional<hydro::RiverTypeOptions> river_type_options(const Scenario& scenario) {
+  const json& h = scenario.resolved["hydro"];
+  if (!h["classify"].get<bool>()) return std::nullopt;
+  hydro::RiverTypeOptions o;
+  o.braided_discharge_m3s = h["braided_discharge_m3s"].get<double>();
+  o.delta_discharge_m3s = h["delta_discharge_m3s"].get<double>();
+  o.coast_distance_km = h["coast_distance_km"].get<double>();
+  return o;
+}
+
+std::vector<lake::LakeSpec> reservoir_specs(const Scenario& scenario) {
+  std::vector<lake::LakeSpec> out;
+  for (const json& r : scenario.resolved["water"]["reservoirs"]) {
+    lake::LakeSpec spec;
+    spec.lon = r["at"][0].get<double>();
+    spec.lat = r["at"][1].get<double>();
+    if (r.contains("level_m")) spec.level_m = r["level_m"].get<double>();
+    if (r.contains("depth_m")) spec.depth_m = r["depth_m"].get<double>();
+    if (r.contains("crest_m")) spec.crest_m = r["crest_m"].get<double>();
+    if (r.contains("dam"))
+      for (const json& p : r["dam"]) spec.dam_lonlat.push_back({p[0].get<double>(), p[1].get<double>()});
+    out.push_back(std::move(spec));
+  }
+  return out;
+}
+
 hydro::D8Codes d8_codes(const Scenario& scenario) {
   return choice(scenario.resolved["hydro"]["d8_codes"], hydro::kD8Codes);
 }

@@ -1,10 +1,14 @@
 // Each stage's options from a resolved scenario (schemas/scenario.schema.json is the one source of defaults).
 // SPDX-License-Identifier: MIT
 #pragma once
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "density/density.hpp"
 #include "hydro/hydro.hpp"
+#include "hydro/river_types.hpp"
+#include "lake/lake.hpp"
 #include "network/network.hpp"
 #include "pipeline/scenario.hpp"
 #include "roads/cost_model.hpp"
@@ -15,6 +19,10 @@ namespace terrapolis::pipeline {
 
 /// The hydro section (sea level from the water section). Weights are not part of a scenario.
 hydro::HydroOptions hydro_options(const Scenario& scenario);
+/// hydro.classify's thresholds, or none when the reaches are not classified.
+std::optional<hydro::RiverTypeOptions> river_type_options(const Scenario& scenario);
+/// The water section's reservoirs (docs/lakes.md), in the scenario's order.
+std::vector<lake::LakeSpec> reservoir_specs(const Scenario& scenario);
 /// Code convention of flowdir.tif.
 hydro::D8Codes d8_codes(const Scenario& scenario);
 /// The density section, with the water section and file names resolved against the scenario.

@@ -7,6 +7,7 @@
 #include <map>
 
 #include "core/error.hpp"
+#include "core/geodesy.hpp"
 #include "io/raster_io.hpp"
 #include "network/layers.hpp"
 #include "pipeline/hillshade.hpp"
@@ -43,11 +44,46 @@ void terrain_run(RunState& s, Progress&, const Log&) {
 
 void terrain_load(RunState&) {}  // the DEM is always read from the input
 
+// ---- reservoirs (Peytavie 2010 §2.4.1; docs/lakes.md) ------------------------------------
+
+constexpr const char* kReservoirs = "reservoirs.tif";
+
+/// The scenario's reservoirs and its water_mask as one raster of added water (1 water, 0 not),
+/// the mask the density and roads stages read; nothing when the scenario declares no reservoir.
+void write_reservoirs(RunState& s, Progress& progress, const Log& log) {
+  const std::vector<lake::LakeSpec> specs = reservoir_specs(s.scenario);
+  if (specs.empty()) return;
+  Raster<float> water = s.dem.like<float>(0.0f);
+  if (const std::string user = s.scenario.path("/water/water_mask"); !user.empty()) {
+    const Raster<float> m = read_resampled(user, s.dem.georef(), s.dem.cols(), s.dem.rows(), Resampling::nearest);
+    for (std::size_t i = 0; i < m.size(); ++i)
+      if (!std::isnan(m[i]) && m[i] != 0) water[i] = 1;
+  }
+  const CellMetrics metrics = cell_metrics(s.dem.georef(), s.dem.cols(), s.dem.rows());
+  json lakes = json::array();
+  for (std::size_t k = 0; k < specs.size(); ++k) {
+    lake::Lake l;
+    try {
+      l = lake::flood(s.dem, metrics, specs[k], progress);
+    } catch (const Error& e) {
+      throw bad_input("water.reservoirs[" + std::to_string(k) + "]: " + e.what());
+    }
+    for (std::size_t i = 0; i < l.mask.size(); ++i)
+      if (l.mask[i] == 1) water[i] = 1;
+    if (l.spills) log.warn("water.reservoirs[" + std::to_string(k) + "]: the water reaches the DEM's edge or nodata");
+    lakes.push_back({{"level_m", round_to(l.level_m, 0.01)}, {"area_km2", round_to(l.area_km2, 1e-4)},
+                     {"volume_m3", std::round(l.volume_m3)}, {"max_depth_m", round_to(l.max_depth_m, 0.01)}});
+  }
+  s.write("hydro", kReservoirs, water, "added water: the scenario's reservoirs and water_mask (1 water, 0 not)", Style::unit_ramp);
+  s.summary["hydro"]["reservoirs"] = lakes;
+}
+
 // ---- hydro (Belhadj 2007 §4.2.2; Barnes et al. 2014; docs/hydro.md) ----------------------
 
 void hydro_run(RunState& s, Progress& progress, const Log& log) {
   const hydro::HydroOptions options = hydro_options(s.scenario);
   hydro::HydroResult r = hydro::run_hydro(s.dem, options, progress);
+  if (const auto types = river_type_options(s.scenario)) hydro::classify_streams(r.streams, r.filled, options.sea_level, *types);
   const json& h = s.scenario.resolved["hydro"];
   const hydro::D8Codes codes = d8_codes(s.scenario);
   s.write("hydro", "filled.tif", r.filled, "conditioned elevation (m), " + h["fill"].get<std::string>() + " depression handling",
@@ -80,6 +116,7 @@ void hydro_run(RunState& s, Progress& progress, const Log& log) {
                         {"belhadj_iterations", r.hydrometry_iterations}};
   if (r.hydrometry_iterations > 0) log.detail("belhadj: " + std::to_string(r.hydrometry_iterations) + " iterations");
   s.hydrometry = std::move(r.hydrometry);
+  write_reservoirs(s, progress, log);
 }
 
 void hydro_load(RunState& s) {
@@ -90,6 +127,7 @@ void hydro_load(RunState& s) {
 
 void density_run(RunState& s, Progress& progress, const Log& log) {
   density::DensityOptions options = density_options(s.scenario);
+  if (!reservoir_specs(s.scenario).empty()) options.water_mask = saved(s, kReservoirs);  // holds the water_mask too
   plugin::add_to_density(plugin::density_factors(s.plugins, s.dem, progress, log), options);
   density::DensityResult r = density::compute_density(s.dem, *s.hydrometry, options, progress);
   const std::pair<const char*, const Raster<float>*> characteristics[] = {{"coast", &r.coast}, {"plateau", &r.plateau}, {"plain", &r.plain}};
@@ -177,7 +215,15 @@ void network_load(RunState& s) { s.network = read_vector(saved(s, "network.geojs
 
 void roads_run(RunState& s, Progress& progress, const Log& log) {
   const RoadsSettings settings = roads_settings(s.scenario);
-  roads::TerrainField terrain(s.dem, s.scenario.resolved["water"]["sea_level_m"].get<double>(), settings.model.unknown_water_depth_m,
+  // Reservoir cells become nodata, which the road search takes as water of unknown depth.
+  Dem with_reservoirs;
+  if (!reservoir_specs(s.scenario).empty()) {
+    with_reservoirs = s.dem;
+    const Raster<float> water = read_resampled(saved(s, kReservoirs), s.dem.georef(), s.dem.cols(), s.dem.rows(), Resampling::nearest);
+    for (std::size_t i = 0; i < water.size(); ++i)
+      if (water[i] == 1) with_reservoirs[i] = NAN;
+  }
+  roads::TerrainField terrain(with_reservoirs.size() ? with_reservoirs : s.dem, s.scenario.resolved["water"]["sea_level_m"].get<double>(), settings.model.unknown_water_depth_m,
                               settings.model.road_radius_m);
   if (!settings.vegetation.empty())
     terrain.set_vegetation(read_resampled(settings.vegetation, s.dem.georef(), s.dem.cols(), s.dem.rows(), Resampling::bilinear));

@@ -1,0 +1,143 @@
+// `terrapolis lake DEM OUTDIR --at LON,LAT --level M | --depth M [--dam LINESTRING --crest M]`.
+// SPDX-License-Identifier: MIT
+#include <CLI/CLI.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <algorithm>
+#include <cctype>
+#include <sstream>
+
+#include "cli/command.hpp"
+#include "cli/commands_list.hpp"
+#include "cli/dem_input.hpp"
+#include "cli/output_dir.hpp"
+#include "core/error.hpp"
+#include "lake/lake.hpp"
+#include "io/text_io.hpp"
+#include "io/vector_io.hpp"
+#include "terrapolis/version.hpp"
+
+namespace terrapolis::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// "LINESTRING (lon lat, lon lat, ...)" (WKT, WGS 84 degrees) into points.
+std::vector<std::array<double, 2>> parse_linestring(const std::string& text) {
+  std::string s = text;
+  const auto open = s.find('('), close = s.rfind(')');
+  std::string head = s.substr(0, open == std::string::npos ? 0 : open);
+  head.erase(std::remove_if(head.begin(), head.end(), ::isspace), head.end());
+  for (auto& ch : head) ch = char(std::toupper(static_cast<unsigned char>(ch)));
+  if (open == std::string::npos || close == std::string::npos || close < open || head != "LINESTRING")
+    throw bad_input("--dam: '" + text + "' is not a WKT LINESTRING (lon lat, lon lat, ...)");
+  std::vector<std::array<double, 2>> points;
+  std::stringstream body(s.substr(open + 1, close - open - 1));
+  for (std::string pair; std::getline(body, pair, ',');) {
+    std::istringstream in(pair);
+    std::array<double, 2> p{};
+    std::string rest;
+    if (!(in >> p[0] >> p[1]) || (in >> rest)) throw bad_input("--dam: '" + pair + "' is not a 'lon lat' pair");
+    points.push_back(p);
+  }
+  if (points.size() < 2) throw bad_input("--dam: a line needs at least two points");
+  return points;
+}
+
+std::string fixed(double v, int digits) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
+  return buf;
+}
+
+class LakeCommand final : public Command {
+ public:
+  std::string name() const override { return "lake"; }
+  std::string summary() const override { return "Lake or reservoir flooded to a level from a point: depth, shoreline, area, volume"; }
+
+  void setup(CLI::App& app) override {
+    dem_.add_to(app);
+    app.add_option("OUTDIR", out_dir_, "Output folder (created if missing)")->required();
+    app.add_option("--at", at_, "Seed LON,LAT (WGS 84) on the lake's floor")->required();
+    app.add_option("--level", level_, "Water surface elevation (m)");
+    app.add_option("--depth", depth_, "Water depth above the seed's ground (m)");
+    app.add_option("--dam", dam_, "Dam line, WKT in lon/lat: 'LINESTRING (lon lat, lon lat)'; its cells rise to --crest");
+    app.add_option("--crest", crest_, "Dam crest elevation (m); the level defaults to it");
+    app.add_option("--run", run_dir_, "Run folder: report the flooded road length (roads.geojson) and the cities touched (cities.geojson)");
+    app.add_flag("--cog", cog_, "Write a Cloud Optimized GeoTIFF");
+    app.add_flag("--overwrite", overwrite_, "Replace existing outputs");
+  }
+
+  void run(Context& context) override {
+    lake::LakeSpec spec;
+    const auto at = parse_pair("--at", at_);
+    spec.lon = at[0];
+    spec.lat = at[1];
+    if (!std::isnan(level_)) spec.level_m = level_;
+    if (!std::isnan(depth_)) spec.depth_m = depth_;
+    if (!std::isnan(crest_)) spec.crest_m = crest_;
+    if (!dam_.empty()) spec.dam_lonlat = parse_linestring(dam_);
+    const std::string roads_path = (fs::path(run_dir_) / "roads.geojson").string(), cities_path = (fs::path(run_dir_) / "cities.geojson").string();
+    if (!run_dir_.empty() && !fs::is_directory(run_dir_)) throw bad_input(run_dir_ + ": --run: not a folder");
+    OutputDir outputs(out_dir_, {"depth.tif", "shoreline.geojson", "lake.json"}, overwrite_);
+    const Dem dem = dem_.read();
+    const CellMetrics metrics = cell_metrics(dem.georef(), dem.cols(), dem.rows());
+    const lake::Lake lake = lake::flood(dem, metrics, spec, context.progress);
+
+    nlohmann::ordered_json report = {
+        {"terrapolis_version", version}, {"dem", fs::path(dem_.path).filename().string()}, {"at", {spec.lon, spec.lat}},
+        {"seed_cell", {lake.seed_col, lake.seed_row}}, {"level_m", lake.level_m}, {"cells", lake.cells},
+        {"area_km2", lake.area_km2}, {"volume_m3", lake.volume_m3}, {"max_depth_m", lake.max_depth_m}, {"spills", lake.spills}};
+    if (!spec.dam_lonlat.empty()) report["dam"] = {{"crest_m", *spec.crest_m}, {"cells", lake.dam_cells}};
+    std::string extra;
+    if (!run_dir_.empty()) {
+      const Crs& crs = dem.georef().crs;
+      if (fs::exists(roads_path)) {
+        const double m = lake::flooded_length_m(lake, read_vector(roads_path, crs));
+        report["flooded_road_km"] = m / 1000;
+        extra += ", " + fixed(m / 1000, 2) + " km of road flooded";
+      }
+      if (fs::exists(cities_path)) {
+        const auto ids = lake::cities_touched(lake, metrics, read_vector(cities_path, crs));
+        report["cities_touched"] = ids;
+        extra += ", " + std::to_string(ids.size()) + " cities touched";
+      }
+      if (!report.contains("flooded_road_km") && !report.contains("cities_touched"))
+        throw bad_input(run_dir_ + ": --run: holds neither roads.geojson nor cities.geojson");
+    }
+    const VectorLayer shoreline = lake::shoreline_layer(lake);
+    outputs.write_all([&](std::size_t i, const std::string& path, bool overwrite) {
+      if (i == 0) {
+        WriteOptions w;
+        w.cog = cog_;
+        w.overwrite = overwrite;
+        w.description = "Water depth (m) of a lake at " + fixed(lake.level_m, 2) + " m";
+        w.metadata = {{"TERRAPOLIS_VERSION", version}, {"TERRAPOLIS_COMMAND", "lake"}, {"SOURCE_DEM", fs::path(dem_.path).filename().string()},
+                      {"AT", at_}, {"LEVEL_M", fixed(lake.level_m, 3)}, {"UNIT", "m"}};
+        write_raster(path, lake.depth, w);
+      } else if (i == 1) {
+        write_vector(path, shoreline, overwrite);
+      } else {
+        write_text_file(path, report.dump(2) + "\n", overwrite);
+      }
+    });
+    if (lake.spills) context.log.warn("lake: the water reaches the DEM's edge or nodata: it would spill beyond, area and volume are lower bounds");
+    context.log.info("lake: level " + fixed(lake.level_m, 2) + " m, " + fixed(lake.area_km2, 4) + " km2, " + fixed(lake.volume_m3 / 1e6, 4) +
+                     " million m3, max depth " + fixed(lake.max_depth_m, 2) + " m" + extra + "; wrote " + out_dir_);
+  }
+
+ private:
+  DemInput dem_;
+  std::string out_dir_, at_, dam_, run_dir_;
+  double level_ = NAN, depth_ = NAN, crest_ = NAN;
+  bool cog_ = false, overwrite_ = false;
+};
+
+}  // namespace
+
+std::unique_ptr<Command> make_lake_command() { return std::make_unique<LakeCommand>(); }
+
+}  // namespace terrapolis::cli

@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# A scenario with a reservoir (water.reservoirs) and classified streams (hydro.classify): the
+# reservoir is water for the density, the streams carry river types, and `lake --run` reads the run.
+# SPDX-License-Identifier: MIT
+source "$(dirname "$0")/lib.sh" "$@"
+cd "$WORK"
+dem=$SAMPLES/gebco2022_15s_north_corsica_capcorse.asc
+reservoir='{"at": [9.4187, 42.5187], "level_m": 90, "dam": [[9.4271, 42.4987], [9.4271, 42.5388]], "crest_m": 95}'
+"$TP" --quiet run -o run --set outputs.preview_width=200 --set "water.reservoirs=[$reservoir]" --set hydro.classify=true \
+  2>/dev/null
+[[ -s run/reservoirs.tif && -s run/reservoirs.qml ]] || fail "no reservoirs.tif"
+/usr/bin/python3 - run <<'PY' || fail "reservoir figures"
+import json, sys
+from osgeo import gdal
+run = sys.argv[1]
+s = json.load(open(run + "/run.json"))["summary"]["hydro"]["reservoirs"]
+assert len(s) == 1 and abs(s[0]["area_km2"] - 2.06) < 0.01 and s[0]["level_m"] == 90, s
+water = gdal.Open(run + "/reservoirs.tif").ReadAsArray()
+buildable = gdal.Open(run + "/buildable.tif").ReadAsArray()
+assert (water == 1).sum() > 0
+assert ((water == 1) & (buildable == 1)).sum() == 0, "a reservoir cell is buildable"
+streams = json.load(open(run + "/streams.geojson"))["features"]
+assert all(f["properties"]["river_type"] in ("B", "E", "D", "delta") for f in streams)
+PY
+# The lake command on the run's own roads and cities.
+"$TP" --quiet lake "$dem" lake --at=9.4187,42.5187 --level 90 --dam "LINESTRING (9.4271 42.4987, 9.4271 42.5388)" --crest 95 --run run
+/usr/bin/python3 -c "
+import json; r = json.load(open('lake/lake.json'))
+assert r['flooded_road_km'] >= 0 and isinstance(r['cities_touched'], list), r
+assert abs(r['area_km2'] - 2.06) < 0.01, r" || fail "lake --run"
+# A reservoir the scenario cannot hold is refused, naming it.
+expect_fail 2 "water.reservoirs\[0\]: --at: the ground" "$TP" --quiet run -o bad --set outputs.preview_width=200 \
+  --set 'water.reservoirs=[{"at": [9.4187, 42.5187], "level_m": 10}]'
+[[ ! -e bad ]] || fail "a refused run left its folder"
+echo ok
