@@ -111,6 +111,7 @@ class HydroCommand final : public Command {
     o.with_hydrometry = wanted[3];
     o.with_streams = wanted[4];
     if (classify_ && !wanted[4]) throw bad_input("--classify: needs the streams output (--outputs ... ,streams)");
+    if (classify_) check(types_);
     const std::string qml_path = (fs::path(out_dir_) / "streams.qml").string();
 
     ReadOptions read;

@@ -50,9 +50,14 @@ RiverType classify_reach(const ReachMeasures& m, const RiverTypeOptions& o) {
   return RiverType::B;
 }
 
+void check(const RiverTypeOptions& o) {
+  if (!(o.braided_discharge_m3s > 0) || !std::isfinite(o.braided_discharge_m3s)) throw bad_input("--braided-discharge: must be positive (m3/s)");
+  if (!(o.delta_discharge_m3s > 0) || !std::isfinite(o.delta_discharge_m3s)) throw bad_input("--delta-discharge: must be positive (m3/s)");
+  if (!(o.coast_distance_km >= 0) || !std::isfinite(o.coast_distance_km)) throw bad_input("--coast-distance: must be >= 0 km");
+}
+
 void classify_streams(VectorLayer& streams, const Dem& filled, const std::optional<double>& sea_level, const RiverTypeOptions& o) {
-  if (!(o.braided_discharge_m3s > 0) || !(o.delta_discharge_m3s > 0) || !(o.coast_distance_km >= 0) || !std::isfinite(o.coast_distance_km))
-    throw bad_input("--braided-discharge, --delta-discharge: must be positive; --coast-distance: must be >= 0");
+  check(o);
   const int f_id = streams.field_index("id"), f_area = streams.field_index("upstream_km2"), f_length = streams.field_index("length_m"),
             f_down = streams.field_index("downstream_id");
   if (f_id < 0 || f_area < 0 || f_length < 0 || f_down < 0) throw bad_input("streams: not a layer of extract_streams");
@@ -122,7 +127,8 @@ void classify_streams(VectorLayer& streams, const Dem& filled, const std::option
     v.emplace_back(m[i].discharge_m3s);
     v.emplace_back(m[i].slope);
     v.emplace_back(m[i].sinuosity);
-    v.push_back(m[i].to_mouth_km < 0 ? FieldValue{} : FieldValue{m[i].to_mouth_km});
+    if (m[i].to_mouth_km < 0) v.emplace_back(std::monostate{});
+    else v.emplace_back(m[i].to_mouth_km);
     v.emplace_back(std::string(river_type_name(classify_reach(m[i], o))));
   }
 }

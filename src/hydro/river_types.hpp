@@ -42,6 +42,9 @@ struct ReachMeasures {
 /// discharge; else E when gentle and sinuous; else B.
 RiverType classify_reach(const ReachMeasures& m, const RiverTypeOptions& options);
 
+/// Throws bad_input naming the command-line option of a threshold out of range.
+void check(const RiverTypeOptions& options);
+
 /// Adds `discharge_m3s`, `slope`, `sinuosity`, `to_mouth_km` (null when the river reaches no
 /// sea) and `river_type` to every reach of `streams` (extract_streams's layer, on `filled`'s grid).
 /// The sea is the cells at or below `sea_level`; without one there is no coast (no D, no delta).

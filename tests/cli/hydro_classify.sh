@@ -39,6 +39,21 @@ assert any(f["properties"]["to_mouth_km"] == 0 for f in reaches)
 print("types:", types)
 EOF
 
+# QGIS (headless) opens streams.geojson with streams.qml applied: categories by river type.
+chmod 700 "$work"
+QT_QPA_PLATFORM=offscreen XDG_RUNTIME_DIR=$work /usr/bin/python3 - "$work/corsica" <<'EOF' || fail "QGIS style"
+import os, sys
+from qgis.core import QgsApplication, QgsVectorLayer
+app = QgsApplication([], False)
+app.initQgis()
+layer = QgsVectorLayer(os.path.join(sys.argv[1], "streams.geojson"), "streams", "ogr")
+assert layer.isValid()
+r = layer.renderer()  # QGIS loads the .qml of the same base name by itself
+assert r.type() == "categorizedSymbol" and r.classAttribute() == "river_type", r.type()
+assert sorted(c.value() for c in r.categories()) == ["B", "D", "E", "delta"]
+os._exit(0)  # skip QGIS's teardown, which may crash in a headless session
+EOF
+
 # Without a sea level there is no coast: no D and no delta, no distance to a mouth.
 "$bin" -q hydro "$samples/spDataLarge_srtm_zion.tif" "$work/zion" --classify --outputs streams --streams-threshold 2 \
   --braided-discharge 0.1 --delta-discharge 0.1
@@ -52,7 +67,7 @@ EOF
 # Refusals: exit 2, nothing written.
 expect_refused "$work/none" "needs the streams output" "$bin" -q hydro "$samples/spDataLarge_srtm_zion.tif" "$work/none" \
   --classify --outputs filled
-expect_refused "$work/none" "must be positive" "$bin" -q hydro "$samples/spDataLarge_srtm_zion.tif" "$work/none" \
+expect_refused "$work/none" "--braided-discharge: must be positive" "$bin" -q hydro "$samples/spDataLarge_srtm_zion.tif" "$work/none" \
   --classify --braided-discharge 0
 # An existing streams.qml is refused like the other outputs.
 expect_fail 2 "exists" "$bin" -q hydro "$samples/gebco2022_15s_north_corsica_capcorse.asc" "$work/corsica" --sea-level 0 \
