@@ -3,7 +3,7 @@
 # on the shared SRTM tiles: wall and CPU time (medians), peak resident memory, and a check that
 # the tiled outputs hold the whole-grid cells.
 # Run from the repository root: bench/scale.sh [path/to/terrapolis] [runs]
-# Needs GNU time (/usr/bin/time), python3-gdal; the DEMs in ../shared/dems.
+# Needs GNU time (/usr/bin/time), gdal-bin, python3; the DEMs in ../shared/dems.
 # SPDX-License-Identifier: MIT
 set -euo pipefail
 bin=$(realpath "${1:-build/src/cli/terrapolis}")
@@ -33,13 +33,11 @@ print(f"  {sys.argv[1]:<40} wall {wall:7.2f} s  cpu {cpu:7.2f} s  peak {peak:7.0
 PY
 }
 
-same_cells() {
-  python3 - "$1" "$2" <<'PY'
-import sys
-from osgeo import gdal
-x, y = (gdal.Open(p).GetRasterBand(1).ReadAsArray() for p in sys.argv[1:3])
-print("    same cells" if x.tobytes() == y.tobytes() else f"    DIFFERENT: {sys.argv[1]} vs {sys.argv[2]}")
-PY
+same_cells() {  # raw copies compared byte for byte
+  rm -f "$work"/[ab].*
+  GDAL_PAM_ENABLED=NO gdal_translate -q -of ENVI "$1" "$work/a.bin"
+  GDAL_PAM_ENABLED=NO gdal_translate -q -of ENVI "$2" "$work/b.bin"
+  if cmp -s "$work/a.bin" "$work/b.bin"; then echo "    $(basename "$2"): same cells"; else echo "    $(basename "$2"): DIFFERENT"; fi
 }
 
 for dem in "${dems[@]}"; do
@@ -50,7 +48,8 @@ for dem in "${dems[@]}"; do
   [[ $name == S46W066 ]] && sea=(--sea-level 0)
   run "whole grid" "$bin" -q hydro "$dem" "$work/out" --outputs $outputs "${sea[@]}"
   "$bin" -q hydro "$dem" "$work/whole" --outputs $outputs "${sea[@]}" --overwrite
-  for option in "--tile-size 1201" "--tile-size 600" "--tile-size 300" "--memory-limit 64" "--memory-limit 32"; do
+  IFS=";" read -ra options <<<"${BENCH_OPTIONS:---tile-size 1201;--tile-size 600;--tile-size 300;--memory-limit 64;--memory-limit 32}"
+  for option in "${options[@]}"; do
     run "tiled $option" "$bin" -q hydro "$dem" "$work/out" "${sea[@]}" $option
     "$bin" -v hydro "$dem" "$work/tiled" "${sea[@]}" $option --overwrite 2>&1 | grep "^tiles:" | sed 's/^/    /'
     for o in filled flowdir accumulation; do same_cells "$work/whole/$o.tif" "$work/tiled/$o.vrt"; done

@@ -61,11 +61,19 @@ std::string run_tiled_hydro_command(const TiledHydroRequest& q, Context& context
       fs::create_directories(out);
       made.push_back(out.string());
     }
-    for (Layer& l : layers)
-      if (l.wanted && !fs::exists(out / l.name)) {
+    for (Layer& l : layers) {
+      if (!l.wanted) continue;
+      if (!fs::exists(out / l.name)) {
         fs::create_directory(out / l.name);
         made.push_back((out / l.name).string());
+      } else if (q.filled_file.overwrite) {
+        // The tiles of an earlier run (perhaps of another tile size) go: the VRT lists only this run's.
+        for (const auto& entry : fs::directory_iterator(out / l.name)) {
+          const std::string n = entry.path().filename().string();
+          if (n.size() == 18 && n.rfind("tile_", 0) == 0 && n.substr(14) == ".tif") fs::remove(entry.path());
+        }
       }
+    }
     const fs::path scratch = out / (".scratch-" + std::to_string(getpid()));
     fs::create_directory(scratch);
     made.push_back(scratch.string());

@@ -62,6 +62,7 @@ expect_refused "$work/r4" "too little" "$bin" hydro "$nz" "$work/r4" --memory-li
 mkdir "$work/empty"
 expect_refused "$work/r5" "no GeoTIFF tile" "$bin" hydro "$work/empty" "$work/r5"
 expect_fail 2 "exists" "$bin" hydro "$zion" "$work/zion_tiled" --tile-size 100
-"$bin" -q hydro "$work/zion_tiles" "$work/zion_tiled" --tile-size 100 --overwrite
+"$bin" -q hydro "$work/zion_tiles" "$work/zion_tiled" --tile-size 200 --overwrite
 same_cells "$work/zion_whole/accumulation.tif" "$work/zion_tiled/accumulation.vrt" || fail "zion: overwrite differs"
+[[ $(ls "$work/zion_tiled/accumulation" | wc -l) -eq 9 ]] || fail "zion: the tiles of the first run were left beside the new ones"
 echo ok
