@@ -352,6 +352,23 @@ DemWindowReader::DemWindowReader(const std::string& path, ReadOptions options)
     }
     if (tiles.empty()) throw bad_input(path + ": folder holds no GeoTIFF tile (.tif)");
     std::sort(tiles.begin(), tiles.end());  // a fixed order: where tiles overlap, the last one wins
+    // A VRT would leave out tiles of another CRS and resample those of another resolution: refuse them.
+    std::array<double, 6> first{};
+    OGRSpatialReference first_srs;
+    for (std::size_t i = 0; i < tiles.size(); ++i) {
+      auto tile = open_raster(tiles[i]);
+      std::array<double, 6> gt{};
+      if (tile->GetGeoTransform(gt.data()) != CE_None) throw bad_input(tiles[i] + ": has no geotransform (not georeferenced)");
+      const OGRSpatialReference* srs = tile->GetSpatialRef();
+      if (i == 0) {
+        first = gt;
+        if (srs) first_srs = *srs;
+      } else if (gt[1] != first[1] || gt[5] != first[5] || gt[2] != first[2] || gt[4] != first[4]) {
+        throw bad_input(tiles[i] + ": cell size differs from " + tiles[0] + "'s; the tiles of a mosaic share one grid");
+      } else if ((srs == nullptr) != first_srs.IsEmpty() || (srs && !srs->IsSame(&first_srs))) {
+        throw bad_input(tiles[i] + ": CRS differs from " + tiles[0] + "'s; the tiles of a mosaic share one CRS");
+      }
+    }
     std::vector<const char*> names;
     for (const auto& t : tiles) names.push_back(t.c_str());
     init_gdal();

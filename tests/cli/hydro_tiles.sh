@@ -61,6 +61,10 @@ expect_refused "$work/r3" "at least 8" "$bin" hydro "$zion" "$work/r3" --tile-si
 expect_refused "$work/r4" "too little" "$bin" hydro "$nz" "$work/r4" --memory-limit 1
 mkdir "$work/empty"
 expect_refused "$work/r5" "no GeoTIFF tile" "$bin" hydro "$work/empty" "$work/r5"
+mkdir "$work/mixed"
+cp "$work/zion_tiles/z_0_0.tif" "$work/mixed/"
+gdal_translate -q -tr 0.001 0.001 "$work/zion_tiles/z_0_1.tif" "$work/mixed/z_0_1.tif"
+expect_refused "$work/r6" "cell size differs" "$bin" hydro "$work/mixed" "$work/r6"
 expect_fail 2 "exists" "$bin" hydro "$zion" "$work/zion_tiled" --tile-size 100
 "$bin" -q hydro "$work/zion_tiles" "$work/zion_tiled" --tile-size 200 --overwrite
 same_cells "$work/zion_whole/accumulation.tif" "$work/zion_tiled/accumulation.vrt" || fail "zion: overwrite differs"
