@@ -6,10 +6,14 @@
 #include <tbb/global_control.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <mutex>
 #include <random>
 #include <set>
+#include <stdexcept>
+#include <string>
 
 #include "core/error.hpp"
 #include "core/geodesy.hpp"
@@ -67,7 +71,10 @@ Whole tiled(const Dem& dem, int tile_size, int concurrent, std::optional<double>
   o.concurrent_tiles = concurrent;
   o.sea_level = sea;
   o.unit = unit;
-  o.scratch_dir = ::testing::TempDir();
+  // A scratch folder of its own: CTest may run the cases of this file at the same time.
+  std::string scratch = ::testing::TempDir() + "tiled-XXXXXX";
+  if (!mkdtemp(scratch.data())) throw std::runtime_error("mkdtemp failed");
+  o.scratch_dir = scratch;
   auto read = [&](int c0, int r0, int cols, int rows) {
     Dem out(cols, rows, {}, NAN);
     for (int r = 0; r < rows; ++r)
@@ -78,6 +85,8 @@ Whole tiled(const Dem& dem, int tile_size, int concurrent, std::optional<double>
   SilentProgress quiet;
   const TiledReport rep = run_tiled_hydro(dem.cols(), dem.rows(), dem.georef(), read, o, sinks, quiet);
   if (report) *report = rep;
+  EXPECT_TRUE(std::filesystem::is_empty(scratch)) << "scratch files left behind";
+  std::filesystem::remove(scratch);
   return w;
 }
 
