@@ -64,7 +64,7 @@ class HydroCommand final : public Command {
     app.add_option("--assume-crs", assume_crs_, "CRS for a DEM file that carries none, e.g. EPSG:32611");
     app.add_option("--outputs", outputs_, "Outputs to write, comma-separated: filled,flowdir,accumulation,hydrometry,streams")
         ->capture_default_str();
-    app.add_option("--tile-size", tile_size_, "Work tile by tile, tiles of N x N cells (writes one GeoTIFF a tile + a VRT)");
+    app.add_option("--tile-size", tile_size_, "Work tile by tile, tiles of at most N x N cells (writes one GeoTIFF a tile + a VRT)");
     app.add_option("--memory-limit", memory_limit_mb_, "Work tile by tile within this much memory (MB), tiles sized to fit");
     app.add_flag("--cog", cog_, "Write Cloud Optimized GeoTIFFs");
     app.add_flag("--overwrite", overwrite_, "Replace existing outputs");
