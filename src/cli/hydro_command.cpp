@@ -11,6 +11,7 @@
 
 #include "cli/command.hpp"
 #include "cli/commands_list.hpp"
+#include "cli/hydro_tiles.hpp"
 #include "core/error.hpp"
 #include "hydro/hydro.hpp"
 #include "hydro/option_names.hpp"
@@ -73,6 +74,8 @@ class HydroCommand final : public Command {
         ->capture_default_str();
     app.add_option("--coast-distance", types_.coast_distance_km, "--classify: river distance (km) to a mouth within which a reach may be braided")
         ->capture_default_str();
+    app.add_option("--tile-size", tile_size_, "Work tile by tile, tiles of at most N x N cells (writes one GeoTIFF a tile + a VRT)");
+    app.add_option("--memory-limit", memory_limit_mb_, "Work tile by tile within this much memory (MB), tiles sized to fit");
     app.add_flag("--cog", cog_, "Write Cloud Optimized GeoTIFFs");
     app.add_flag("--overwrite", overwrite_, "Replace existing outputs");
   }
@@ -114,8 +117,56 @@ class HydroCommand final : public Command {
     if (classify_) check(types_);
     const std::string qml_path = (fs::path(out_dir_) / "streams.qml").string();
 
+    std::vector<std::pair<std::string, std::string>> provenance = {
+        {"TERRAPOLIS_VERSION", version}, {"TERRAPOLIS_COMMAND", "hydro"}, {"SOURCE_DEM", fs::path(dem_path_).filename().string()},
+        {"FILL", fill_}, {"FLOW", flow_}, {"MFD_EXPONENT", number(mfd_exponent_)}, {"HYDROMETRY", hydrometry_},
+        {"ITERATIONS", std::to_string(iterations_)}, {"THRESHOLD", number(threshold_)}, {"VERTICAL", vertical_},
+        {"BELHADJ_SHARE", share_}, {"SEA_LEVEL", o.sea_level ? number(*o.sea_level) : "off"}};
+    auto opts = [&](const std::string& description, std::vector<std::pair<std::string, std::string>> extra = {}) {
+      WriteOptions w;
+      w.cog = cog_;
+      w.overwrite = overwrite_;
+      w.description = description;
+      w.deflate_level = 1;  // 13 M-cell float rasters: a third of the compression time, files ~4 % larger
+      w.metadata = provenance;
+      w.metadata.insert(w.metadata.end(), extra.begin(), extra.end());
+      return w;
+    };
     ReadOptions read;
     if (!assume_crs_.empty()) read.assume_crs = assume_crs_;
+    const std::string flowdir_description = "D8 flow direction, " + describe(codes);
+    const std::vector<std::pair<std::string, std::string>> flowdir_metadata = {{"D8_CODES", codes_}, {"D8_CODES_DESCRIPTION", describe(codes)}};
+    const std::string acc_unit = units_ == "cells" ? "cells" : units_;
+    const std::string acc_description = "Upstream " + std::string(units_ == "cells" ? "cell count" : "area (" + acc_unit + ")") + ", " +
+                                        flow_ + " routing" + (weights_.empty() ? "" : ", weighted");
+    if (tile_size_ > 0 || memory_limit_mb_ > 0 || fs::is_directory(dem_path_)) {
+      // The tile engine: fill, D8 and accumulation, tile by tile (docs/scale.md).
+      if (o.fill != FillMethod::priority_flood || o.flow != FlowMethod::d8 || !weights_.empty())
+        throw bad_input("tiled hydro (--tile-size, --memory-limit, a folder of tiles): only --fill priority-flood, --flow d8, no --weights");
+      if (outputs_ != kDefaultOutputs && (wanted[3] || wanted[4]))
+        throw bad_input("--outputs: hydrometry and streams are not computed on tiles yet; ask for filled,flowdir,accumulation");
+      if (classify_) throw bad_input("--classify: streams are not computed on tiles yet");
+      if (tile_size_ != 0 && tile_size_ < 8) throw bad_input("--tile-size: must be at least 8 cells");
+      if (memory_limit_mb_ < 0) throw bad_input("--memory-limit: must be a positive number of MB");
+      TiledHydroRequest q;
+      q.dem_path = dem_path_;
+      q.out_dir = out_dir_;
+      q.read = read;
+      q.tile_size = tile_size_;
+      q.memory_limit_mb = memory_limit_mb_ > 0 ? memory_limit_mb_ : 1024;
+      q.sea_level = o.sea_level;
+      q.unit = o.unit;
+      q.accumulation_scale = units_ == "km2" ? 1e-6 : 1.0;
+      q.codes = codes;
+      q.filled = wanted[0];
+      q.flowdir = wanted[1];
+      q.accumulation = wanted[2];
+      q.filled_file = opts("Conditioned elevation (m), " + fill_ + " depression handling");
+      q.flowdir_file = opts(flowdir_description, flowdir_metadata);
+      q.accumulation_file = opts(acc_description, {{"UNIT", acc_unit}});
+      context.log.info(run_tiled_hydro_command(q, context));
+      return;
+    }
     const Dem dem = read_dem(dem_path_, read);
     if (!weights_.empty()) o.weights = read_resampled(weights_, dem.georef(), dem.cols(), dem.rows(), Resampling::bilinear);
 
@@ -137,21 +188,6 @@ class HydroCommand final : public Command {
       context.log.detail(line);
     }
 
-    std::vector<std::pair<std::string, std::string>> provenance = {
-        {"TERRAPOLIS_VERSION", version}, {"TERRAPOLIS_COMMAND", "hydro"}, {"SOURCE_DEM", fs::path(dem_path_).filename().string()},
-        {"FILL", fill_}, {"FLOW", flow_}, {"MFD_EXPONENT", number(mfd_exponent_)}, {"HYDROMETRY", hydrometry_},
-        {"ITERATIONS", std::to_string(iterations_)}, {"THRESHOLD", number(threshold_)}, {"VERTICAL", vertical_},
-        {"BELHADJ_SHARE", share_}, {"SEA_LEVEL", o.sea_level ? number(*o.sea_level) : "off"}};
-    auto opts = [&](const std::string& description, std::vector<std::pair<std::string, std::string>> extra = {}) {
-      WriteOptions w;
-      w.cog = cog_;
-      w.overwrite = overwrite_;
-      w.description = description;
-      w.deflate_level = 1;  // 13 M-cell float rasters: a third of the compression time, files ~4 % larger
-      w.metadata = provenance;
-      w.metadata.insert(w.metadata.end(), extra.begin(), extra.end());
-      return w;
-    };
     Raster<float> acc;
     if (wanted[2]) {
       acc = result.filled.like<float>(NAN);
@@ -159,7 +195,6 @@ class HydroCommand final : public Command {
       for (std::size_t i = 0; i < acc.size(); ++i) acc[i] = float(result.accumulation[i] * scale);
       result.accumulation = Raster<double>();  // release before writing
     }
-    const std::string acc_unit = units_ == "cells" ? "cells" : units_;
     std::vector<std::string> written;
     try {
       if (created) fs::create_directories(out_dir_);
@@ -174,15 +209,11 @@ class HydroCommand final : public Command {
         });
       if (wanted[1])
         writes.push_back([&, p = path(1)] {
-          write_raster(p, encode_d8(result.d8, codes),
-                       opts("D8 flow direction, " + describe(codes), {{"D8_CODES", codes_}, {"D8_CODES_DESCRIPTION", describe(codes)}}));
+          write_raster(p, encode_d8(result.d8, codes), opts(flowdir_description, flowdir_metadata));
         });
       if (wanted[2])
         writes.push_back([&, p = path(2)] {
-          write_raster(p, acc,
-                       opts("Upstream " + std::string(units_ == "cells" ? "cell count" : "area (" + acc_unit + ")") + ", " +
-                                flow_ + " routing" + (weights_.empty() ? "" : ", weighted"),
-                            {{"UNIT", acc_unit}}));
+          write_raster(p, acc, opts(acc_description, {{"UNIT", acc_unit}}));
         });
       if (wanted[3])
         writes.push_back([&, p = path(3)] { write_raster(p, result.hydrometry, opts("Hydrometry in [0,1] (" + hydrometry_ + ")")); });
@@ -204,10 +235,12 @@ class HydroCommand final : public Command {
 
  private:
   std::string dem_path_, out_dir_, fill_ = "priority-flood", flow_ = "d8", codes_ = "esri", hydrometry_ = "belhadj";
-  std::string outputs_ = "filled,flowdir,accumulation,hydrometry,streams";
+  static constexpr const char* kDefaultOutputs = "filled,flowdir,accumulation,hydrometry,streams";
+  std::string outputs_ = kDefaultOutputs;
   std::string vertical_ = "metres", share_ = "all", units_ = "m2", weights_, assume_crs_;
   double mfd_exponent_ = 1.1, threshold_ = 1.0 / 1048576, streams_km2_ = 10.0, sea_level_ = NAN;
-  int iterations_ = 0;
+  int iterations_ = 0, tile_size_ = 0;
+  double memory_limit_mb_ = 0;
   bool cog_ = false, overwrite_ = false, classify_ = false;
   RiverTypeOptions types_;
 };

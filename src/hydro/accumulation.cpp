@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "hydro/exact_accumulation.hpp"
 #include "hydro/grid.hpp"
 
 namespace terrapolis::hydro {
@@ -21,6 +22,17 @@ Raster<double> accumulate(const Dem& filled, const FlowRouter& router,
   if (options.weights && (options.weights->cols() != cols || options.weights->rows() != rows))
     throw bad_input("weights: raster is not on the DEM's grid");
   Raster<double> acc = filled.like<double>(0.0);
+  if (router.method() == FlowMethod::d8 && !options.weights) {
+    // Fixed-point sums, the same bits as the tile engine's whatever the tiling.
+    const FixedPointUnits units = fixed_point_units(metrics, cols, options.unit);
+    std::vector<std::int64_t> sum(filled.size(), 0);
+    for (int r = 0; r < rows; ++r)
+      for (int c = 0; c < cols; ++c)
+        if (!std::isnan(filled(c, r))) sum[acc.index(c, r)] = units.per_row[std::size_t(r)];
+    accumulate_d8_units(router.d8(), sum);
+    for (std::size_t i = 0; i < acc.size(); ++i) acc[i] = std::isnan(filled[i]) ? NAN : units.value(sum[i]);
+    return acc;
+  }
   // Own contributions; in-degrees of the receivers that lie inside the grid.
   BigVector<std::uint8_t> indegree(filled.size(), 0);
   BigVector<std::uint8_t> receivers(filled.size(), 0);  // bit k: neighbour k receives

@@ -21,19 +21,12 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "hydro/flood_queue.hpp"
 #include "hydro/grid.hpp"
+#include "hydro/spill_graph.hpp"
 
 namespace terrapolis::hydro {
 namespace {
-
-/// Queue key: the elevation's bits made order-preserving as an unsigned integer, then the cell
-/// index, so one 64-bit comparison orders by elevation and breaks ties by index (determinism).
-inline std::uint64_t key(float z, std::uint32_t i) {
-  std::uint32_t bits;
-  std::memcpy(&bits, &z, sizeof bits);
-  bits = (bits & 0x80000000u) ? ~bits : (bits | 0x80000000u);
-  return (std::uint64_t(bits) << 32) | i;
-}
 
 /// Binary heap on the keys: pops in (elevation, index) order, the order epsilon filling and
 /// breaching depend on.
@@ -50,51 +43,6 @@ class HeapQueue {
  private:
   std::priority_queue<std::uint64_t, std::vector<std::uint64_t>, std::greater<>> heap_;
 };
-
-/// Radix heap (Ahuja, Mehlhorn, Orlin, Tarjan 1990) on the 32 elevation bits of the keys: a
-/// monotone queue (Priority-Flood never pushes below the last popped elevation) in O(1) amortised
-/// per item instead of a heap's O(log n) cache misses. Equal elevations pop in no fixed index
-/// order, which plain filling does not see: its result, each cell raised to the lowest spill
-/// elevation of any path to an outlet, does not depend on the order of ties.
-class RadixQueue {
- public:
-  bool empty() const { return size_ == 0; }
-  void push(std::uint64_t item) {
-    buckets_[std::size_t(bucket(std::uint32_t(item >> 32)))].push_back(item);
-    ++size_;
-  }
-  std::uint64_t pop() {
-    if (buckets_[0].empty()) {
-      std::size_t b = 1;
-      while (buckets_[b].empty()) ++b;
-      std::uint32_t lowest = 0xffffffffu;
-      for (std::uint64_t item : buckets_[b]) lowest = std::min(lowest, std::uint32_t(item >> 32));
-      last_ = lowest;
-      for (std::uint64_t item : buckets_[b]) buckets_[std::size_t(bucket(std::uint32_t(item >> 32)))].push_back(item);
-      buckets_[b].clear();
-    }
-    const std::uint64_t item = buckets_[0].back();
-    buckets_[0].pop_back();
-    --size_;
-    return item;
-  }
-
- private:
-  int bucket(std::uint32_t key) const { return key == last_ ? 0 : 32 - std::countl_zero(key ^ last_); }
-  std::array<std::vector<std::uint64_t>, 33> buckets_;
-  std::uint32_t last_ = 0;
-  std::size_t size_ = 0;
-};
-
-/// The next cell to flood: the depression queue first (cells raised to the current spill), then
-/// the lowest of the priority queue.
-template <class Queue>
-std::uint32_t next_cell(Queue& open, std::deque<std::uint32_t>& pit) {
-  if (pit.empty()) return std::uint32_t(open.pop());
-  const std::uint32_t i = pit.front();
-  pit.pop_front();
-  return i;
-}
 
 /// The Priority-Flood of Barnes et al. 2014, Algorithm 2 (with its plain queue for cells inside
 /// depressions) or 3 (epsilon). `visit(cell, parent_direction)` is told the neighbour index k from
@@ -117,7 +65,7 @@ void priority_flood(Dem& z, const std::optional<double>& sea_level, bool epsilon
       }
       if (touches_outside(z, c, r) || is_sea(z[i], sea_level)) {
         closed[i] = 1;
-        open.push(key(z[i], std::uint32_t(i)));
+        open.push(flood_key(z[i], std::uint32_t(i)));
       }
     }
   std::size_t done = 0;
@@ -139,7 +87,7 @@ void priority_flood(Dem& z, const std::optional<double>& sea_level, bool epsilon
         if (raise) z[n] = spill;
         pit.push_back(std::uint32_t(n));
       } else {
-        open.push(key(z[n], std::uint32_t(n)));
+        open.push(flood_key(z[n], std::uint32_t(n)));
       }
     }
   }
@@ -235,10 +183,10 @@ void fill_strips(Dem& z, const std::optional<double>& sea_level, int strips, Pro
           } else if (edge_row || c == 0 || c == cols - 1 || (near_nodata && touches_outside(z, c, r)) ||
                      is_sea(z[i], sea_level)) {
             label[i] = 0;
-            open.push(key(z[i], std::uint32_t(i)));
+            open.push(flood_key(z[i], std::uint32_t(i)));
           } else if (cut) {
             label[i] = next++;
-            open.push(key(z[i], std::uint32_t(i)));
+            open.push(flood_key(z[i], std::uint32_t(i)));
           } else {
             label[i] = kOpen;
           }
@@ -270,7 +218,7 @@ void fill_strips(Dem& z, const std::optional<double>& sea_level, int strips, Pro
               z[n] = zc;
               pit.push_back(std::uint32_t(n));
             } else {
-              open.push(key(z[n], std::uint32_t(n)));
+              open.push(flood_key(z[n], std::uint32_t(n)));
             }
           } else if (ln != lc && ln != kVoid) {
             // Two watersheds meet. Both values are final (a cell is raised when it is reached),
@@ -290,11 +238,7 @@ void fill_strips(Dem& z, const std::optional<double>& sea_level, int strips, Pro
     nodes += labels_used[std::size_t(s)] - 1;
   }
   auto global = [&](int s, Label l) { return l == 0 ? 0u : base[std::size_t(s)] + l; };
-  struct Edge {
-    std::uint32_t a, b;
-    float spill;
-  };
-  std::vector<Edge> list;
+  std::vector<SpillEdge> list;
   for (int s = 0; s < strips; ++s)
     edges[std::size_t(s)].for_each(
         [&](std::uint32_t a, std::uint32_t b, float w) { list.push_back({global(s, Label(a)), global(s, Label(b)), w}); });
@@ -314,41 +258,7 @@ void fill_strips(Dem& z, const std::optional<double>& sea_level, int strips, Pro
       }
     }
   }
-  // Adjacency in compressed rows, then the graph's Priority-Flood from label 0.
-  std::vector<std::uint32_t> start(std::size_t(nodes) + 1, 0);
-  for (const Edge& e : list) {
-    ++start[e.a + 1];
-    ++start[e.b + 1];
-  }
-  for (std::size_t v = 0; v < nodes; ++v) start[v + 1] += start[v];
-  std::vector<std::pair<std::uint32_t, float>> adjacent(start[nodes]);
-  {
-    std::vector<std::uint32_t> fill_at(start.begin(), start.end() - 1);
-    for (const Edge& e : list) {
-      adjacent[fill_at[e.a]++] = {e.b, e.spill};
-      adjacent[fill_at[e.b]++] = {e.a, e.spill};
-    }
-  }
-  list = {};
-  std::vector<float> level(nodes, INFINITY);
-  std::vector<std::uint8_t> settled(nodes, 0);
-  std::priority_queue<std::pair<float, std::uint32_t>, std::vector<std::pair<float, std::uint32_t>>, std::greater<>> queue;
-  level[0] = -INFINITY;
-  queue.push({-INFINITY, 0});
-  while (!queue.empty()) {
-    const auto [w, v] = queue.top();
-    queue.pop();
-    if (settled[v]) continue;
-    settled[v] = 1;
-    for (std::uint32_t e = start[v]; e < start[v + 1]; ++e) {
-      const auto [u, spill] = adjacent[e];
-      const float l = std::max(w, spill);
-      if (l < level[u]) {
-        level[u] = l;
-        queue.push({l, u});
-      }
-    }
-  }
+  const std::vector<float> level = spill_levels(nodes, list);
   // Every valid cell is connected to a true outlet, so every label has a finite level.
   tbb::parallel_for(tbb::blocked_range<int>(0, strips, 1), [&](const tbb::blocked_range<int>& range) {
     for (int s = range.begin(); s < range.end(); ++s) {

@@ -43,6 +43,10 @@ std::uint8_t steepest(const Dem& z, const double* step, const std::optional<doub
 
 }  // namespace
 
+std::uint8_t d8_first_pass(const Dem& filled, const double* step, const std::optional<double>& sea_level, int col, int row) {
+  return steepest(filled, step, sea_level, col, row);
+}
+
 Raster<std::uint8_t> d8_directions(const Dem& filled, const CellMetrics& metrics, const std::optional<double>& sea_level,
                                    Progress& progress) {
   ProgressStep step(progress, "flow directions");

@@ -35,6 +35,12 @@ enum class D8Codes {
 Raster<std::uint8_t> d8_directions(const Dem& filled, const CellMetrics& metrics, const std::optional<double>& sea_level,
                                    Progress& progress);
 
+/// The first-pass D8 code of cell (col,row) of `filled`: the steepest strictly lower neighbour,
+/// kTerminal on sea, kNoData, the first outside neighbour for outlets without a lower one, or
+/// kNoFlow (flats, for drain_flats). `step` holds CellMetrics::step_m of the cell's row for k = 0..7.
+/// d8_directions applies it to every cell; the tile engine to tiles with a halo.
+std::uint8_t d8_first_pass(const Dem& filled, const double* step, const std::optional<double>& sea_level, int col, int row);
+
 /// File codes of `d8` in `convention` (uint8, nodata 255).
 Raster<std::uint8_t> encode_d8(const Raster<std::uint8_t>& d8, D8Codes convention);
 /// The file code of neighbour k (neighbours.hpp order: 0 = E, then clockwise) in a convention.
@@ -63,6 +69,8 @@ class FlowRouter {
   void split(int col, int row, FlowSplit& out) const;
   /// Bit k set when neighbour k receives water from (col,row) and lies inside the grid on valid data.
   std::uint8_t inner_receivers(int col, int row) const;
+  FlowMethod method() const { return method_; }
+  const Raster<std::uint8_t>& d8() const { return d8_; }
 
  private:
   const Dem& z_;

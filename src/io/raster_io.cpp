@@ -5,6 +5,7 @@
 #include <cpl_conv.h>
 #include <cpl_error.h>
 #include <gdal_priv.h>
+#include <gdal_utils.h>
 #include <gdalwarper.h>
 #include <tbb/global_control.h>
 
@@ -93,7 +94,7 @@ RasterHeader header_of(const std::string& path, GDALDataset& ds, const ReadOptio
   // Refuse before allocating anything: float values plus the working copies a stage makes.
   const double bytes = double(h.cols) * double(h.rows) * sizeof(float);
   const double memory = double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE));
-  if (double(h.cols) * double(h.rows) > double(std::numeric_limits<std::int32_t>::max()) || bytes * 4 > memory)
+  if (!options.windowed && (double(h.cols) * double(h.rows) > double(std::numeric_limits<std::int32_t>::max()) || bytes * 4 > memory))
     throw bad_input(path + ": size " + std::to_string(h.cols) + "x" + std::to_string(h.rows) + " (" +
                     std::to_string(std::int64_t(bytes / 1e6)) + " MB as float) is too large for this machine's memory");
   std::array<double, 6> gt;
@@ -134,6 +135,37 @@ GDALDataType gdal_type(std::uint16_t) { return GDT_UInt16; }
 GDALDataType gdal_type(std::int32_t) { return GDT_Int32; }
 GDALDataType gdal_type(std::uint32_t) { return GDT_UInt32; }
 
+/// Turns the raw values of a window (col0, row0) read into `dem` into metres, NaN on nodata (the
+/// nodata value, the mask band, non-finite values); returns the number of valid cells.
+std::size_t to_metres(const std::string& path, GDALRasterBand* band, const RasterHeader& h, double vfactor, int col0, int row0,
+                      Dem& dem) {
+  // A mask band that is not just "nodata value" or "all valid" (alpha, internal mask) also hides cells.
+  std::vector<std::uint8_t> mask;
+  const int flags = band->GetMaskFlags();
+  if (!(flags & GMF_ALL_VALID) && !(flags & GMF_NODATA)) {
+    mask.resize(dem.size());
+    QuietGdal quiet;
+    if (band->GetMaskBand()->RasterIO(GF_Read, col0, row0, dem.cols(), dem.rows(), mask.data(), dem.cols(), dem.rows(), GDT_Byte, 0, 0) != CE_None)
+      throw bad_input(path + ": corrupt mask band (" + detail::last_gdal_error("read failed") + ")");
+  }
+  // Compare in float: the nodata value went through the same conversion as the data.
+  const bool has_nd = h.nodata.has_value() && !std::isnan(*h.nodata);
+  const float nd = has_nd ? float(*h.nodata) : 0.0f;
+  const double factor = h.scale * vfactor, offset = h.offset * vfactor;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  std::size_t valid = 0;
+  for (std::size_t i = 0; i < dem.size(); ++i) {
+    float& v = dem[i];
+    if ((has_nd && v == nd) || (!mask.empty() && mask[i] == 0) || !std::isfinite(v)) {
+      v = nan;
+      continue;
+    }
+    if (factor != 1.0 || offset != 0.0) v = float(v * factor + offset);
+    ++valid;
+  }
+  return valid;
+}
+
 }  // namespace
 
 void init_gdal() {
@@ -163,30 +195,7 @@ Dem read_dem(const std::string& path, const ReadOptions& options) {
     if (band->RasterIO(GF_Read, 0, 0, h.cols, h.rows, dem.data(), h.cols, h.rows, GDT_Float32, 0, 0) != CE_None)
       throw bad_input(path + ": corrupt or truncated (" + detail::last_gdal_error("read failed") + ")");
   }
-  // A mask band that is not just "nodata value" or "all valid" (alpha, internal mask) also hides cells.
-  std::vector<std::uint8_t> mask;
-  const int flags = band->GetMaskFlags();
-  if (!(flags & GMF_ALL_VALID) && !(flags & GMF_NODATA)) {
-    mask.resize(dem.size());
-    QuietGdal quiet;
-    if (band->GetMaskBand()->RasterIO(GF_Read, 0, 0, h.cols, h.rows, mask.data(), h.cols, h.rows, GDT_Byte, 0, 0) != CE_None)
-      throw bad_input(path + ": corrupt mask band (" + detail::last_gdal_error("read failed") + ")");
-  }
-  // Compare in float: the nodata value went through the same conversion as the data.
-  const bool has_nd = h.nodata.has_value() && !std::isnan(*h.nodata);
-  const float nd = has_nd ? float(*h.nodata) : 0.0f;
-  const double factor = h.scale * vfactor, offset = h.offset * vfactor;
-  const float nan = std::numeric_limits<float>::quiet_NaN();
-  std::size_t valid = 0;
-  for (std::size_t i = 0; i < dem.size(); ++i) {
-    float& v = dem[i];
-    if ((has_nd && v == nd) || (!mask.empty() && mask[i] == 0) || !std::isfinite(v)) {
-      v = nan;
-      continue;
-    }
-    if (factor != 1.0 || offset != 0.0) v = float(v * factor + offset);
-    ++valid;
-  }
+  const std::size_t valid = to_metres(path, band, h, vfactor, 0, 0, dem);
   if (valid == 0) throw bad_input(path + ": holds no data (every cell is nodata)");
   return dem;
 }
@@ -321,5 +330,101 @@ template void write_raster(const std::string&, const Raster<std::int16_t>&, cons
 template void write_raster(const std::string&, const Raster<std::uint16_t>&, const WriteOptions&);
 template void write_raster(const std::string&, const Raster<std::int32_t>&, const WriteOptions&);
 template void write_raster(const std::string&, const Raster<std::uint32_t>&, const WriteOptions&);
+
+struct DemWindowReader::Dataset {
+  DatasetPtr dataset;
+  GDALRasterBand* band = nullptr;
+  double vfactor = 1.0;
+  std::mutex mutex;  // GDAL datasets are not thread-safe
+};
+
+DemWindowReader::DemWindowReader(const std::string& path, ReadOptions options)
+    : path_(path), dataset_(std::make_unique<Dataset>()) {
+  options.windowed = true;
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) {
+    std::vector<std::string> tiles;
+    for (const auto& entry : fs::directory_iterator(path, ec)) {
+      std::string ext = entry.path().extension().string();
+      std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+      if (entry.is_regular_file() && (ext == ".tif" || ext == ".tiff")) tiles.push_back(entry.path().string());
+    }
+    if (tiles.empty()) throw bad_input(path + ": folder holds no GeoTIFF tile (.tif)");
+    std::sort(tiles.begin(), tiles.end());  // a fixed order: where tiles overlap, the last one wins
+    // A VRT would leave out tiles of another CRS and resample those of another resolution: refuse them.
+    std::array<double, 6> first{};
+    OGRSpatialReference first_srs;
+    for (std::size_t i = 0; i < tiles.size(); ++i) {
+      auto tile = open_raster(tiles[i]);
+      std::array<double, 6> gt{};
+      if (tile->GetGeoTransform(gt.data()) != CE_None) throw bad_input(tiles[i] + ": has no geotransform (not georeferenced)");
+      const OGRSpatialReference* srs = tile->GetSpatialRef();
+      if (i == 0) {
+        first = gt;
+        if (srs) first_srs = *srs;
+      } else if (gt[1] != first[1] || gt[5] != first[5] || gt[2] != first[2] || gt[4] != first[4]) {
+        throw bad_input(tiles[i] + ": cell size differs from " + tiles[0] + "'s; the tiles of a mosaic share one grid");
+      } else if ((srs == nullptr) != first_srs.IsEmpty() || (srs && !srs->IsSame(&first_srs))) {
+        throw bad_input(tiles[i] + ": CRS differs from " + tiles[0] + "'s; the tiles of a mosaic share one CRS");
+      }
+    }
+    std::vector<const char*> names;
+    for (const auto& t : tiles) names.push_back(t.c_str());
+    init_gdal();
+    QuietGdal quiet;
+    int usage_error = 0;
+    GDALDatasetH vrt = GDALBuildVRT("", int(names.size()), nullptr, names.data(), nullptr, &usage_error);
+    if (!vrt) throw bad_input(path + ": cannot join its tiles (" + detail::last_gdal_error("unknown error") + ")");
+    dataset_->dataset.reset(GDALDataset::FromHandle(vrt));
+  } else {
+    dataset_->dataset = open_raster(path);
+  }
+  header_ = header_of(path, *dataset_->dataset, options, dataset_->band, dataset_->vfactor);
+}
+
+DemWindowReader::~DemWindowReader() = default;
+
+Dem DemWindowReader::read(int col0, int row0, int cols, int rows) const {
+  Georef georef = header_.georef;
+  const GeoTransform& gt = header_.georef.transform;
+  georef.transform[0] = gt[0] + col0 * gt[1] + row0 * gt[2];
+  georef.transform[3] = gt[3] + col0 * gt[4] + row0 * gt[5];
+  Dem window(cols, rows, georef, std::numeric_limits<float>::quiet_NaN());
+  const int c0 = std::max(col0, 0), r0 = std::max(row0, 0);
+  const int c1 = std::min(col0 + cols, header_.cols), r1 = std::min(row0 + rows, header_.rows);
+  if (c0 >= c1 || r0 >= r1) return window;
+  Dem part(c1 - c0, r1 - r0, georef);
+  {
+    std::lock_guard lock(dataset_->mutex);
+    QuietGdal quiet;
+    if (dataset_->band->RasterIO(GF_Read, c0, r0, part.cols(), part.rows(), part.data(), part.cols(), part.rows(), GDT_Float32, 0,
+                                 0) != CE_None)
+      throw bad_input(path_ + ": corrupt or truncated (" + detail::last_gdal_error("read failed") + ")");
+    to_metres(path_, dataset_->band, header_, dataset_->vfactor, c0, r0, part);
+  }
+  for (int r = 0; r < part.rows(); ++r)
+    std::copy_n(&part(0, r), part.cols(), &window(c0 - col0, r0 - row0 + r));
+  return window;
+}
+
+void write_vrt(const std::string& path, const std::vector<std::string>& tiles, bool overwrite) {
+  init_gdal();
+  detail::check_output(path, overwrite);
+  std::vector<const char*> names;
+  for (const auto& t : tiles) names.push_back(t.c_str());
+  const std::string tmp = detail::temporary_name(path);
+  QuietGdal quiet;
+  int usage_error = 0;
+  GDALDatasetH vrt = GDALBuildVRT(tmp.c_str(), int(names.size()), nullptr, names.data(), nullptr, &usage_error);
+  const bool ok = vrt && CPLGetLastErrorType() < CE_Failure;
+  if (vrt) GDALClose(vrt);
+  if (!ok) {
+    const std::string msg = detail::last_gdal_error("write failed");
+    detail::discard_file(tmp);
+    throw bad_input(path + ": cannot write output (" + msg + ")");
+  }
+  detail::commit_file(tmp, path);
+}
 
 }  // namespace terrapolis

@@ -1,6 +1,7 @@
 // Reading DEMs and rasters from any GDAL format, and writing GeoTIFF / Cloud Optimized GeoTIFF.
 // SPDX-License-Identifier: MIT
 #pragma once
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
@@ -16,6 +17,8 @@ void init_gdal();
 struct ReadOptions {
   std::optional<int> band;                ///< 1-based band; required for multi-band files
   std::optional<std::string> assume_crs;  ///< CRS for files that carry none ("EPSG:n", WKT, PROJ)
+  /// The raster is read by windows (DemWindowReader): no whole-raster size check.
+  bool windowed = false;
 };
 
 /// What a raster file holds, read from its header only (no pixel is read).
@@ -59,6 +62,31 @@ struct WriteOptions {
 /// uint8, int16, uint16, int32, uint32.
 template <class T>
 void write_raster(const std::string& path, const Raster<T>& raster, const WriteOptions& options = {});
+
+/// Reads windows of an elevation model too large to hold whole: a GeoTIFF (BigTIFF), a GDAL VRT
+/// mosaic, or a folder of GeoTIFF tiles (joined into an in-memory VRT, which refuses tiles of
+/// different CRSs or resolutions). Values as read_dem's: metres, NaN nodata.
+class DemWindowReader {
+ public:
+  explicit DemWindowReader(const std::string& path, ReadOptions options = {});
+  ~DemWindowReader();
+  DemWindowReader(const DemWindowReader&) = delete;
+  DemWindowReader& operator=(const DemWindowReader&) = delete;
+  const RasterHeader& header() const { return header_; }
+  /// The cells [col0, col0 + cols) x [row0, row0 + rows); those outside the raster are NaN. The
+  /// georeferencing is the window's. Serialised: one reader may be shared between threads.
+  Dem read(int col0, int row0, int cols, int rows) const;
+
+ private:
+  struct Dataset;
+  std::string path_;
+  RasterHeader header_;
+  std::unique_ptr<Dataset> dataset_;
+};
+
+/// Writes a GDAL VRT mosaic of `tiles` (paths stored relative to the VRT's folder) under a
+/// temporary name, then renames it.
+void write_vrt(const std::string& path, const std::vector<std::string>& tiles, bool overwrite);
 
 /// Refuses an output path that exists (unless overwrite) or whose folder is missing or read-only.
 void check_output_path(const std::string& path, bool overwrite);

@@ -1,0 +1,34 @@
+// `terrapolis hydro` on a mosaic, tile by tile (--tile-size / --memory-limit).
+// SPDX-License-Identifier: MIT
+#pragma once
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "cli/command.hpp"
+#include "hydro/accumulation.hpp"
+#include "hydro/flow_directions.hpp"
+#include "io/raster_io.hpp"
+
+namespace terrapolis::cli {
+
+struct TiledHydroRequest {
+  std::string dem_path, out_dir;
+  ReadOptions read;
+  int tile_size = 0;             ///< 0: from memory_limit_mb
+  double memory_limit_mb = 1024;
+  std::optional<double> sea_level;
+  hydro::AccumulationUnit unit = hydro::AccumulationUnit::area_m2;
+  double accumulation_scale = 1;  ///< file value = accumulation x scale (km2: 1e-6)
+  hydro::D8Codes codes = hydro::D8Codes::esri;
+  bool filled = true, flowdir = true, accumulation = true;
+  WriteOptions filled_file, flowdir_file, accumulation_file;  ///< description, metadata, COG, overwrite
+};
+
+/// Writes OUTDIR/filled.vrt, flowdir.vrt, accumulation.vrt over one GeoTIFF a tile in
+/// OUTDIR/filled/, flowdir/, accumulation/ (tile_RRRR_CCCC.tif); the same cells as the whole-grid
+/// command. Returns the log line.
+std::string run_tiled_hydro_command(const TiledHydroRequest& request, Context& context);
+
+}  // namespace terrapolis::cli

@@ -1,0 +1,91 @@
+// The tile engine of the hydrology stage: fill, D8 directions and accumulation of a mosaic read
+// and written tile by tile, in bounded memory, bit-identical to the whole-grid computation.
+// SPDX-License-Identifier: MIT
+#pragma once
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/progress.hpp"
+#include "core/raster.hpp"
+#include "hydro/accumulation.hpp"
+
+namespace terrapolis::hydro::tiled {
+
+/// A rectangle of cells of the mosaic.
+struct TileRect {
+  int col0 = 0, row0 = 0, cols = 0, rows = 0;
+};
+
+/// The mosaic cut into tiles of about `tile_size` cells a side (at least 8): tiles of a row or a
+/// column of tiles differ by at most one cell, tiles are numbered row-major from the north-west.
+class TileGrid {
+ public:
+  TileGrid(int cols, int rows, int tile_size);
+  int count() const { return across() * down(); }
+  int across() const { return int(col_bounds_.size()) - 1; }
+  int down() const { return int(row_bounds_.size()) - 1; }
+  int cols() const { return col_bounds_.back(); }
+  int rows() const { return row_bounds_.back(); }
+  TileRect rect(int tile) const;
+  /// The tile holding cell (col,row) of the mosaic (inside it).
+  int tile_of(int col, int row) const;
+
+ private:
+  std::vector<int> col_bounds_, row_bounds_;
+};
+
+/// Reads cells [col0, col0+cols) x [row0, row0+rows) of the mosaic's DEM (metres, NaN nodata;
+/// NaN outside the mosaic). Called from several threads at once.
+using ReadWindow = std::function<Dem(int col0, int row0, int cols, int rows)>;
+
+/// What the engine hands out, one tile at a time (from several threads at once), each raster on
+/// its tile's grid and georeferencing; an empty function skips that output's work where it can.
+struct TileSinks {
+  std::function<void(int tile, const Dem& filled)> filled;
+  std::function<void(int tile, const Raster<std::uint8_t>& d8)> d8;  ///< flow_directions.hpp codes
+  std::function<void(int tile, const Raster<double>& accumulation)> accumulation;
+};
+
+struct TiledOptions {
+  /// Tile side in cells; 0: the largest that keeps the state within memory_limit_mb.
+  int tile_size = 0;
+  /// Memory for the engine's state (tiles being processed, the global graphs), MB.
+  double memory_limit_mb = 1024;
+  /// Tiles processed at once (each holds its state): 0 = as many as threads allowed.
+  int concurrent_tiles = 0;
+  std::optional<double> sea_level;
+  AccumulationUnit unit = AccumulationUnit::area_m2;
+  /// Folder for the D8 codes kept between passes (1 byte a cell, removed at the end).
+  std::string scratch_dir;
+};
+
+/// What a run did, for logs and the memory bound.
+struct TiledReport {
+  int tile_size = 0, tiles = 0, concurrent_tiles = 0;
+  std::uint64_t labels = 0, spill_edges = 0;   ///< Barnes 2016 spillover graph
+  std::uint64_t flat_cells_shared = 0;          ///< cells of flats that cross tile edges, solved globally
+  std::uint64_t links = 0;                      ///< Barnes 2017: flow paths leaving a tile
+  double tile_state_bytes = 0;                  ///< per tile processed at once
+  double global_state_bytes = 0;                ///< at the largest: frames plus the spill graph, shared flats or links
+};
+
+/// Bytes of state per cell of a tile processed at once (the largest pass: the fill's labels and
+/// queue, the halo windows, the flat resolution's arrays), used to size tiles from a memory limit.
+inline constexpr double kTileBytesPerCell = 48;
+
+/// The tile side that keeps `concurrent` tiles and the global state of a cols x rows mosaic
+/// within `memory_limit_mb`; throws bad_input when not even 64-cell tiles fit.
+int tile_size_for(int cols, int rows, double memory_limit_mb, int concurrent);
+
+/// Runs priority-flood filling (Barnes 2016), D8 with flat resolution (Barnes et al. 2014b, flats
+/// that cross tile edges gathered and solved whole) and D8 accumulation (Barnes 2017, fixed-point
+/// sums) on a `cols` x `rows` mosaic georeferenced by `georef`. The tiles handed to `sinks`,
+/// put together, equal fill_depressions (priority_flood), d8_directions and accumulate (D8) on the
+/// whole grid bit for bit, for any tile size. Deterministic for any thread count.
+TiledReport run_tiled_hydro(int cols, int rows, const Georef& georef, const ReadWindow& read, const TiledOptions& options,
+                            const TileSinks& sinks, Progress& progress);
+
+}  // namespace terrapolis::hydro::tiled

@@ -1,0 +1,72 @@
+#!/usr/bin/env bash
+# `terrapolis hydro` tile by tile (--tile-size, --memory-limit, a folder of tiles, a VRT): the
+# mosaic of its tiles equals the whole-grid outputs cell for cell; refusals; nothing left behind.
+# SPDX-License-Identifier: MIT
+source "$(dirname "$0")/lib.sh" "$@"
+bin=$TP samples=$SAMPLES work=$WORK
+
+# same_cells A B: two rasters (any GDAL format, e.g. a VRT of tiles) hold the same cells, byte for
+# byte (both copied to raw ENVI files and compared), on the same grid.
+same_cells() {
+  rm -f "$WORK"/[ab].*
+  GDAL_PAM_ENABLED=NO gdal_translate -q -of ENVI "$1" "$WORK/a.bin" && GDAL_PAM_ENABLED=NO gdal_translate -q -of ENVI "$2" "$WORK/b.bin"
+  cmp -s "$WORK/a.bin" "$WORK/b.bin" || { echo "$1 and $2: cells differ"; return 1; }
+  [[ $(gdalinfo "$1" | grep -E "^(Size is|Origin|Pixel Size)") == $(gdalinfo "$2" | grep -E "^(Size is|Origin|Pixel Size)") ]] ||
+    { echo "$1 and $2: grids differ"; return 1; }
+}
+outputs=(filled flowdir accumulation)
+
+# SRTM 1" of Zion (geographic) cut into 3 x 3 input tiles; processed on 5 x 5 tiles of 100.
+zion=$samples/spDataLarge_srtm_zion.tif
+mkdir "$work/zion_tiles"
+for i in 0 1 2; do for j in 0 1 2; do  # 465 x 457 cells: columns 3 x 155, rows 152 + 152 + 153
+  gdal_translate -q -srcwin $((i * 155)) $((j * 152)) 155 $((j == 2 ? 153 : 152)) "$zion" "$work/zion_tiles/z_${j}_${i}.tif"
+done; done
+"$bin" -q hydro "$zion" "$work/zion_whole" --outputs filled,flowdir,accumulation
+"$bin" -q hydro "$work/zion_tiles" "$work/zion_tiled" --tile-size 100
+for o in "${outputs[@]}"; do
+  same_cells "$work/zion_whole/$o.tif" "$work/zion_tiled/$o.vrt" || fail "zion: tiled $o differs"
+  [[ $(ls "$work/zion_tiled/$o"/tile_*.tif | wc -l) -eq 25 ]] || fail "zion: expected 25 $o tiles"
+done
+gdalinfo "$work/zion_tiled/flowdir/tile_0002_0003.tif" | grep -q "D8_CODES=esri" || fail "tile without its metadata"
+gdalinfo "$work/zion_tiled/filled.vrt" | grep -q 'ID\["EPSG",4326\]' || fail "VRT without the CRS"
+
+# Corsica (sea level, coast) through a VRT with km2 and TauDEM codes, on one thread.
+gdalbuildvrt -q "$work/corsica.vrt" "$samples/gebco2022_15s_north_corsica_capcorse.asc"
+"$bin" -q hydro "$samples/gebco2022_15s_north_corsica_capcorse.asc" "$work/cor_whole" --sea-level 0 --area-units km2 \
+  --d8-codes taudem --outputs filled,flowdir,accumulation
+"$bin" -q hydro "$work/corsica.vrt" "$work/cor_tiled" --sea-level 0 --area-units km2 --d8-codes taudem --tile-size 40 --threads 1
+for o in "${outputs[@]}"; do same_cells "$work/cor_whole/$o.tif" "$work/cor_tiled/$o.vrt" || fail "corsica: tiled $o differs"; done
+
+# NZ (NaN nodata) at twice its resolution: 6.5 M cells, 26 MB as float, within a memory limit of
+# 20 MB for the engine's state (checked from its report): many tiles, the same cells.
+nz=$work/nz2.tif
+gdal_translate -q -outsize 200% 200% -r bilinear "$samples/spDataLarge_nz_elev.tif" "$nz"
+"$bin" -q hydro "$nz" "$work/nz_whole" --outputs filled,flowdir,accumulation --area-units cells
+"$bin" -v hydro "$nz" "$work/nz_tiled" --memory-limit 20 --area-units cells --threads 1 2>"$work/nz.log"
+for o in "${outputs[@]}"; do same_cells "$work/nz_whole/$o.tif" "$work/nz_tiled/$o.vrt" || fail "nz: tiled $o differs"; done
+line=$(grep "^tiles: " "$work/nz.log") || fail "no tile report: $(cat "$work/nz.log")"
+[[ $line =~ ^tiles:\ ([0-9]+)\ of\ [0-9]+\ cells\ a\ side,\ ([0-9]+)\ at\ once.*state\ ([0-9.]+)\ MB\ a\ tile\ \+\ ([0-9.]+)\ MB\ global ]] ||
+  fail "unreadable tile report: $line"
+(( BASH_REMATCH[1] > 20 )) || fail "expected many tiles: $line"
+awk -v n="${BASH_REMATCH[2]}" -v t="${BASH_REMATCH[3]}" -v g="${BASH_REMATCH[4]}" 'BEGIN { exit !(n * t + g <= 20.0) }' ||
+  fail "state over the memory limit: $line"
+[[ -z $(ls -A "$work/nz_tiled" | grep scratch) ]] || fail "scratch folder left behind"
+no_leftovers "$work"
+
+# Refusals: exit 2, nothing written.
+expect_refused "$work/r1" "only --fill priority-flood" "$bin" hydro "$zion" "$work/r1" --tile-size 64 --fill breach
+expect_refused "$work/r2" "not computed on tiles" "$bin" hydro "$zion" "$work/r2" --tile-size 64 --outputs filled,streams
+expect_refused "$work/r3" "at least 8" "$bin" hydro "$zion" "$work/r3" --tile-size 3
+expect_refused "$work/r4" "too little" "$bin" hydro "$nz" "$work/r4" --memory-limit 1
+mkdir "$work/empty"
+expect_refused "$work/r5" "no GeoTIFF tile" "$bin" hydro "$work/empty" "$work/r5"
+mkdir "$work/mixed"
+cp "$work/zion_tiles/z_0_0.tif" "$work/mixed/"
+gdal_translate -q -tr 0.001 0.001 "$work/zion_tiles/z_0_1.tif" "$work/mixed/z_0_1.tif"
+expect_refused "$work/r6" "cell size differs" "$bin" hydro "$work/mixed" "$work/r6"
+expect_fail 2 "exists" "$bin" hydro "$zion" "$work/zion_tiled" --tile-size 100
+"$bin" -q hydro "$work/zion_tiles" "$work/zion_tiled" --tile-size 200 --overwrite
+same_cells "$work/zion_whole/accumulation.tif" "$work/zion_tiled/accumulation.vrt" || fail "zion: overwrite differs"
+[[ $(ls "$work/zion_tiled/accumulation" | wc -l) -eq 9 ]] || fail "zion: the tiles of the first run were left beside the new ones"
+echo ok
