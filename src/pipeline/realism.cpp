@@ -35,13 +35,13 @@ std::vector<std::string> settlement_warnings(const RunState& s, const sites::Sit
       continue;
     }
     bool same = true;
-    for (int dr = -2; dr <= 2 && same; ++dr)
-      for (int dc = -2; dc <= 2 && same; ++dc)
+    for (int dr = -4; dr <= 4 && same; ++dr)
+      for (int dc = -4; dc <= 4 && same; ++dc)
         same = dem.inside(site.col + dc, site.row + dr) && dem(site.col + dc, site.row + dr) == z;
     if (same && flat++ == 0) first_flat = "city " + std::to_string(site.id) + " at " + std::to_string(int(std::lround(z))) + " m";
   }
   if (flat)
-    warnings.push_back(std::to_string(flat) + " settlement(s) on a perfectly flat surface (5 x 5 cells of one altitude, e.g. " + first_flat +
+    warnings.push_back(std::to_string(flat) + " settlement(s) on a perfectly flat surface (9 x 9 cells of one altitude, e.g. " + first_flat +
                        "): a lake or reservoir in SRTM-like DEMs; pass it as water (water.water_mask) or check");
   if (nodata) warnings.push_back(std::to_string(nodata) + " settlement(s) centred on a nodata cell");
   if (r.land_area_km2 > 0 && r.target_population / r.land_area_km2 > kPlausiblePeoplePerKm2)

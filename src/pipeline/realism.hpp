@@ -11,7 +11,7 @@
 
 namespace terrapolis::pipeline {
 
-/// Warnings on the placed settlements: a centre on a flat surface (5 x 5 cells of one altitude,
+/// Warnings on the placed settlements: a centre on a flat surface (9 x 9 cells of one altitude,
 /// a lake in SRTM), on nodata, and a population implausibly dense for the land area.
 std::vector<std::string> settlement_warnings(const RunState& state, const sites::SitesResult& result);
 

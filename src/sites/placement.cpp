@@ -162,6 +162,8 @@ SitesResult place_sites(const Raster<float>& density, const Raster<std::uint8_t>
     table = rank_size_quotas(cell_size, rank_size_populations(result.target_population, options.zipf_exponent, options.min_population),
                              options);
     if (options.refill_rounds < 0 || options.candidates < 0) throw bad_input("sites: candidates and refill rounds must be >= 0");
+    if (options.r_min_m > 0 || options.r_max_m > 0)
+      throw bad_input("sites: r_min and r_max set the classes of the belhadj2007 quotas; with rank_size the radii come from the populations");
   }
   const int n = int(table.classes.size());
   // Ascending radius index i of Algorithm 14 (r = r_min + i dr); class = n - 1 - i.
