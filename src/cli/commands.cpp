@@ -14,6 +14,7 @@ std::vector<std::unique_ptr<Command>> all_commands() {
   commands.push_back(make_lake_command());
   commands.push_back(make_density_command());
   commands.push_back(make_sites_command());
+  commands.push_back(make_calibrate_command());
   commands.push_back(make_network_command());
   commands.push_back(make_path_command());
   commands.push_back(make_roads_command());

@@ -30,6 +30,7 @@ class RunCommand final : public Command {
     app.add_option("--only", only_, "Rerun only these stages (later stages keep their saved, now stale, results)")
         ->expected(1, -1)
         ->check(CLI::IsMember(stages));
+    app.add_option("--until", until_, "Stop after this stage (the run folder holds the stages up to it)")->check(CLI::IsMember(stages));
     app.add_flag("--print-scenario", print_, "Print the resolved scenario (defaults filled) and exit");
   }
   void run(Context& context) override {
@@ -45,6 +46,7 @@ class RunCommand final : public Command {
     options.overwrite = overwrite_;
     options.from = from_;
     options.only = only_;
+    options.until = until_;
     const auto manifest = pipeline::run_scenario(scenario, options, context.progress, context.log);
     if (context.log.level() != LogLevel::quiet) {
       std::printf("%s", pipeline::format_summary(manifest).c_str());
@@ -53,7 +55,7 @@ class RunCommand final : public Command {
   }
 
  private:
-  std::string file_, output_, from_;
+  std::string file_, output_, from_, until_;
   std::vector<std::string> sets_, only_;
   long long seed_ = -1;
   bool overwrite_ = false, print_ = false;

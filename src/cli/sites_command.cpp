@@ -87,6 +87,12 @@ class SitesCommand final : public Command {
     app.add_option("--disc-test", disc_test_, "exact: whole disc clear of uninhabitable cells; perimeter: only each circle, as the thesis")
         ->check(CLI::IsMember({"exact", "perimeter"}))
         ->capture_default_str();
+    app.add_option("--quotas", quotas_, "Sizes: rank_size (the region's population by a rank-size law) or belhadj2007 (the thesis's census table)")
+        ->check(CLI::IsMember({"rank_size", "belhadj2007"}))
+        ->capture_default_str();
+    app.add_option("--population", options_.population, "rank_size: people in the region (0: 60 people/km2 of buildable land, the world average)")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
     app.add_option("--candidates", options_.candidates, "Candidate positions M (0: 20 x the number of sites)")->check(CLI::NonNegativeNumber);
     app.add_option("--r-min", options_.r_min_m, "Smallest radius, metres (0: the class step dr)")->check(CLI::NonNegativeNumber);
     app.add_option("--r-max", options_.r_max_m, "Radii run up to r_max - dr, metres (0: 1e6 people / 400 + dr)")->check(CLI::NonNegativeNumber);
@@ -104,6 +110,7 @@ class SitesCommand final : public Command {
 
   void run(Context& context) override {
     options_.mode = mode_ == "manhattan" ? sites::SitesOptions::Mode::manhattan : sites::SitesOptions::Mode::paris;
+    options_.quotas = quotas_ == "belhadj2007" ? sites::SitesOptions::Quotas::belhadj2007 : sites::SitesOptions::Quotas::rank_size;
     options_.disc_test = disc_test_ == "perimeter" ? sites::SitesOptions::DiscTest::perimeter : sites::SitesOptions::DiscTest::exact;
     OutputDir outputs(out_, {"cities.geojson", "city_extents.geojson"}, overwrite_);
     const auto t0 = std::chrono::steady_clock::now();
@@ -131,12 +138,15 @@ class SitesCommand final : public Command {
       }
       std::printf("total %9s %7d %7d %7zu\n", "", quota, placed, result.sites.size());
     }
+    if (options_.quotas == sites::SitesOptions::Quotas::rank_size)
+      std::printf("sites: %.0f people (%s), rank-size law down to %.0f\n", result.target_population,
+                  result.population_assumed ? "assumed: default people/km2 x buildable land" : "given", options_.min_population);
     std::printf("sites: %zu cities (%d roots, %zu suburbs) from %d candidates, dr %.0f m, seed %llu\n", result.sites.size(), roots,
                 result.sites.size() - std::size_t(roots), result.candidates, result.dr_m, static_cast<unsigned long long>(result.seed));
   }
 
  private:
-  std::string dir_, out_, mode_ = "paris", disc_test_ = "exact";
+  std::string dir_, out_, mode_ = "paris", disc_test_ = "exact", quotas_ = "rank_size";
   sites::SitesOptions options_;
   bool report_ = false, overwrite_ = false;
 };

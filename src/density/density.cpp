@@ -79,6 +79,10 @@ void check_options(const Dem& dem, const Raster<float>& hydrometry, const Densit
     if (!std::isfinite(w)) throw bad_input("--weights: weights must be finite numbers");
     any = any || w != 0;
   }
+  for (double w : o.terrain_weights) {
+    if (!std::isfinite(w)) throw bad_input("density: terrain weights must be finite numbers");
+    any = any || w != 0;
+  }
   for (const auto& [path, w] : o.layers) {
     if (!std::isfinite(w)) throw bad_input("--layer " + path + ": weight must be a finite number");
     any = any || w != 0;
@@ -125,7 +129,91 @@ Raster<float> read_layer(const std::string& path, const Dem& dem) {
   return layer;
 }
 
+/// The 1-D squared distance transform of f sampled at increasing positions y (Felzenszwalb &
+/// Huttenlocher 2012, non-uniform samples): d[q] = min_p f[p] + (y[q] - y[p])^2.
+void lower_envelope(const std::vector<double>& y, const std::vector<double>& f, std::vector<double>& d, std::vector<int>& v,
+                    std::vector<double>& z) {
+  const int n = int(y.size());
+  int k = -1;
+  for (int q = 0; q < n; ++q) {
+    if (!std::isfinite(f[std::size_t(q)])) continue;
+    while (k >= 0) {
+      const int p = v[std::size_t(k)];
+      const double s = ((f[std::size_t(q)] + y[std::size_t(q)] * y[std::size_t(q)]) - (f[std::size_t(p)] + y[std::size_t(p)] * y[std::size_t(p)])) /
+                       (2 * (y[std::size_t(q)] - y[std::size_t(p)]));
+      if (s <= z[std::size_t(k)]) --k;
+      else {
+        z[std::size_t(k + 1)] = s;
+        break;
+      }
+    }
+    if (k < 0) z[0] = -std::numeric_limits<double>::infinity();
+    v[std::size_t(++k)] = q;
+    z[std::size_t(k + 1)] = std::numeric_limits<double>::infinity();
+  }
+  if (k < 0) {
+    std::fill(d.begin(), d.end(), std::numeric_limits<double>::infinity());
+    return;
+  }
+  for (int q = 0, j = 0; q < n; ++q) {
+    while (z[std::size_t(j + 1)] < y[std::size_t(q)]) ++j;
+    const int p = v[std::size_t(j)];
+    d[std::size_t(q)] = f[std::size_t(p)] + (y[std::size_t(q)] - y[std::size_t(p)]) * (y[std::size_t(q)] - y[std::size_t(p)]);
+  }
+}
+
+/// Replaces each value by its rank among the raster's values (NaN skipped): the share of values
+/// below it, ties counted half, in [0,1]. Scale-free, so that "low for this region" means the same
+/// in the Alps and on a coastal plain.
+void to_land_rank(Raster<float>& r) {
+  std::vector<float> sorted;
+  for (std::size_t i = 0; i < r.size(); ++i)
+    if (!std::isnan(r[i])) sorted.push_back(r[i]);
+  std::sort(sorted.begin(), sorted.end());
+  const double n = double(sorted.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, r.size(), 1 << 14), [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t i = range.begin(); i < range.end(); ++i) {
+      if (std::isnan(r[i])) continue;
+      const auto lo = std::lower_bound(sorted.begin(), sorted.end(), r[i]), hi = std::upper_bound(lo, sorted.end(), r[i]);
+      r[i] = float((double(lo - sorted.begin()) + 0.5 * double(hi - lo)) / n);
+    }
+  });
+}
+
 }  // namespace
+
+std::vector<float> distance_to_m(const std::vector<std::uint8_t>& feature, const CellMetrics& metrics, int cols, int rows) {
+  const std::size_t n = std::size_t(cols) * std::size_t(rows);
+  std::vector<double> row_d2(n);
+  // Rows: squared metres to the nearest feature of the row, at the row's width.
+  tbb::parallel_for(tbb::blocked_range<int>(0, rows, 8), [&](const tbb::blocked_range<int>& range) {
+    std::vector<double> y(static_cast<std::size_t>(cols)), f(static_cast<std::size_t>(cols)), d(static_cast<std::size_t>(cols)),
+        z(std::size_t(cols) + 1);
+    std::vector<int> v(static_cast<std::size_t>(cols));
+    for (int r = range.begin(); r < range.end(); ++r) {
+      const double w = metrics.width_m[std::size_t(r)];
+      for (int c = 0; c < cols; ++c) {
+        y[std::size_t(c)] = c * w;
+        f[std::size_t(c)] = feature[std::size_t(r) * std::size_t(cols) + std::size_t(c)] ? 0.0 : std::numeric_limits<double>::infinity();
+      }
+      lower_envelope(y, f, d, v, z);
+      for (int c = 0; c < cols; ++c) row_d2[std::size_t(r) * std::size_t(cols) + std::size_t(c)] = d[std::size_t(c)];
+    }
+  });
+  std::vector<double> northing(static_cast<std::size_t>(rows), 0.0);
+  for (int r = 1; r < rows; ++r) northing[std::size_t(r)] = northing[std::size_t(r - 1)] + metrics.height_m[std::size_t(r)];
+  std::vector<float> out(n);
+  tbb::parallel_for(tbb::blocked_range<int>(0, cols, 16), [&](const tbb::blocked_range<int>& range) {
+    std::vector<double> f(static_cast<std::size_t>(rows)), d(static_cast<std::size_t>(rows)), z(std::size_t(rows) + 1);
+    std::vector<int> v(static_cast<std::size_t>(rows));
+    for (int c = range.begin(); c < range.end(); ++c) {
+      for (int r = 0; r < rows; ++r) f[std::size_t(r)] = row_d2[std::size_t(r) * std::size_t(cols) + std::size_t(c)];
+      lower_envelope(northing, f, d, v, z);
+      for (int r = 0; r < rows; ++r) out[std::size_t(r) * std::size_t(cols) + std::size_t(c)] = float(std::sqrt(d[std::size_t(r)]));
+    }
+  });
+  return out;
+}
 
 double combine(const double* weights, const double* values, std::size_t n) {
   double negative = 0, total = 0, sum = 0;
@@ -366,6 +454,39 @@ DensityResult compute_density(const Dem& dem, const Raster<float>& hydrometry, c
     divide_land_by_max(result.plateau, kind, result.buildable);
   }
 
+  // ---- terrain terms: altitude, slope, nearness to water and to rivers ----------------------
+  const bool terrain_used = std::any_of(options.terrain_weights.begin(), options.terrain_weights.end(), [](double w) { return w != 0; });
+  if (terrain_used || options.terrain_terms) {
+    ProgressStep step(progress, "density: terrain terms");
+    std::vector<std::uint8_t> wet(n), river(n, 0);
+    for (std::size_t i = 0; i < n; ++i) wet[i] = kind[i] == water;
+    const bool rivers_known = options.rivers.size() == n;
+    if (options.rivers.size() != 0 && !rivers_known) throw bad_input("rivers: not on the DEM's grid");
+    if (rivers_known)
+      for (std::size_t i = 0; i < n; ++i) river[i] = options.rivers[i] != 0 && options.rivers[i] != options.rivers.nodata;
+    const std::vector<float> to_water = any_water ? distance_to_m(wet, metrics, cols, rows) : std::vector<float>();
+    step.update(0.4);
+    const std::vector<float> to_river = rivers_known ? distance_to_m(river, metrics, cols, rows) : std::vector<float>();
+    step.update(0.8);
+    result.altitude = dem.like<float>(nan_f);
+    result.slope = dem.like<float>(nan_f);
+    result.coast_near = dem.like<float>(nan_f);
+    result.river_near = dem.like<float>(nan_f);
+    tbb::parallel_for(tbb::blocked_range<int>(0, rows, 8), [&](const tbb::blocked_range<int>& range) {
+      for (int r = range.begin(); r < range.end(); ++r)
+        for (int x = 0; x < cols; ++x) {
+          const std::size_t i = dem.index(x, r);
+          if (kind[i] != land) continue;
+          result.altitude[i] = dem[i];
+          result.slope[i] = slope_deg(dem, metrics, x, r);
+          result.coast_near[i] = any_water ? float(std::exp(-double(to_water[i]) / 10000.0)) : 0.0f;
+          result.river_near[i] = rivers_known ? float(std::exp(-double(to_river[i]) / 2000.0)) : 0.0f;
+        }
+    });
+    to_land_rank(result.altitude);
+    to_land_rank(result.slope);
+  }
+
   // ---- hydrometry, layers, buildable, combination -----------------------------------------
   result.density = dem.like<float>(nan_f);
   {
@@ -375,7 +496,10 @@ DensityResult compute_density(const Dem& dem, const Raster<float>& hydrometry, c
     std::vector<double> weights(options.weights.begin(), options.weights.end());
     for (const auto& [path, weight] : options.layers) weights.push_back(weight);
     for (const auto& f : options.factors) weights.push_back(f.weight);
-    const std::size_t first_factor = 4 + layers.size();
+    const std::size_t first_factor = 4 + layers.size(), first_terrain = first_factor + options.factors.size();
+    // The terrain terms come last, and only when used: the thesis's model sums exactly what it always did.
+    const Raster<float>* terrain[4] = {&result.altitude, &result.slope, &result.coast_near, &result.river_near};
+    if (terrain_used) weights.insert(weights.end(), options.terrain_weights.begin(), options.terrain_weights.end());
     for_rows(rows, step, [&](int r0, int r1) {
       std::vector<double> values(weights.size()), cell_weights(weights);
       for (int r = r0; r < r1; ++r)
@@ -398,6 +522,8 @@ DensityResult compute_density(const Dem& dem, const Raster<float>& hydrometry, c
             values[first_factor + f] = std::isnan(v) ? 0.0 : std::clamp(double(v), 0.0, 1.0);
             cell_weights[first_factor + f] = std::isnan(v) ? 0.0 : weights[first_factor + f];
           }
+          if (terrain_used)
+            for (std::size_t t = 0; t < 4; ++t) values[first_terrain + t] = (*terrain[t])[i];
           for (std::size_t k = 0; k < cell_weights.size() && !any; ++k) any = cell_weights[k] != 0;
           result.density[i] = any ? float(combine(cell_weights.data(), values.data(), cell_weights.size())) : 0.0f;
         }
@@ -414,6 +540,7 @@ DensityResult compute_density(const Dem& dem, const Raster<float>& hydrometry, c
         const std::size_t i = dem.index(x, r);
         if (kind[i] != unknown) ++t.known_cells;
         if (kind[i] == water) ++t.water_cells;
+        if (kind[i] == land) t.land_area_km2 += metrics.area_m2[std::size_t(r)] * 1e-6;
         if (result.buildable[i] == 1) {
           ++t.buildable_cells;
           row_sum[std::size_t(r)] += result.density[i];
@@ -428,6 +555,7 @@ DensityResult compute_density(const Dem& dem, const Raster<float>& hydrometry, c
     stats.known_cells += t.known_cells;
     stats.water_cells += t.water_cells;
     stats.buildable_cells += t.buildable_cells;
+    stats.land_area_km2 += t.land_area_km2;
     for (std::size_t k = 0; k < 10; ++k) stats.histogram[k] += t.histogram[k];
     sum += row_sum[std::size_t(r)];
   }

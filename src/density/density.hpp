@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/geodesy.hpp"
 #include "core/progress.hpp"
 #include "core/raster.hpp"
 
@@ -54,6 +55,14 @@ struct DensityOptions {
   // ---- combination ---------------------------------------------------------------------------
   /// Weights of (coast, hydrometry, plateau, plain): negative repulsive, 0 neutral, positive attractive.
   std::array<double, 4> weights{1, 1, 1.5, 0};
+  /// Weights of the terrain terms (altitude, slope, coast_near, river_near), combined with the
+  /// four characteristics: 0 leaves them out (the thesis's model).
+  std::array<double, 4> terrain_weights{0, 0, 0, 0};
+  /// Computes the terrain terms even when their weights are 0 (calibration, realism figures).
+  bool terrain_terms = false;
+  /// Cells of the river network on the DEM's grid (non-zero = river), for river_near; empty: no
+  /// rivers known (river_near 0).
+  Raster<std::uint8_t> rivers;
   /// User rasters (any GDAL raster, resampled bilinearly to the DEM grid) and their weights.
   std::vector<std::pair<std::string, double>> layers;
   /// User exclusion rasters (nearest resampling): non-zero cells are uninhabitable.
@@ -81,6 +90,7 @@ struct DensityStats {
   std::size_t buildable_cells = 0;   ///< habitable cells
   std::array<std::size_t, 10> histogram{};  ///< buildable cells per density decile [0,0.1) .. [0.9,1]
   double mean_density = 0.0;         ///< mean density over buildable cells
+  double land_area_km2 = 0.0;        ///< area of the land cells (with data, not water), km²
   double r_min_m = 0.0, r_max_m = 0.0;  ///< radii actually used (r_min may have been raised)
   int ring_bands = 0;                ///< largest number of bands per disc (rows when exact)
   bool ring_exact = true;            ///< every disc was summed row by row
@@ -95,6 +105,11 @@ struct DensityResult {
   Raster<float> hydrometry;  ///< the hydrometry used (input), 0 on water
   Raster<float> density;     ///< the weighted combination, 0 where uninhabitable
   Raster<std::uint8_t> buildable;  ///< 1 habitable, 0 uninhabitable (water, too high, too steep...), 255 nodata
+  // Terrain terms, computed when a terrain weight is not 0 or options.terrain_terms; NaN off land.
+  Raster<float> altitude;    ///< rank of the altitude among the land cells (share lower, ties half), [0,1]
+  Raster<float> slope;       ///< rank of the slope among the land cells, [0,1]
+  Raster<float> coast_near;  ///< exp(-d / 10 km), d the distance to the nearest water cell (0 with no water)
+  Raster<float> river_near;  ///< exp(-d / 2 km), d the distance to the nearest river cell (0 with no rivers)
   DensityStats stats;
 };
 
@@ -110,6 +125,14 @@ double combine(const double* weights, const double* values, std::size_t n);
 /// thread count. Throws bad_input for inconsistent options or unreadable user rasters.
 DensityResult compute_density(const Dem& dem, const Raster<float>& hydrometry, const DensityOptions& options,
                               Progress& progress);
+
+/// Names of the terrain terms, in the order of DensityOptions::terrain_weights.
+inline constexpr std::array<const char*, 4> kTerrainTerms = {"altitude", "slope", "coast_near", "river_near"};
+
+/// Distance in metres from each cell's centre to the nearest cell where `feature` is non-zero
+/// (infinity when there is none): an exact Euclidean transform (Felzenszwalb & Huttenlocher
+/// 2012) with columns measured at the feature row's width, rows by the northings of the grid.
+std::vector<float> distance_to_m(const std::vector<std::uint8_t>& feature, const CellMetrics& metrics, int cols, int rows);
 
 /// Describes each output for its metadata ("coast.tif" -> one line).
 std::string describe_output(const std::string& name);

@@ -47,6 +47,7 @@ struct RunState {
   plugin::PluginSet plugins;  ///< the scenario's plugins, loaded and checked before any work
   // Typed results of the stages, filled in data-flow order.
   std::optional<Raster<float>> hydrometry;        ///< hydro: [0,1]
+  std::optional<Raster<std::uint8_t>> rivers;     ///< hydro: 1 on river cells (upstream area over the streams threshold)
   std::optional<Raster<float>> density;           ///< density: [0,1]
   std::optional<Raster<std::uint8_t>> buildable;  ///< density: 1 habitable, 0 not, 255 nodata
   std::vector<sites::Site> sites;                 ///< sites: sorted by radius, decreasing

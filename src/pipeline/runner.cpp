@@ -148,7 +148,9 @@ json run_scenario(const Scenario& scenario, const RunOptions& options, Progress&
     state.plugins = std::move(plugins);
     json timings = json::array();
     json ran = json::array(), reused = json::array(), stale = json::array();
-    for (std::size_t i = 0; i < stages().size(); ++i) {
+    const std::size_t last = options.until.empty() ? stages().size() - 1 : stage_index("--until", options.until);
+    if (rerun && last + 1 < stages().size()) throw bad_input("--until: only for a new run (not with --from or --only)");
+    for (std::size_t i = 0; i <= last; ++i) {
       const StageDef& stage = stages()[i];
       const Log stage_log = log.stage(stage.name);
       if (plan[i] != Action::run) {
@@ -232,8 +234,27 @@ std::string format_summary(const json& manifest) {
     const json& c = sum["sites"];
     line("  sites    %d cities (%d roots, %d suburbs), %.0f people\n", c["cities"].get<int>(), c["roots"].get<int>(),
          c["suburbs"].get<int>(), c["population"].get<double>());
+    if (c.contains("population_source"))
+      line("           %.0f people in the region, %s; largest %.0f\n", c["target_population"].get<double>(),
+           c["population_source"].get<std::string>().c_str(), c["largest"].get<double>());
     for (const auto& [k, v] : c["per_class"].items())
       line("           class %s (radius %.0f m): %d\n", k.c_str(), v["radius_m"].get<double>(), v["cities"].get<int>());
+    if (c.contains("warnings"))
+      for (const auto& w : c["warnings"]) line("           warning: %.200s\n", w.get<std::string>().c_str());
+  }
+  if (sum.contains("realism")) {
+    const json& r = sum["realism"];
+    line("  realism  against %zu real places: %d settlements of min_population or more for %d, %.0f people for %.0f, largest %.0f for %.0f\n",
+         r["places"].get<std::size_t>(), r["count"]["generated"].get<int>(), r["count"]["reference"].get<int>(),
+         r["total"]["generated"].get<double>(), r["total"]["reference"].get<double>(), r["largest"]["generated"].get<double>(),
+         r["largest"]["reference"].get<double>());
+    if (r.contains("skill")) {
+      const json& k = r["skill"];
+      line("           density AUC %.3f (population-weighted %.3f); baselines:", k["auc"].get<double>(), k["weighted_auc"].get<double>());
+      for (const auto& [name, b] : k["baselines"].items()) line(" %s %.3f", name.c_str(), b["auc"].get<double>());
+      line("\n           ten largest real places with a top-10 settlement within 10 km: %d (random land points: %.1f)\n",
+           r["top10"]["within_10km"].get<int>(), r["top10"]["random_within_10km"].get<double>());
+    }
   }
   if (sum.contains("network")) {
     const json& n = sum["network"];

@@ -21,6 +21,8 @@ struct RunOptions {
   std::string from;
   /// Rerun only these stages; earlier ones are read back, later ones keep their saved files (stale).
   std::vector<std::string> only;
+  /// Stop after this stage (a new run folder holds the stages up to it); empty: every stage.
+  std::string until;
 };
 
 /// Runs `scenario` into its output folder, written under a temporary name and renamed at the end

@@ -134,10 +134,18 @@ Scenario load_scenario(const std::string& file, const std::vector<std::string>& 
   if (seed) doc["seed"] = *seed;
   const std::string problem = validate_scenario(doc);
   if (!problem.empty()) throw bad_input(s.source + ": " + problem);
+  // density.preset: its weights stand in for the schema's defaults of the weights not given.
+  const nlohmann::json schema_doc = nlohmann::json::parse(scenario_schema_text());
+  if (doc.contains("density") && doc["density"].contains("preset")) {
+    const std::string preset = doc["density"]["preset"].get<std::string>();
+    const auto& presets = schema_doc["properties"]["density"]["properties"]["preset"]["x-weights"];
+    if (presets.contains(preset))
+      for (const auto& [term, weight] : presets[preset].items())
+        if (!doc["density"].contains("weights") || !doc["density"]["weights"].contains(term)) doc["density"]["weights"][term] = weight;
+  }
   s.resolved = with_defaults(doc, schema_defaults());
   // Objects listed in a top-level array (plugins) get their own defaults too.
-  const nlohmann::json schema = nlohmann::json::parse(scenario_schema_text());
-  for (const auto& [key, sub] : schema["properties"].items())
+  for (const auto& [key, sub] : schema_doc["properties"].items())
     if (sub.value("type", "") == "array" && sub.contains("items") && sub["items"].contains("properties")) {
       const json item_defaults = defaults_of(sub["items"]);
       for (auto& item : s.resolved[key])

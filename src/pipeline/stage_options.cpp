@@ -86,6 +86,7 @@ density::DensityOptions density_options(const Scenario& scenario) {
   const json& weights = d["weights"];
   o.weights = {weights["coast"].get<double>(), weights["hydrometry"].get<double>(), weights["plateau"].get<double>(),
                weights["plain"].get<double>()};
+  for (std::size_t k = 0; k < density::kTerrainTerms.size(); ++k) o.terrain_weights[k] = weights[density::kTerrainTerms[k]].get<double>();
   for (const auto& layer : d["layers"])
     o.layers.emplace_back(scenario.file(layer["file"].get<std::string>()), layer["weight"].get<double>());
   for (const auto& file : d["exclusions"]) o.exclusions.push_back(scenario.file(file.get<std::string>()));
@@ -109,7 +110,21 @@ sites::SitesOptions sites_options(const Scenario& scenario) {
   o.people_per_m = s["people_per_m"].get<double>();
   o.quota_scale = s["quota_scale"].get<double>();
   o.refill_rounds = s["refill_rounds"].get<int>();
+  o.quotas = s["quotas"] == "belhadj2007" ? sites::SitesOptions::Quotas::belhadj2007 : sites::SitesOptions::Quotas::rank_size;
+  o.population = s["population"].get<double>();
+  o.people_per_km2 = s["people_per_km2"].get<double>();
+  o.zipf_exponent = s["zipf_exponent"].get<double>();
+  o.min_population = s["min_population"].get<double>();
+  o.area_exponent = s["area_exponent"].get<double>();
+  o.town_density_per_km2 = s["town_density_per_km2"].get<double>();
   return o;
+}
+
+Raster<std::uint8_t> river_cells(const Raster<double>& accumulation_m2, const Scenario& scenario) {
+  const double threshold_m2 = scenario.resolved["hydro"]["streams_threshold_km2"].get<double>() * 1e6;
+  Raster<std::uint8_t> rivers = accumulation_m2.like<std::uint8_t>(0);
+  for (std::size_t i = 0; i < rivers.size(); ++i) rivers[i] = accumulation_m2[i] >= threshold_m2 ? 1 : 0;  // NaN: not a river
+  return rivers;
 }
 
 network::NetworkOptions network_options(const Scenario& scenario) {

@@ -11,6 +11,7 @@
 #include "io/raster_io.hpp"
 #include "network/layers.hpp"
 #include "pipeline/hillshade.hpp"
+#include "pipeline/realism.hpp"
 #include "pipeline/stage_options.hpp"
 #include "roads/road_network.hpp"
 #include "roads/terrain_field.hpp"
@@ -117,10 +118,15 @@ void hydro_run(RunState& s, Progress& progress, const Log& log) {
   if (r.hydrometry_iterations > 0) log.detail("belhadj: " + std::to_string(r.hydrometry_iterations) + " iterations");
   s.hydrometry = std::move(r.hydrometry);
   write_reservoirs(s, progress, log);
+  s.rivers = river_cells(r.accumulation, s.scenario);
 }
 
 void hydro_load(RunState& s) {
   s.hydrometry = read_resampled(saved(s, "hydrometry.tif"), s.dem.georef(), s.dem.cols(), s.dem.rows(), Resampling::nearest);
+  const Raster<float> km2 = read_resampled(saved(s, "accumulation.tif"), s.dem.georef(), s.dem.cols(), s.dem.rows(), Resampling::nearest);
+  Raster<double> m2 = s.dem.like<double>(NAN);
+  for (std::size_t i = 0; i < m2.size(); ++i) m2[i] = double(km2[i]) * 1e6;
+  s.rivers = river_cells(m2, s.scenario);
 }
 
 // ---- density (Belhadj 2007 §4.2; docs/density.md) -----------------------------------------
@@ -129,6 +135,7 @@ void density_run(RunState& s, Progress& progress, const Log& log) {
   density::DensityOptions options = density_options(s.scenario);
   if (!reservoir_specs(s.scenario).empty()) options.water_mask = saved(s, kReservoirs);  // holds the water_mask too
   plugin::add_to_density(plugin::density_factors(s.plugins, s.dem, progress, log), options);
+  if (s.rivers) options.rivers = *s.rivers;
   density::DensityResult r = density::compute_density(s.dem, *s.hydrometry, options, progress);
   const std::pair<const char*, const Raster<float>*> characteristics[] = {{"coast", &r.coast}, {"plateau", &r.plateau}, {"plain", &r.plain}};
   for (const auto& [name, raster] : characteristics)
@@ -139,7 +146,9 @@ void density_run(RunState& s, Progress& progress, const Log& log) {
   const std::size_t land = st.known_cells - st.water_cells;
   s.summary["density"] = {{"buildable_land_share", land ? round_to(double(st.buildable_cells) / double(land), 1e-4) : 0.0},
                           {"water_share", st.known_cells ? round_to(double(st.water_cells) / double(st.known_cells), 1e-4) : 0.0},
-                          {"mean_density", round_to(st.mean_density, 1e-4)}};
+                          {"mean_density", round_to(st.mean_density, 1e-4)},
+                          {"land_area_km2", round_to(st.land_area_km2, 0.01)},
+                          {"preset", s.scenario.resolved["density"]["preset"]}};
   s.density = std::move(r.density);
   s.buildable = std::move(r.buildable);
 }
@@ -155,8 +164,12 @@ void density_load(RunState& s) {
 
 // ---- sites (Belhadj 2007 §4.3.1, Algorithms 13-15; docs/sites.md) --------------------------
 
-void sites_run(RunState& s, Progress& progress, const Log&) {
-  const sites::SitesResult r = sites::place_sites(*s.density, *s.buildable, sites_options(s.scenario), progress);
+void sites_run(RunState& s, Progress& progress, const Log& log) {
+  sites::SitesOptions options = sites_options(s.scenario);
+  // The land of the density stage (water and nodata excluded), for the default population.
+  if (s.summary.contains("density") && s.summary["density"].contains("land_area_km2"))
+    options.land_area_km2 = s.summary["density"]["land_area_km2"].get<double>();
+  const sites::SitesResult r = sites::place_sites(*s.density, *s.buildable, options, progress);
   const Crs& crs = s.dem.georef().crs;
   s.cities = sites::cities_layer(r, crs);
   s.write("sites", "cities.geojson", *s.cities, "city centres with radius, class, population, parent and depth", Style::cities);
@@ -174,6 +187,29 @@ void sites_run(RunState& s, Progress& progress, const Log&) {
     if (per_class.count(int(k))) classes[std::to_string(k)] = {{"radius_m", r.quotas[k].radius_m}, {"cities", per_class[int(k)]}};
   s.summary["sites"] = {{"cities", r.sites.size()}, {"roots", roots}, {"suburbs", int(r.sites.size()) - roots},
                         {"population", population}, {"per_class", classes}};
+  json& summary = s.summary["sites"];
+  if (options.quotas == sites::SitesOptions::Quotas::rank_size) {
+    char source[256];
+    if (r.population_assumed)
+      std::snprintf(source, sizeof source, "assumed: %.0f people/km2 (world average, World Bank 2020) x %.1f km2 of land", options.people_per_km2,
+                    r.land_area_km2);
+    else
+      std::snprintf(source, sizeof source, "given (sites.population)");
+    summary["quotas"] = "rank_size";
+    summary["target_population"] = r.target_population;
+    summary["population_source"] = source;
+    summary["largest"] = r.sites.empty() ? 0 : std::max_element(r.sites.begin(), r.sites.end(), [](const auto& a, const auto& b) {
+                                                 return a.population < b.population;
+                                               })->population;
+  } else {
+    summary["quotas"] = "belhadj2007";
+  }
+  std::vector<std::string> warnings = settlement_warnings(s, r);
+  const std::string reference = s.scenario.path("/sites/reference");
+  const json realism = reference.empty() ? json() : realism_figures(s, r, reference, warnings, progress);
+  for (const auto& w : warnings) log.warn(w);
+  summary["warnings"] = warnings;
+  if (!reference.empty()) s.summary["realism"] = realism;  // last: inserting moves the entries `summary` points into
   s.sites = r.sites;
 }
 

@@ -141,7 +141,30 @@ SitesResult place_sites(const Raster<float>& density, const Raster<std::uint8_t>
   // The DEM's scale e of Algorithm 13 (1/e = metres per cell): the coarser side of a cell at the centre row.
   const int centre = rows / 2;
   const double cell_size = std::max(metrics.width_m[std::size_t(centre)], metrics.height_m[std::size_t(centre)]);
-  QuotaTable table = compute_quotas(cell_size, options);
+  SitesResult result;
+  QuotaTable table;
+  if (options.quotas == SitesOptions::Quotas::belhadj2007) {
+    table = compute_quotas(cell_size, options);
+  } else {
+    // The region's people: the figure given, else the default density times the land area.
+    double land_km2 = options.land_area_km2;
+    if (!(land_km2 > 0)) {
+      double m2 = 0;
+      for (int r = 0; r < rows; ++r)
+        for (int c = 0; c < cols; ++c)
+          if (buildable(c, r) == 1) m2 += metrics.area_m2[std::size_t(r)];
+      land_km2 = m2 * 1e-6;
+    }
+    if (!(std::isfinite(options.people_per_km2) && options.people_per_km2 >= 0)) throw bad_input("sites: people_per_km2 must be >= 0");
+    result.population_assumed = !(options.population > 0);
+    result.land_area_km2 = land_km2;
+    result.target_population = result.population_assumed ? std::round(options.people_per_km2 * land_km2) : options.population;
+    table = rank_size_quotas(cell_size, rank_size_populations(result.target_population, options.zipf_exponent, options.min_population),
+                             options);
+    if (options.refill_rounds < 0 || options.candidates < 0) throw bad_input("sites: candidates and refill rounds must be >= 0");
+    if (options.r_min_m > 0 || options.r_max_m > 0)
+      throw bad_input("sites: r_min and r_max set the classes of the belhadj2007 quotas; with rank_size the radii come from the populations");
+  }
   const int n = int(table.classes.size());
   // Ascending radius index i of Algorithm 14 (r = r_min + i dr); class = n - 1 - i.
   std::vector<double> radius(static_cast<std::size_t>(n));
@@ -151,7 +174,6 @@ SitesResult place_sites(const Raster<float>& density, const Raster<std::uint8_t>
     quota[std::size_t(i)] = table.classes[std::size_t(n - 1 - i)].quota;
   }
 
-  SitesResult result;
   result.dr_m = table.dr_m;
   result.seed = options.seed;
 
@@ -266,7 +288,12 @@ SitesResult place_sites(const Raster<float>& density, const Raster<std::uint8_t>
     std::sort(merged.begin(), merged.end(), by_size);
     result.sites = resolve_inclusions(merged, options.mode, distance, cols, rows);
   }
-  for (const Site& s : result.sites) ++table.classes[std::size_t(s.radius_class)].kept;
+  for (Site& s : result.sites) {
+    QuotaClass& c = table.classes[std::size_t(s.radius_class)];
+    // rank_size: within a class, sites (by density order) take the class's sizes, largest first.
+    if (!table.populations.empty()) s.population = table.populations[std::size_t(s.radius_class)][std::size_t(c.kept)];
+    ++c.kept;
+  }
   result.quotas = table.classes;
   return result;
 }

@@ -18,13 +18,38 @@ struct Site {
   int col = 0, row = 0;          ///< the cell holding the centre
   double radius_m = 0;           ///< disc radius, metres (geodesic)
   int radius_class = 0;          ///< 0 = the largest radius class
-  std::int64_t population = 0;   ///< people_per_m x radius_m (Belhadj eq. 4.2), rounded
+  std::int64_t population = 0;   ///< rank_size: the settlement's share of the rank-size law; belhadj2007: people_per_m x radius_m (eq. 4.2)
   double density = 0;            ///< density model value at the centre, in [0,1]
   int parent = -1;               ///< index of the parent site, -1 for a root (Algorithm 15)
   int depth = 0;                 ///< 0 for roots, parent's depth + 1 otherwise
 };
 
 struct SitesOptions {
+  /// Where the size classes and their quotas come from. rank_size: a region's population split
+  /// by a rank-size (Zipf) law down to min_population, radii from an urban-area allometry;
+  /// belhadj2007: the thesis's census table for metropolitan France (Algorithm 13, eq. 4.1-4.2).
+  enum class Quotas { rank_size, belhadj2007 } quotas = Quotas::rank_size;
+  // ---- rank_size -------------------------------------------------------------------------------
+  /// People in the region (a census figure); 0: people_per_km2 x land_area_km2.
+  double population = 0;
+  /// Default density of people when `population` is 0: 60 per km² of land, the world's average
+  /// (World Bank, World Development Indicators EN.POP.DNST, 2020).
+  double people_per_km2 = 60;
+  /// Land area of the region, km²; 0: the area of the buildable cells.
+  double land_area_km2 = 0;
+  /// q of the rank-size law P_k = P_1 k^-q (Zipf's law: q = 1, Gabaix 1999; Soo 2005 measures
+  /// Pareto exponents 1/q around 1.1 over 73 countries).
+  double zipf_exponent = 1;
+  /// The smallest settlement, people: the law stops at the last rank still this large.
+  double min_population = 1000;
+  /// b of the urban-area allometry A = A_0 (P / 1000)^b: built-up area grows slower than
+  /// population (Bettencourt 2013, Science 340: b between 2/3 and 5/6).
+  double area_exponent = 5.0 / 6.0;
+  /// People per km² of built-up area of a settlement of 1,000 people (A_0 = 1000 / this):
+  /// 1,500, the cell density of the EU-OECD degree of urbanisation's urban centres
+  /// (Dijkstra & Poelman 2014).
+  double town_density_per_km2 = 1500;
+  // ---- belhadj2007 -----------------------------------------------------------------------------
   std::uint64_t seed = 1;   ///< seed of the candidate draw (std::mt19937_64)
   int candidates = 0;       ///< M, candidate positions drawn; 0: automatic (20 x N_sites, at most every buildable cell)
   double r_min_m = 0;       ///< smallest radius, metres; 0: the class step dr
@@ -56,7 +81,7 @@ struct SitesOptions {
 /// One radius class of the quota table (Algorithm 13).
 struct QuotaClass {
   double radius_m = 0;  ///< class radius, metres
-  int quota = 0;        ///< Q[i] = floor(f(g(radius)))
+  int quota = 0;        ///< Q[i] = floor(f(g(radius))), or the settlements of the rank-size law in this class
   int placed = 0;       ///< sites given this class by the growth, all rounds (first round: never above quota)
   int kept = 0;         ///< sites of this class in the result (never above quota)
 };
@@ -66,6 +91,8 @@ struct QuotaTable {
   double dr_m = 0;      ///< class step, metres
   double r_min_m = 0, r_max_m = 0;
   std::vector<QuotaClass> classes;
+  /// rank_size: the populations of each class, largest first (empty for belhadj2007).
+  std::vector<std::vector<std::int64_t>> populations;
   int total() const;    ///< N_sites, the sum of quotas
 };
 
@@ -75,6 +102,9 @@ struct SitesResult {
   double dr_m = 0;                  ///< class step used, metres
   int candidates = 0;               ///< M, candidates drawn
   std::uint64_t seed = 1;           ///< seed used
+  double target_population = 0;     ///< rank_size: the region's people the law was fitted to
+  double land_area_km2 = 0;         ///< rank_size: the land area used for the default population
+  bool population_assumed = false;  ///< rank_size: target from people_per_km2 (no census figure given)
 };
 
 /// f(x) of Belhadj eq. 4.1: urban units of x people. For x >= x_max the base is clamped at 0
@@ -88,6 +118,25 @@ double class_step_m(double cell_size_m, const SitesOptions& options);
 /// for a grid whose cells are `cell_size_m` metres. Throws bad_input when the range is empty
 /// or a parameter is out of range.
 QuotaTable compute_quotas(double cell_size_m, const SitesOptions& options);
+
+/// The rank-size law fitted to `total` people: P_k = total k^-q / H_N(q), H_N(q) = sum_{k<=N} k^-q,
+/// with N the largest count whose smallest settlement P_N still reaches min_population (none when
+/// total < min_population). Rounded to whole people by largest remainders: the sizes add up to
+/// round(total) exactly. Largest first.
+std::vector<std::int64_t> rank_size_populations(double total, double zipf_exponent, double min_population);
+
+/// q of the rank-size law fitted to `sizes` by least squares on ln P_k = c - q ln(k - 1/2)
+/// (the rank shifted by 1/2 against the small-sample bias, Gabaix & Ibragimov 2011); NaN for
+/// fewer than 3 sizes.
+double rank_size_exponent(std::vector<double> sizes);
+
+/// Radius, metres, of the disc whose area is the built-up area of `people`: A = (1000 /
+/// town_density) (people / 1000)^area_exponent km².
+double urban_radius_m(double people, const SitesOptions& options);
+
+/// The size classes of `populations` (largest first): class radii r_min + i dr with r_min = dr,
+/// each settlement in the smallest class whose radius covers urban_radius_m of its population.
+QuotaTable rank_size_quotas(double cell_size_m, const std::vector<std::int64_t>& populations, const SitesOptions& options);
 
 /// Algorithms 13, 14 and 15: places sites on `density` (values in [0,1], NaN nodata) where
 /// `buildable` is 1; any other cell, and everything outside the grid, is uninhabitable.

@@ -4,7 +4,7 @@ BIN=$TP
 T=$WORK
 DEM=$SAMPLES/gebco2022_15s_north_corsica_capcorse.asc
 stand_in_density "$DEM" "$T/in"
-"$BIN" --quiet sites "$T/in" "$T/s" --seed 5
+"$BIN" --quiet sites "$T/in" "$T/s" --seed 5 --quotas belhadj2007
 
 "$BIN" --quiet network "$T/s/cities.geojson" "$T/n" | tee "$T/out.txt"
 grep -q "k 1.80" "$T/out.txt"

@@ -10,6 +10,7 @@ JSON
 cat > scenario.json <<JSON
 {"dem": "$SAMPLES/gebco2022_15s_north_corsica_capcorse.asc", "output": "run",
  "outputs": {"preview_width": 300},
+ "sites": {"quotas": "belhadj2007"}, "density": {"preset": "belhadj2007"},
  "plugins": [{"id": "distance", "params": {"vector": "protected.geojson", "density": {"exclude_within_m": 0},
               "road": {"forbidden_within_m": 0, "structures": ["road", "bridge", "tunnel"]}}}]}
 JSON

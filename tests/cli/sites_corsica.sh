@@ -5,7 +5,7 @@ T=$WORK
 DEM=$SAMPLES/gebco2022_15s_north_corsica_capcorse.asc
 stand_in_density "$DEM" "$T/in"
 
-"$BIN" --quiet sites "$T/in" "$T/a" --seed 5 --report > "$T/report.txt"
+"$BIN" --quiet sites "$T/in" "$T/a" --seed 5 --report --quotas belhadj2007 > "$T/report.txt"
 cat "$T/report.txt"
 grep -q "^class  radius_m   quota  placed    kept" "$T/report.txt"
 # 15" cells are 462.9 m north-south: dr = 462, classes 462 .. 2310 m. Class 0 (2310 m, 924000 people):
@@ -29,7 +29,7 @@ nextents=$(ogrinfo -so -al "$T/a/city_extents.geojson" | grep -o "Feature Count:
 test "$ncities" = "$nextents"
 
 # Same seed, same bytes (whatever the thread count); another seed, another placement.
-"$BIN" --quiet --threads 1 sites "$T/in" "$T/b" --seed 5
+"$BIN" --quiet --threads 1 sites "$T/in" "$T/b" --seed 5 --quotas belhadj2007
 cmp "$T/a/cities.geojson" "$T/b/cities.geojson"
 cmp "$T/a/city_extents.geojson" "$T/b/city_extents.geojson"
 "$BIN" --quiet sites "$T/in" "$T/c" --seed 6

@@ -42,7 +42,13 @@ TEST(StageOptions, DensityDefaultsEqualTheCode) {
   EXPECT_EQ(s.plateau_min_m, c.plateau_min_m);
   EXPECT_EQ(s.plateau_max_m, c.plateau_max_m);
   EXPECT_EQ(s.plain_max_variation_m, c.plain_max_variation_m);
-  EXPECT_EQ(s.weights, c.weights);
+  // The code's weights are the thesis's: the scenario's belhadj2007 preset; its default is the fitted set.
+  const density::DensityOptions t = density_options(load_scenario("", {"density.preset=\"belhadj2007\""}));
+  EXPECT_EQ(t.weights, c.weights);
+  EXPECT_EQ(t.terrain_weights, c.terrain_weights);
+  EXPECT_NE(s.terrain_weights, c.terrain_weights);
+  // A weight set by hand wins over the preset.
+  EXPECT_EQ(density_options(load_scenario("", {"density.preset=\"belhadj2007\"", "density.weights.plain=2"})).weights[3], 2.0);
   EXPECT_EQ(s.layers, c.layers);
   EXPECT_EQ(s.exclusions, c.exclusions);
 }

@@ -15,6 +15,7 @@ TEST(SitesLayers, FieldContractAndRoundTrip) {
   const auto s = fixtures::scenario_from_sample("gebco2022_15s_north_corsica_capcorse.asc");
   SilentProgress progress;
   SitesOptions o;
+  o.quotas = SitesOptions::Quotas::belhadj2007;  // the thesis's table: these tests check Algorithms 13-15
   o.seed = 21;
   const SitesResult r = place_sites(s.density, s.buildable, o, progress);
   const Crs& crs = s.density.georef().crs;

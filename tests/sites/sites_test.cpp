@@ -23,6 +23,7 @@ namespace {
 //   r =  500: 4 + 1068 * 0.4096  = 441.4528 -> 441
 TEST(Quotas, ThesisCorsicaTable) {
   SitesOptions o;
+  o.quotas = SitesOptions::Quotas::belhadj2007;  // the thesis's table: these tests check Algorithms 13-15
   o.r_min_m = 500;
   o.r_max_m = 3000;
   const QuotaTable t = compute_quotas(500.0, o);
@@ -41,6 +42,7 @@ TEST(Quotas, ThesisCorsicaTable) {
 //   scale 0.015958 x (4, 5.7088, 31.3408, 142.4128, 441.4528) = (0.064, 0.091, 0.500, 2.273, 7.045)
 TEST(Quotas, ScaledToARegion) {
   SitesOptions o;
+  o.quotas = SitesOptions::Quotas::belhadj2007;  // the thesis's table: these tests check Algorithms 13-15
   o.r_min_m = 500;
   o.r_max_m = 3000;
   o.quota_scale = 8680.0 / 543940.0;
@@ -53,6 +55,7 @@ TEST(Quotas, ScaledToARegion) {
 
 TEST(Quotas, StepAndAutomaticRange) {
   SitesOptions o;
+  o.quotas = SitesOptions::Quotas::belhadj2007;  // the thesis's table: these tests check Algorithms 13-15
   EXPECT_EQ(class_step_m(30.85, o), 50.0);    // dr_min wins on fine grids
   EXPECT_EQ(class_step_m(463.7, o), 463.0);   // floor(1/e) on coarse ones
   const QuotaTable t = compute_quotas(30.0, o);
@@ -67,12 +70,14 @@ TEST(Quotas, StepAndAutomaticRange) {
 
 TEST(Quotas, PastXmaxStaysAtUmin) {
   SitesOptions o;
+  o.quotas = SitesOptions::Quotas::belhadj2007;  // the thesis's table: these tests check Algorithms 13-15
   EXPECT_EQ(units_for_people(2e6, o), 4.0);
   EXPECT_EQ(units_for_people(0, o), 1072.0);
 }
 
 TEST(Quotas, EmptyRangeIsBadInput) {
   SitesOptions o;
+  o.quotas = SitesOptions::Quotas::belhadj2007;  // the thesis's table: these tests check Algorithms 13-15
   o.r_min_m = 1000;
   o.r_max_m = 1020;
   try {
@@ -158,6 +163,7 @@ TEST(Placement, CorsicaGeographicInvariants) {
   SilentProgress progress;
   for (auto [mode, refill] : {std::pair{SitesOptions::Mode::paris, 8}, {SitesOptions::Mode::manhattan, 8}, {SitesOptions::Mode::paris, 0}}) {
     SitesOptions o;
+    o.quotas = SitesOptions::Quotas::belhadj2007;  // the thesis's table: these tests check Algorithms 13-15
     o.seed = 7;
     o.mode = mode;
     o.refill_rounds = refill;
@@ -181,6 +187,7 @@ TEST(Placement, VermontProjectedInvariants) {
   const auto s = fixtures::scenario_from_sample("whiteboxR_DEM_vermont.tif");
   SilentProgress progress;
   SitesOptions o;
+  o.quotas = SitesOptions::Quotas::belhadj2007;  // the thesis's table: these tests check Algorithms 13-15
   o.seed = 3;
   o.r_max_m = 800;
   const SitesResult r = place_sites(s.density, s.buildable, o, progress);
@@ -192,6 +199,7 @@ TEST(Placement, PerimeterModeKeepsQuotas) {
   const auto s = fixtures::scenario_from_sample("gebco2022_15s_north_corsica_capcorse.asc");
   SilentProgress progress;
   SitesOptions o;
+  o.quotas = SitesOptions::Quotas::belhadj2007;  // the thesis's table: these tests check Algorithms 13-15
   o.disc_test = SitesOptions::DiscTest::perimeter;
   const SitesResult r = place_sites(s.density, s.buildable, o, progress);
   EXPECT_GT(r.sites.size(), 20u);
@@ -202,6 +210,7 @@ TEST(Placement, SameSeedSameSitesOtherSeedOtherSites) {
   const auto s = fixtures::scenario_from_sample("gebco2022_15s_north_corsica_capcorse.asc");
   SilentProgress progress;
   SitesOptions o;
+  o.quotas = SitesOptions::Quotas::belhadj2007;  // the thesis's table: these tests check Algorithms 13-15
   o.seed = 11;
   const SitesResult a = place_sites(s.density, s.buildable, o, progress);
   const SitesResult b = place_sites(s.density, s.buildable, o, progress);
@@ -221,6 +230,7 @@ TEST(Placement, ExactDiscSeesTheHolePerimeterMissesIt) {
     s.density(20, 20) = 1.0f;
     s.buildable(22, 19) = 0;
     SitesOptions o;
+    o.quotas = SitesOptions::Quotas::belhadj2007;  // the thesis's table: these tests check Algorithms 13-15
     o.r_min_m = 100;
     o.r_max_m = 1000;
     o.dr_min_m = 300;

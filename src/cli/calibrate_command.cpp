@@ -1,0 +1,270 @@
+// `terrapolis calibrate DEM... --settlements PLACES...`: fits the density model's weights to real
+// settlements by a presence/background logistic likelihood (Warton & Shepherd 2010), with held-out skill.
+// SPDX-License-Identifier: MIT
+#include <CLI/CLI.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include <nlohmann/json.hpp>
+
+#include "cli/command.hpp"
+#include "cli/commands_list.hpp"
+#include "core/error.hpp"
+#include "density/calibration.hpp"
+#include "hydro/hydro.hpp"
+#include "io/raster_io.hpp"
+#include "pipeline/scenario.hpp"
+#include "pipeline/stage_options.hpp"
+#include "sites/sites.hpp"
+
+namespace terrapolis::cli {
+namespace {
+
+using json = nlohmann::ordered_json;
+constexpr std::size_t kTerms = 8;
+constexpr std::array<const char*, kTerms> kTermNames = {"coast", "hydrometry", "plateau", "plain", "altitude", "slope", "coast_near", "river_near"};
+
+/// One region: its presences and background sample (terms), and every land cell for the AUC.
+struct Region {
+  std::string name;
+  std::vector<std::array<double, kTerms>> presence, background, land;
+  std::vector<double> population;
+  int dropped = 0;
+  density::Skill baselines;  // baselines only (the density field is not used)
+  std::vector<double> sizes;  // populations of min_population or more
+};
+
+double score(const std::vector<double>& beta, const std::array<double, kTerms>& x) {
+  double s = 0;
+  for (std::size_t j = 0; j < kTerms; ++j) s += beta[j + 1] * x[j];
+  return s;
+}
+
+/// AUCs (plain and population-weighted) of a linear score on a region, presences restricted to `use` (empty: all).
+std::pair<double, double> region_auc(const std::vector<double>& beta, const Region& r, const std::vector<std::size_t>& use = {}) {
+  std::vector<double> bg, pres, w;
+  bg.reserve(r.land.size());
+  for (const auto& x : r.land) bg.push_back(score(beta, x));
+  auto add = [&](std::size_t k) { pres.push_back(score(beta, r.presence[k])), w.push_back(r.population[k]); };
+  if (use.empty())
+    for (std::size_t k = 0; k < r.presence.size(); ++k) add(k);
+  else
+    for (std::size_t k : use) add(k);
+  return {density::auc(pres, {}, bg), density::auc(pres, w, bg)};
+}
+
+/// Pooled fit: each training region's presences weigh 1 in all, its background 1 in all, so
+/// regions count equally whatever their number of places. Presences in `held_out` of region
+/// `fold_region` are left out.
+std::vector<double> fit(const std::vector<Region>& regions, const std::vector<bool>& train, double ridge, int fold_region = -1,
+                        const std::vector<std::size_t>& held_out = {}) {
+  std::vector<std::vector<double>> x;
+  std::vector<double> y, w;
+  for (std::size_t g = 0; g < regions.size(); ++g) {
+    if (!train[g]) continue;
+    const Region& r = regions[g];
+    std::vector<bool> skip(r.presence.size(), false);
+    if (int(g) == fold_region)
+      for (std::size_t k : held_out) skip[k] = true;
+    std::size_t kept = 0;
+    for (std::size_t k = 0; k < r.presence.size(); ++k) kept += !skip[k];
+    if (kept == 0) continue;
+    for (std::size_t k = 0; k < r.presence.size(); ++k)
+      if (!skip[k]) x.emplace_back(r.presence[k].begin(), r.presence[k].end()), y.push_back(1), w.push_back(1.0 / double(kept));
+    for (const auto& b : r.background) x.emplace_back(b.begin(), b.end()), y.push_back(0), w.push_back(1.0 / double(r.background.size()));
+  }
+  if (x.empty()) throw bad_input("calibrate: no places to fit on");
+  return density::fit_logistic(x, y, w, ridge);
+}
+
+json auc_pair(std::pair<double, double> a) {
+  auto r = [](double v) { return std::isfinite(v) ? json(std::round(v * 1000) / 1000) : json(nullptr); };
+  return {{"auc", r(a.first)}, {"weighted_auc", r(a.second)}};
+}
+
+class CalibrateCommand final : public Command {
+ public:
+  std::string name() const override { return "calibrate"; }
+  std::string summary() const override {
+    return "Fit the density model's weights to real settlements (presence/background likelihood) and report its skill";
+  }
+
+  void setup(CLI::App& app) override {
+    app.add_option("DEM", dems_, "DEM(s) of the region(s), any GDAL raster")->required();
+    app.add_option("--settlements", places_, "Real places of each DEM, in the same order: GeoJSON/GPKG points or CSV (lon,lat) with a population field")
+        ->required();
+    app.add_option("--scenario", scenarios_, "Scenario whose water, hydro and density options are used: one for every DEM, or one per DEM in order (default: the defaults)");
+    app.add_option("--fragment", fragment_, "Write the fitted weights as a scenario fragment (JSON) to this file");
+    app.add_option("--report", report_, "Write the report as JSON to this file");
+    app.add_option("--folds", folds_, "Folds of the cross-validation within a region (one region given)")->check(CLI::Range(2, 100))->capture_default_str();
+    app.add_option("--background", background_, "Background cells sampled per region for the fit")->check(CLI::Range(100, 10000000))->capture_default_str();
+    app.add_option("--ridge", ridge_, "Ridge penalty on the weights (times the total weight)")->check(CLI::NonNegativeNumber)->capture_default_str();
+    app.add_option("--seed", seed_, "Seed of the background sample and of the folds")->capture_default_str();
+    app.add_flag("--overwrite", overwrite_, "Replace existing --fragment / --report files");
+  }
+
+  void run(Context& context) override {
+    if (dems_.size() != places_.size())
+      throw bad_input("--settlements: give one places file per DEM (" + std::to_string(dems_.size()) + " DEMs, " + std::to_string(places_.size()) + " files)");
+    for (const std::string& out : {fragment_, report_})
+      if (!out.empty() && std::filesystem::exists(out) && !overwrite_) throw bad_input(out + ": output exists (use --overwrite)");
+    if (scenarios_.size() > 1 && scenarios_.size() != dems_.size())
+      throw bad_input("--scenario: give one scenario, or one per DEM (" + std::to_string(dems_.size()) + " DEMs)");
+    std::vector<Region> regions;
+    for (std::size_t g = 0; g < dems_.size(); ++g) {
+      const pipeline::Scenario scenario = pipeline::load_scenario(scenarios_.empty() ? "" : scenarios_[scenarios_.size() == 1 ? 0 : g]);
+      regions.push_back(load_region(dems_[g], places_[g], scenario, scenario.resolved["sites"]["min_population"].get<double>(), context));
+    }
+
+    const std::size_t n = regions.size();
+    const std::vector<bool> all(n, true);
+    const std::vector<double> beta = fit(regions, all, ridge_);
+    json report;
+    report["regions"] = json::array();
+    std::vector<double> thesis(kTerms + 1, 0.0);
+    thesis[1] = 1, thesis[2] = 1, thesis[3] = 1.5;  // belhadj2007: coast 1, hydrometry 1, plateau 1.5
+    std::printf("%-40s %6s %7s %7s %7s %7s %7s %7s %7s %6s\n", "region", "places", "fit", "held", "w.held", "thesis", "-elev", "-slope",
+                "coast", "q");
+    for (std::size_t g = 0; g < n; ++g) {
+      const Region& r = regions[g];
+      std::pair<double, double> held{NAN, NAN};
+      json held_weights = nullptr;
+      if (n > 1) {
+        std::vector<bool> others(n, true);
+        others[g] = false;
+        const std::vector<double> b = fit(regions, others, ridge_);
+        held = region_auc(b, r);
+        held_weights = scaled_weights(b);
+      } else {
+        held = cross_validated(regions, beta.size());
+      }
+      const auto in_region = region_auc(beta, r);
+      const auto thesis_auc = region_auc(thesis, r);
+      json baselines = json::object();
+      for (std::size_t k = 0; k < 3; ++k)
+        baselines[density::kBaselineNames[k]] = auc_pair({r.baselines.baseline_auc[k], r.baselines.baseline_weighted_auc[k]});
+      double total = 0;
+      for (double p : r.sizes) total += p;
+      const double q = sites::rank_size_exponent(r.sizes);
+      report["regions"].push_back({{"region", r.name},
+                                   {"places", r.presence.size()},
+                                   {"places_dropped", r.dropped},
+                                   {"fitted_in_sample", auc_pair(in_region)},
+                                   {n > 1 ? "held_out_region" : "cross_validated", auc_pair(held)},
+                                   {"held_out_weights", held_weights},
+                                   {"belhadj2007", auc_pair(thesis_auc)},
+                                   {"baselines", baselines},
+                                   {"settlements", {{"count", r.sizes.size()}, {"total", total}, {"largest", r.sizes.empty() ? 0.0 : r.sizes[0]},
+                                                    {"rank_size_exponent", std::isfinite(q) ? json(std::round(q * 1000) / 1000) : json(nullptr)}}}});
+      std::printf("%-40s %6zu %7.3f %7.3f %7.3f %7.3f %7.3f %7.3f %7.3f %6.2f\n", r.name.c_str(), r.presence.size(), in_region.first,
+                  held.first, held.second, thesis_auc.first, r.baselines.baseline_auc[0], r.baselines.baseline_auc[1], r.baselines.baseline_auc[2], q);
+    }
+    const json weights = scaled_weights(beta);
+    report["weights"] = weights;
+    report["method"] = n > 1 ? "logistic presence/background, regions weighted equally; held out: leave one region out"
+                             : "logistic presence/background; held out: " + std::to_string(folds_) + "-fold cross-validation on the places";
+    std::printf("weights:");
+    for (const auto& [k, v] : weights.items()) std::printf(" %s %.4f", k.c_str(), v.get<double>());
+    std::printf("\n(fit: in-sample AUC; held: %s AUC, w.: population-weighted; thesis: the belhadj2007 weights; q: rank-size exponent of the places)\n",
+                n > 1 ? "leave-one-region-out" : "cross-validated");
+    const json fragment = {{"density", {{"weights", weights}}}};
+    if (!fragment_.empty()) write_json(fragment_, fragment);
+    if (!report_.empty()) write_json(report_, report);
+  }
+
+ private:
+  Region load_region(const std::string& dem_path, const std::string& places_path, const pipeline::Scenario& scenario, double min_population,
+                     Context& context) {
+    const Dem dem = read_dem(dem_path);
+    hydro::HydroResult hydro = hydro::run_hydro(dem, pipeline::hydro_options(scenario), context.progress);
+    density::DensityOptions options = pipeline::density_options(scenario);
+    options.terrain_terms = true;
+    options.rivers = pipeline::river_cells(hydro.accumulation, scenario);
+    const density::DensityResult model = density::compute_density(dem, hydro.hydrometry, options, context.progress);
+    const std::vector<std::uint8_t> land = density::land_cells(model);
+    Region r;
+    r.name = std::filesystem::path(dem_path).stem().string();
+    const std::vector<density::Place> places = density::read_places(places_path, dem, land, r.dropped);
+    if (places.empty()) throw bad_input(places_path + ": no place on the land of " + dem_path);
+    std::vector<std::size_t> cells;
+    for (std::size_t i = 0; i < land.size(); ++i)
+      if (land[i]) cells.push_back(i), r.land.push_back(density::terms_at(model, i));
+    for (const auto& p : places) {
+      r.presence.push_back(density::terms_at(model, dem.index(p.col, p.row)));
+      r.population.push_back(p.population);
+      if (p.population >= min_population) r.sizes.push_back(p.population);
+    }
+    std::mt19937_64 generator(seed_);
+    const std::size_t b = std::min(background_, cells.size());
+    for (std::size_t k = 0; k < b; ++k) std::swap(cells[k], cells[k + std::size_t(generator() % (cells.size() - k))]);
+    for (std::size_t k = 0; k < b; ++k) r.background.push_back(density::terms_at(model, cells[k]));
+    r.baselines = density::skill(model.density, model, places, land);
+    context.log.info(r.name + ": " + std::to_string(places.size()) + " places (" + std::to_string(r.dropped) + " off the land or the grid)");
+    return r;
+  }
+
+  /// One region: k-fold cross-validation over its places (seeded folds), held-out AUCs pooled.
+  std::pair<double, double> cross_validated(const std::vector<Region>& regions, std::size_t) {
+    const Region& r = regions[0];
+    std::vector<std::size_t> order(r.presence.size());
+    for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+    std::mt19937_64 generator(seed_ + 1);
+    for (std::size_t k = order.size(); k > 1; --k) std::swap(order[k - 1], order[std::size_t(generator() % k)]);
+    std::vector<double> pres, w, bg;
+    for (int f = 0; f < folds_; ++f) {
+      std::vector<std::size_t> held;
+      for (std::size_t k = std::size_t(f); k < order.size(); k += std::size_t(folds_)) held.push_back(order[k]);
+      if (held.empty()) continue;
+      const std::vector<double> beta = fit(regions, {true}, ridge_, 0, held);
+      // Scores of different folds are not on one scale: each fold's AUC, weighted by its size.
+      const auto a = region_auc(beta, r, held);
+      double wp = 0;
+      for (std::size_t k : held) wp += r.population[k];
+      pres.push_back(a.first * double(held.size())), w.push_back(double(held.size()));
+      bg.push_back(a.second * wp), bg.push_back(wp);
+    }
+    double s = 0, n = 0, sw = 0, nw = 0;
+    for (std::size_t k = 0; k < pres.size(); ++k) s += pres[k], n += w[k], sw += bg[2 * k], nw += bg[2 * k + 1];
+    return {s / n, nw > 0 ? sw / nw : NAN};
+  }
+
+  /// Weights scaled so the largest is 1 in magnitude: the density ranks cells as the linear predictor does.
+  static json scaled_weights(const std::vector<double>& beta) {
+    double largest = 0;
+    for (std::size_t j = 1; j < beta.size(); ++j) largest = std::max(largest, std::abs(beta[j]));
+    json weights = json::object();
+    for (std::size_t j = 0; j < kTerms; ++j) weights[kTermNames[j]] = largest > 0 ? std::round(beta[j + 1] / largest * 1e4) / 1e4 : 0.0;
+    return weights;
+  }
+
+  void write_json(const std::string& path, const json& value) {
+    const std::string temp = path + ".tmp-calibrate";
+    {
+      std::ofstream out(temp);
+      out << value.dump(2) << "\n";
+      if (!out) {
+        std::filesystem::remove(temp);
+        throw processing_error(path + ": cannot write");
+      }
+    }
+    std::filesystem::rename(temp, path);
+  }
+
+  std::vector<std::string> dems_, places_, scenarios_;
+  std::string fragment_, report_;
+  int folds_ = 5;
+  std::size_t background_ = 20000;
+  double ridge_ = 1e-3;
+  std::uint64_t seed_ = 1;
+  bool overwrite_ = false;
+};
+
+}  // namespace
+
+std::unique_ptr<Command> make_calibrate_command() { return std::make_unique<CalibrateCommand>(); }
+
+}  // namespace terrapolis::cli

@@ -1,0 +1,136 @@
+// Realism figures of a run against real places, and settlement warnings.
+// SPDX-License-Identifier: MIT
+#include "pipeline/realism.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "core/geodesy.hpp"
+#include "density/calibration.hpp"
+#include "pipeline/stage_options.hpp"
+
+namespace terrapolis::pipeline {
+namespace {
+
+using json = nlohmann::ordered_json;
+
+double rounded(double v, double step) { return std::isfinite(v) ? std::round(v / step) * step : v; }
+
+/// People per km² of land above which a whole region is implausible: denser than Hong Kong's
+/// 6,700 over its whole land area would be a city-state, not a region.
+constexpr double kPlausiblePeoplePerKm2 = 5000;
+
+}  // namespace
+
+std::vector<std::string> settlement_warnings(const RunState& s, const sites::SitesResult& r) {
+  std::vector<std::string> warnings;
+  const Dem& dem = s.dem;
+  int flat = 0, nodata = 0;
+  std::string first_flat;
+  for (const auto& site : r.sites) {
+    const float z = dem(site.col, site.row);
+    if (std::isnan(z)) {
+      ++nodata;
+      continue;
+    }
+    bool same = true;
+    for (int dr = -4; dr <= 4 && same; ++dr)
+      for (int dc = -4; dc <= 4 && same; ++dc)
+        same = dem.inside(site.col + dc, site.row + dr) && dem(site.col + dc, site.row + dr) == z;
+    if (same && flat++ == 0) first_flat = "city " + std::to_string(site.id) + " at " + std::to_string(int(std::lround(z))) + " m";
+  }
+  if (flat)
+    warnings.push_back(std::to_string(flat) + " settlement(s) on a perfectly flat surface (9 x 9 cells of one altitude, e.g. " + first_flat +
+                       "): a lake or reservoir in SRTM-like DEMs; pass it as water (water.water_mask) or check");
+  if (nodata) warnings.push_back(std::to_string(nodata) + " settlement(s) centred on a nodata cell");
+  if (r.land_area_km2 > 0 && r.target_population / r.land_area_km2 > kPlausiblePeoplePerKm2)
+    warnings.push_back("population " + std::to_string(std::llround(r.target_population)) + " on " + std::to_string(std::llround(r.land_area_km2)) +
+                       " km2 of land is " + std::to_string(std::llround(r.target_population / r.land_area_km2)) +
+                       " people/km2, above any real region (check sites.population)");
+  return warnings;
+}
+
+json realism_figures(RunState& s, const sites::SitesResult& r, const std::string& reference, std::vector<std::string>& warnings,
+                     Progress& progress) {
+  // The terrain terms for the baselines and the land mask: the run's density options, terms on.
+  density::DensityOptions options = density_options(s.scenario);
+  options.terrain_terms = true;
+  if (s.rivers) options.rivers = *s.rivers;
+  const density::DensityResult terms = density::compute_density(s.dem, *s.hydrometry, options, progress);
+  const std::vector<std::uint8_t> land = density::land_cells(terms);
+  int dropped = 0;
+  std::vector<density::Place> places = density::read_places(reference, s.dem, land, dropped);
+  const double min_population = s.scenario.resolved["sites"]["min_population"].get<double>();
+  std::vector<double> real_sizes, generated_sizes;
+  double real_total = 0, generated_total = 0;
+  for (const auto& p : places)
+    if (p.population >= min_population) real_sizes.push_back(p.population), real_total += p.population;
+  for (const auto& site : r.sites)
+    if (double(site.population) >= min_population) generated_sizes.push_back(double(site.population)), generated_total += double(site.population);
+  std::sort(generated_sizes.begin(), generated_sizes.end(), std::greater<>());
+  json out;
+  out["reference"] = reference;
+  out["places"] = places.size();
+  out["places_dropped"] = dropped;
+  out["count"] = {{"generated", generated_sizes.size()}, {"reference", real_sizes.size()},
+                  {"ratio", real_sizes.empty() ? json(nullptr) : json(rounded(double(generated_sizes.size()) / double(real_sizes.size()), 1e-3))}};
+  out["total"] = {{"generated", generated_total}, {"reference", real_total},
+                  {"ratio", real_total > 0 ? json(rounded(generated_total / real_total, 1e-3)) : json(nullptr)}};
+  out["largest"] = {{"generated", generated_sizes.empty() ? 0.0 : generated_sizes[0]}, {"reference", real_sizes.empty() ? 0.0 : real_sizes[0]}};
+  const double q_gen = sites::rank_size_exponent(generated_sizes), q_ref = sites::rank_size_exponent(real_sizes);
+  out["rank_size_exponent"] = {{"generated", std::isfinite(q_gen) ? json(rounded(q_gen, 1e-3)) : json(nullptr)},
+                               {"reference", std::isfinite(q_ref) ? json(rounded(q_ref, 1e-3)) : json(nullptr)}};
+  if (places.empty()) return out;
+
+  const density::Skill skill = density::skill(*s.density, terms, places, land);
+  json baselines = json::object();
+  for (std::size_t k = 0; k < 3; ++k)
+    baselines[density::kBaselineNames[k]] = {{"auc", rounded(skill.baseline_auc[k], 1e-3)}, {"weighted_auc", rounded(skill.baseline_weighted_auc[k], 1e-3)}};
+  out["skill"] = {{"auc", rounded(skill.auc, 1e-3)}, {"weighted_auc", rounded(skill.weighted_auc, 1e-3)}, {"baselines", baselines}};
+  if (skill.auc < skill.best_baseline())
+    warnings.push_back("the density model ranks the reference places worse (AUC " + std::to_string(skill.auc).substr(0, 5) +
+                       ") than a single-factor baseline (AUC " + std::to_string(skill.best_baseline()).substr(0, 5) +
+                       "); calibrate it (terrapolis calibrate)");
+
+  // Location: the ten largest real places against the ten largest generated settlements.
+  const Crs& crs = s.dem.georef().crs;
+  const std::size_t top = std::min<std::size_t>(10, places.size()), top_gen = std::min<std::size_t>(10, r.sites.size());
+  std::vector<std::size_t> order(r.sites.size());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return r.sites[a].population > r.sites[b].population; });
+  auto nearest = [&](double x, double y, const std::vector<std::array<double, 2>>& points) {
+    double best = INFINITY;
+    for (const auto& p : points) best = std::min(best, crs_distance_m(crs, x, y, p[0], p[1]));
+    return best;
+  };
+  std::vector<std::array<double, 2>> generated;
+  for (std::size_t k = 0; k < top_gen; ++k) generated.push_back({r.sites[order[k]].x, r.sites[order[k]].y});
+  json largest = json::array();
+  int within = 0;
+  for (std::size_t k = 0; k < top; ++k) {
+    const double d = nearest(places[k].x, places[k].y, generated);
+    within += d <= 10000;
+    largest.push_back({{"name", places[k].name}, {"population", places[k].population},
+                       {"nearest_top_km", std::isfinite(d) ? json(rounded(d / 1000, 0.01)) : json(nullptr)}});
+  }
+  // The same count for random land points in place of the generated settlements (seeded draws).
+  std::vector<std::size_t> land_cells;
+  for (std::size_t i = 0; i < land.size(); ++i)
+    if (land[i]) land_cells.push_back(i);
+  std::mt19937_64 generator(s.scenario.resolved["seed"].get<std::uint64_t>());
+  const int draws = 100;
+  double random_within = 0;
+  for (int d = 0; d < draws && top_gen > 0; ++d) {
+    std::vector<std::array<double, 2>> points;
+    for (std::size_t k = 0; k < top_gen; ++k) {
+      const std::size_t i = land_cells[std::size_t(generator() % land_cells.size())];
+      points.push_back(s.dem.georef().cell_centre(int(i % std::size_t(s.dem.cols())), int(i / std::size_t(s.dem.cols()))));
+    }
+    for (std::size_t k = 0; k < top; ++k) random_within += nearest(places[k].x, places[k].y, points) <= 10000;
+  }
+  out["top10"] = {{"within_10km", within}, {"random_within_10km", rounded(random_within / draws, 0.01)}, {"places", largest}};
+  return out;
+}
+
+}  // namespace terrapolis::pipeline

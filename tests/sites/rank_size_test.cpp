@@ -1,0 +1,98 @@
+// Settlement sizes from a population: the rank-size law, the urban-area allometry, and counts that
+// follow the population rather than the grid.
+// SPDX-License-Identifier: MIT
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numeric>
+
+#include "core/error.hpp"
+#include "sites/fixtures.hpp"
+#include "sites/sites.hpp"
+
+using namespace terrapolis;
+using namespace terrapolis::sites;
+
+// 3000 people, q = 1, at least 1000 each: N = 2 gives 3000 x (1/2) / (1 + 1/2) = 1000 >= 1000;
+// N = 3 gives 3000 x (1/3) / (11/6) = 545 < 1000. So two settlements, 2000 and 1000.
+TEST(RankSize, HandComputedSplit) {
+  EXPECT_EQ(rank_size_populations(3000, 1.0, 1000), (std::vector<std::int64_t>{2000, 1000}));
+  EXPECT_TRUE(rank_size_populations(999, 1.0, 1000).empty());
+  EXPECT_EQ(rank_size_populations(1000, 1.0, 1000), (std::vector<std::int64_t>{1000}));
+  EXPECT_THROW(rank_size_populations(1000, 0.0, 1000), Error);
+}
+
+TEST(RankSize, TotalsSumToTheTarget) {
+  for (double total : {1500.0, 43093.0, 94321.4, 1.6e6, 2.5e7})
+    for (double q : {0.7, 1.0, 1.35}) {
+      const auto sizes = rank_size_populations(total, q, 1000);
+      ASSERT_FALSE(sizes.empty()) << total << " " << q;
+      EXPECT_EQ(std::accumulate(sizes.begin(), sizes.end(), std::int64_t(0)), std::llround(total)) << total << " " << q;
+      for (std::size_t k = 1; k < sizes.size(); ++k) ASSERT_LE(sizes[k], sizes[k - 1]);
+      EXPECT_GE(sizes.back(), 999) << total << " " << q;  // the law's last rank, up to rounding
+      // The next rank would fall below the minimum: N is the largest count the law allows.
+      double h = 0;
+      for (std::size_t k = 1; k <= sizes.size() + 1; ++k) h += std::pow(double(k), -q);
+      EXPECT_LT(total * std::pow(double(sizes.size() + 1), -q) / h, 1000.0);
+    }
+}
+
+TEST(RankSize, ExponentOfAPerfectLaw) {
+  std::vector<double> sizes;
+  for (int k = 1; k <= 300; ++k) sizes.push_back(1e6 * std::pow(k, -1.2));
+  EXPECT_NEAR(rank_size_exponent(sizes), 1.2, 0.08);
+  EXPECT_TRUE(std::isnan(rank_size_exponent({5000, 2000})));
+}
+
+// A = (1000 / 1500) km2 x (P / 1000)^(5/6): 1000 people, 0.6667 km2, r = sqrt(666 667 / pi) = 460.66 m;
+// 100 000 people: 0.6667 x 100^(5/6) = 30.94 km2, r = 3138 m.
+TEST(RankSize, UrbanRadius) {
+  SitesOptions o;
+  EXPECT_NEAR(urban_radius_m(1000, o), 460.66, 0.01);
+  EXPECT_NEAR(urban_radius_m(1e5, o), std::sqrt(1000.0 / 1500 * std::pow(100.0, 5.0 / 6) * 1e6 / M_PI), 1e-6);
+  EXPECT_NEAR(urban_radius_m(1e5, o), 3138.3, 0.5);
+}
+
+TEST(RankSize, ClassesCoverTheRadii) {
+  SitesOptions o;
+  const std::vector<std::int64_t> sizes = {100000, 20000, 1000};
+  const QuotaTable t = rank_size_quotas(463.7, sizes, o);
+  EXPECT_EQ(t.dr_m, 463.0);
+  // 3138 m -> 7 steps of 463 m (3241 m); 1000 people (461 m) -> the first class, 463 m.
+  ASSERT_EQ(t.classes.size(), 7u);
+  EXPECT_EQ(t.classes.front().radius_m, 7 * 463.0);
+  EXPECT_EQ(t.classes.front().quota, 1);
+  EXPECT_EQ(t.classes.back().radius_m, 463.0);
+  EXPECT_EQ(t.populations.back(), (std::vector<std::int64_t>{1000}));
+  EXPECT_EQ(t.total(), 3);
+}
+
+// Same land (400 km2), cells of 100 m or 50 m: the same settlements. Ten times the people: more of them.
+TEST(RankSize, CountsFollowThePopulationNotTheGrid) {
+  SilentProgress progress;
+  SitesOptions o;
+  o.population = 200000;
+  const auto coarse = fixtures::flat_scenario(200, 200, 100.0), fine = fixtures::flat_scenario(400, 400, 50.0);
+  const SitesResult a = place_sites(coarse.density, coarse.buildable, o, progress);
+  const SitesResult b = place_sites(fine.density, fine.buildable, o, progress);
+  const auto count = [](const SitesResult& r) {
+    int n = 0;
+    for (const auto& q : r.quotas) n += q.quota;
+    return n;
+  };
+  EXPECT_EQ(count(a), count(b));
+  EXPECT_EQ(count(a), int(rank_size_populations(200000, 1, 1000).size()));
+  std::int64_t people = 0;
+  for (const auto& s : a.sites) people += s.population;
+  EXPECT_EQ(std::size_t(count(a)), a.sites.size());  // a flat, open region holds every settlement
+  EXPECT_EQ(people, 200000);
+  o.population = 2000000;
+  const SitesResult c = place_sites(coarse.density, coarse.buildable, o, progress);
+  EXPECT_GT(count(c), 5 * count(a));
+  // No population given: the default density over the land (buildable cells, 400 km2).
+  o.population = 0;
+  const SitesResult d = place_sites(coarse.density, coarse.buildable, o, progress);
+  EXPECT_TRUE(d.population_assumed);
+  EXPECT_NEAR(d.land_area_km2, 400.0, 1e-6);
+  EXPECT_EQ(d.target_population, 24000.0);
+}
