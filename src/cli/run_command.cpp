@@ -21,7 +21,9 @@ class RunCommand final : public Command {
   void setup(CLI::App& app) override {
     app.add_option("SCENARIO", file_, "Scenario file (JSON, see schemas/scenario.schema.json); default: the embedded scenario");
     app.add_option("--set", sets_, "Override a field: stage.field=value (repeatable), e.g. --set density.weights=[1,1,0,0]");
-    app.add_option("--seed", seed_, "Seed of the run (overrides the scenario's)");
+    // The schema's range (a JSON-safe integer): a negative or larger seed is refused, never replaced.
+    app.add_option("--seed", seed_, "Seed of the run, 0 .. 2^53-1 (overrides the scenario's)")
+        ->check(CLI::Range(std::uint64_t(0), std::uint64_t(9007199254740991)));
     app.add_option("-o,--output", output_, "Run folder (overrides the scenario's)");
     app.add_flag("--overwrite", overwrite_, "Replace the run folder if it exists");
     const std::vector<std::string> stages = pipeline::stage_names();
@@ -34,10 +36,9 @@ class RunCommand final : public Command {
     app.add_flag("--print-scenario", print_, "Print the resolved scenario (defaults filled) and exit");
   }
   void run(Context& context) override {
-    if (!output_.empty()) sets_.push_back("output=\"" + output_ + "\"");
-    std::optional<std::uint64_t> seed;
-    if (seed_ >= 0) seed = std::uint64_t(seed_);
-    const pipeline::Scenario scenario = pipeline::load_scenario(file_, sets_, seed);
+    // As a JSON string (quotes and backslashes escaped); an empty one is the schema's to refuse.
+    if (output_) sets_.push_back("output=" + nlohmann::json(*output_).dump());
+    const pipeline::Scenario scenario = pipeline::load_scenario(file_, sets_, seed_);
     if (print_) {
       std::printf("%s\n", scenario.resolved.dump(2).c_str());
       return;
@@ -55,9 +56,10 @@ class RunCommand final : public Command {
   }
 
  private:
-  std::string file_, output_, from_, until_;
+  std::string file_, from_, until_;
+  std::optional<std::string> output_;
   std::vector<std::string> sets_, only_;
-  long long seed_ = -1;
+  std::optional<std::uint64_t> seed_;
   bool overwrite_ = false, print_ = false;
 };
 

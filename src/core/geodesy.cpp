@@ -71,7 +71,14 @@ double CellMetrics::total_area_m2(int cols) const {
 }
 
 CellMetrics cell_metrics(const Georef& georef, int /*cols*/, int rows) {
-  return georef.crs.geographic ? geographic_metrics(georef, rows) : projected_metrics(georef, rows);
+  CellMetrics m = georef.crs.geographic ? geographic_metrics(georef, rows) : projected_metrics(georef, rows);
+  // Every stage divides by these: a zero, NaN or infinite cell (a geotransform that slipped past the
+  // reader, e.g. a grid built in code) is refused here rather than turned into a huge disc or loop.
+  const auto bad = [](double v) { return !std::isfinite(v) || v <= 0; };
+  if (std::any_of(m.width_m.begin(), m.width_m.end(), bad) || std::any_of(m.height_m.begin(), m.height_m.end(), bad) ||
+      std::any_of(m.area_m2.begin(), m.area_m2.end(), bad))
+    throw bad_input("the grid's geotransform gives a zero, negative or non-finite cell size");
+  return m;
 }
 
 double geodesic_distance_m(const Ellipsoid& e, double lon1, double lat1, double lon2, double lat2) {

@@ -110,6 +110,51 @@ Crs crs_from_user(const std::string& definition) {
 
 Crs wgs84() { return crs_from_user("EPSG:4326"); }
 
+namespace {
+
+/// The value of "+key=" in a PROJ string, or "".
+std::string proj_parameter(const std::string& proj4, const std::string& key) {
+  const std::string token = "+" + key + "=";
+  const auto at = proj4.find(token);
+  if (at == std::string::npos) return "";
+  const auto start = at + token.size();
+  return proj4.substr(start, proj4.find(' ', start) - start);
+}
+
+}  // namespace
+
+CrsDefinition crs_definition(const Crs& crs) {
+  // With an EPSG code, the official definition (its AUTHORITY node): QGIS then identifies the code
+  // rather than matching the file's WKT to another CRS (OGC:CRS84 for an ESRI .prj of WGS 84).
+  OGRSpatialReference srs = detail::to_ogr(crs);
+  if (crs.epsg) {
+    OGRSpatialReference official;
+    CPLErrorReset();
+    if (official.importFromEPSG(*crs.epsg) == OGRERR_NONE) srs = official;
+  }
+  CrsDefinition d;
+  d.description = crs.name;
+  d.epsg = crs.epsg;
+  d.geographic = crs.geographic;
+  CPLErrorReset();
+  char* text = nullptr;
+  const char* wkt1[] = {"FORMAT=WKT1_GDAL", nullptr};
+  d.wkt = srs.exportToWkt(&text, wkt1) == OGRERR_NONE && text ? text : crs.wkt;
+  CPLFree(text);
+  text = nullptr;
+  if (srs.exportToProj4(&text) == OGRERR_NONE && text) d.proj4 = text;
+  CPLFree(text);
+  while (!d.proj4.empty() && d.proj4.back() == ' ') d.proj4.pop_back();
+  d.projection_acronym = proj_parameter(d.proj4, "proj");
+  const char* ellipsoid_auth = srs.GetAuthorityName("SPHEROID");
+  const char* ellipsoid_code = srs.GetAuthorityCode("SPHEROID");
+  if (ellipsoid_auth && ellipsoid_code) d.ellipsoid_acronym = std::string(ellipsoid_auth) + ":" + ellipsoid_code;
+  else d.ellipsoid_acronym = proj_parameter(d.proj4, "ellps");
+  if (d.ellipsoid_acronym.empty())  // a datum named by PROJ (+datum=NAD83) hides its ellipsoid: its name then
+    if (const char* name = srs.GetAttrValue("SPHEROID")) d.ellipsoid_acronym = name;
+  return d;
+}
+
 struct CrsTransform::Impl {
   OGRCoordinateTransformation* ct = nullptr;
   ~Impl() { if (ct) OGRCoordinateTransformation::DestroyCT(ct); }

@@ -3,6 +3,7 @@
 #pragma once
 #include <array>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "core/raster.hpp"
@@ -14,6 +15,16 @@ Crs crs_from_user(const std::string& definition);
 
 /// WGS 84 longitude/latitude, longitude first.
 Crs wgs84();
+
+/// A CRS spelled every way a client without PROJ's database lookup may need (QGIS's
+/// <spatialrefsys>): WKT (WKT1 when it can hold the CRS, else WKT2), PROJ string, and the
+/// acronyms of its projection ("longlat", "utm") and ellipsoid ("EPSG:7030", else PROJ's name).
+struct CrsDefinition {
+  std::string wkt, proj4, description, projection_acronym, ellipsoid_acronym;
+  std::optional<int> epsg;
+  bool geographic = false;
+};
+CrsDefinition crs_definition(const Crs& crs);
 
 /// Transforms coordinates from one CRS to another, longitude first for geographic CRSs.
 class CrsTransform {

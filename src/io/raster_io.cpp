@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <limits>
 #include <memory>
@@ -69,6 +70,84 @@ double vertical_factor(const std::string& path, GDALRasterBand* band, const OGRS
   throw bad_input(path + ": unknown vertical unit '" + unit + "'");
 }
 
+std::string number(double v) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.10g", v);
+  return text;
+}
+
+/// Refuses a geotransform no stage can work on: non-finite terms, a zero or degenerate cell (its
+/// two axes parallel), a geographic extent off the globe, or a projected extent larger than the Earth.
+void check_georeferencing(const std::string& path, const RasterHeader& h) {
+  const GeoTransform& gt = h.georef.transform;
+  if (!std::all_of(gt.begin(), gt.end(), [](double v) { return std::isfinite(v); }))
+    throw bad_input(path + ": geotransform has a NaN or infinite term (" + number(gt[0]) + ", " + number(gt[1]) + ", " +
+                    number(gt[2]) + ", " + number(gt[3]) + ", " + number(gt[4]) + ", " + number(gt[5]) + ")");
+  const double width = std::hypot(gt[1], gt[4]), height = std::hypot(gt[2], gt[5]);
+  if (width == 0 || height == 0)
+    throw bad_input(path + ": geotransform has a zero cell size (" + number(width) + " x " + number(height) + ")");
+  // |det| = width * height * sin(angle between the axes): near 0, the cells are flat parallelograms.
+  const double det = gt[1] * gt[5] - gt[2] * gt[4];
+  if (std::abs(det) < 1e-6 * width * height)
+    throw bad_input(path + ": geotransform is degenerate (its pixel and line axes are parallel)");
+  const double xs[4] = {gt[0], gt[0] + h.cols * gt[1], gt[0] + h.rows * gt[2], gt[0] + h.cols * gt[1] + h.rows * gt[2]};
+  const double ys[4] = {gt[3], gt[3] + h.cols * gt[4], gt[3] + h.rows * gt[5], gt[3] + h.cols * gt[4] + h.rows * gt[5]};
+  const auto [xmin, xmax] = std::minmax_element(std::begin(xs), std::end(xs));
+  const auto [ymin, ymax] = std::minmax_element(std::begin(ys), std::end(ys));
+  if (h.georef.crs.geographic) {
+    // Half a cell of slack: grids registered on their nodes put cell edges just past the poles or the antimeridian.
+    const double sx = 0.5 * width + 1e-9, sy = 0.5 * height + 1e-9;
+    if (*ymin < -90 - sy || *ymax > 90 + sy || *xmin < -180 - sx || *xmax > 360 + sx || *xmax - *xmin > 360 + 2 * sx)
+      throw bad_input(path + ": geographic extent lon " + number(*xmin) + " .. " + number(*xmax) + ", lat " + number(*ymin) +
+                      " .. " + number(*ymax) + " is outside [-180, 360] x [-90, 90] (a pixel-unit geotransform labelled with a "
+                      "geographic CRS?)");
+    // Cell widths vanish at a pole: a row centred on it (a node-registered global grid) has no area.
+    const double top = gt[3] + 0.5 * gt[5], bottom = gt[3] + (h.rows - 0.5) * gt[5];
+    if (std::max(std::abs(top), std::abs(bottom)) >= 90)
+      throw bad_input(path + ": a row of cells is centred on a pole (a node-registered grid?); crop that row");
+  } else {
+    const double unit = h.georef.crs.linear_unit_m, earth = 5e7;  // the equator (40,075 km), with margin
+    if ((*xmax - *xmin) * unit > earth || (*ymax - *ymin) * unit > earth)
+      throw bad_input(path + ": extent " + number((*xmax - *xmin) * unit / 1000) + " x " + number((*ymax - *ymin) * unit / 1000) +
+                      " km is larger than the Earth (wrong cell size or unit?)");
+  }
+}
+
+/// Every output vector is written in WGS 84 lon/lat (RFC 7946): refuse up front a DEM whose cells
+/// cannot all be transformed there (a CRS used outside its projection's domain, e.g. a UTM zone
+/// labelling coordinates thousands of kilometres from its meridian), rather than fail on an output.
+/// Tests cell centres on a lattice of at most 257 x 257, its last row and column on the grid's.
+void check_lonlat_domain(const std::string& path, const RasterHeader& h) {
+  if (h.georef.crs.empty()) return;
+  const OGRSpatialReference from = detail::to_ogr(h.georef.crs);
+  OGRSpatialReference to;
+  to.SetWellKnownGeogCS("WGS84");
+  to.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  QuietGdal quiet;
+  std::unique_ptr<OGRCoordinateTransformation> ct(OGRCreateCoordinateTransformation(&from, &to));
+  if (!ct) throw bad_input(path + ": its CRS cannot be transformed to WGS 84 (" + detail::last_gdal_error("no transformation") + ")");
+  auto lattice = [](int n) {
+    std::vector<double> at;
+    const int step = std::max(1, n / 256);
+    for (int i = 0; i < n; i += step) at.push_back(i + 0.5);
+    if (at.back() != n - 0.5) at.push_back(n - 0.5);
+    return at;
+  };
+  const std::vector<double> cols = lattice(h.cols), rows = lattice(h.rows);
+  const GeoTransform& gt = h.georef.transform;
+  std::vector<double> x, y;
+  for (double r : rows)
+    for (double c : cols) x.push_back(gt[0] + c * gt[1] + r * gt[2]), y.push_back(gt[3] + c * gt[4] + r * gt[5]);
+  std::vector<double> lon = x, lat = y;
+  std::vector<int> ok(x.size(), 0);
+  ct->Transform(x.size(), lon.data(), lat.data(), nullptr, ok.data());
+  for (std::size_t i = 0; i < x.size(); ++i)
+    if (!ok[i] || !std::isfinite(lon[i]) || !std::isfinite(lat[i]) || std::abs(lat[i]) > 90)
+      throw bad_input(path + ": the cell at " + h.georef.crs.name + " (" + number(x[i]) + ", " + number(y[i]) +
+                      ") cannot be transformed to WGS 84 lon/lat (" + detail::last_gdal_error("outside the CRS's domain") +
+                      "); is the CRS right?");
+}
+
 RasterHeader header_of(const std::string& path, GDALDataset& ds, const ReadOptions& options, GDALRasterBand*& band_out,
                        double& vfactor) {
   RasterHeader h;
@@ -106,6 +185,7 @@ RasterHeader header_of(const std::string& path, GDALDataset& ds, const ReadOptio
     h.georef.crs = detail::describe(*srs);
   } else if (options.assume_crs) {
     OGRSpatialReference user;
+    QuietGdal quiet;
     if (user.SetFromUserInput(options.assume_crs->c_str()) != OGRERR_NONE)
       throw bad_input(path + ": unknown CRS '" + *options.assume_crs + "' given to --assume-crs");
     h.georef.crs = detail::describe(user);
@@ -114,6 +194,8 @@ RasterHeader header_of(const std::string& path, GDALDataset& ds, const ReadOptio
   }
   if (h.georef.crs.geographic && (gt[2] != 0 || gt[4] != 0))
     throw bad_input(path + ": rotated geographic grids are not supported");
+  check_georeferencing(path, h);
+  check_lonlat_domain(path, h);
   int has_nodata = 0;
   const double nd = b->GetNoDataValue(&has_nodata);
   if (has_nodata) h.nodata = nd;
@@ -173,6 +255,9 @@ void init_gdal() {
   std::call_once(once, [] {
     GDALAllRegister();
     CPLSetConfigOption("GDAL_PAM_ENABLED", "NO");  // never write .aux.xml beside inputs or outputs
+    // GDAL's messages never reach the terminal on their own ("ERROR 1: ..." before our line): each
+    // failure is reported once, naming the input, from CPLGetLastErrorMsg (recorded before handlers run).
+    CPLSetErrorHandler(CPLQuietErrorHandler);
   });
 }
 

@@ -123,7 +123,7 @@ void write_vector(const std::string& path, const VectorLayer& layer, bool overwr
 VectorLayer read_vector(const std::string& path, const Crs& target) {
   init_gdal();
   std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) throw bad_input(path + ": no such file");
+  if (!std::filesystem::exists(path, ec) && path.rfind("/vsi", 0) != 0) throw bad_input(path + ": no such file");
   CPLPushErrorHandler(CPLQuietErrorHandler);
   CPLErrorReset();
   GDALDataset* ds = GDALDataset::Open(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY);

@@ -3,12 +3,14 @@
 #include "pipeline/compare.hpp"
 
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <set>
 #include <sstream>
 
 #include "core/error.hpp"
+#include "core/json_input.hpp"
 
 namespace terrapolis::pipeline {
 namespace {
@@ -62,12 +64,13 @@ std::string text(const json& v) {
 
 json load_manifest(const std::string& run_folder) {
   const std::string path = run_folder + "/run.json";
-  std::ifstream in(path);
-  if (!in) throw bad_input(run_folder + ": not a run folder (no run.json)");
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) throw bad_input(run_folder + ": not a run folder (no run.json)");
+  const std::string text = read_json_file(path);
   try {
-    return json::parse(in);
-  } catch (const json::parse_error&) {
-    throw bad_input(path + ": not valid JSON");
+    return json::parse(text);
+  } catch (const json::exception& e) {
+    throw bad_input(path + ": not valid JSON (" + json_error_text(e.what()) + ")");
   }
 }
 

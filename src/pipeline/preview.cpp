@@ -194,18 +194,22 @@ void write_preview(const RunState& state, const std::string& path, int width) {
   if (state.density) legend.insert(legend.begin(), {hex(0xf03b20), "density", false});
   legend.insert(legend.begin(), {hex(0x9ecae1), "sea", false});
 
-  // Legend box, bottom left.
-  const int row_h = int(14 * unit), box_w = int(110 * unit), box_h = row_h * int(legend.size()) + int(8 * unit);
-  const int bx = int(8 * unit), by = height - box_h - int(8 * unit);
-  canvas.rect(bx, by, bx + box_w, by + box_h, hex(0xffffff), 0.8f);
+  // Legend box, bottom left, scaled down to fit the image (in units: 126 wide with its margins,
+  // 14 per entry plus 24 high); left out when its text would be under 7 px (a thumbnail).
   std::vector<TerrapolisPngText> texts;
-  const float black[3] = {0.1f, 0.1f, 0.1f};
-  for (std::size_t i = 0; i < legend.size(); ++i) {
-    const int y = by + int(4 * unit) + int(i) * row_h;
-    const int sw = int(18 * unit), sh = legend[i].line ? std::max(2, int(3 * unit)) : int(9 * unit);
-    const int sx0 = bx + int(5 * unit), sy0 = y + (row_h - sh) / 2;
-    canvas.rect(sx0, sy0, sx0 + sw, sy0 + sh, legend[i].color);
-    texts.push_back({bx + int(28 * unit), y + row_h - int(3 * unit), int(11 * unit), {black[0], black[1], black[2]}, legend[i].label.c_str()});
+  const double lu = std::min({unit, width / 126.0, height / (14.0 * double(legend.size()) + 24.0)});
+  if (11 * lu >= 7) {
+    const int row_h = int(14 * lu), box_w = int(110 * lu), box_h = row_h * int(legend.size()) + int(8 * lu);
+    const int bx = int(8 * lu), by = height - box_h - int(8 * lu);
+    canvas.rect(bx, by, bx + box_w, by + box_h, hex(0xffffff), 0.8f);
+    const float black[3] = {0.1f, 0.1f, 0.1f};
+    for (std::size_t i = 0; i < legend.size(); ++i) {
+      const int y = by + int(4 * lu) + int(i) * row_h;
+      const int sw = int(18 * lu), sh = legend[i].line ? std::max(2, int(3 * lu)) : int(9 * lu);
+      const int sx0 = bx + int(5 * lu), sy0 = y + (row_h - sh) / 2;
+      canvas.rect(sx0, sy0, sx0 + sw, sy0 + sh, legend[i].color);
+      texts.push_back({bx + int(28 * lu), y + row_h - int(3 * lu), int(11 * lu), {black[0], black[1], black[2]}, legend[i].label.c_str()});
+    }
   }
   const std::string tmp = path + ".tmp.png";
   char error[512] = {};

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "io/crs.hpp"
 
 namespace terrapolis::pipeline {
 namespace {
@@ -34,6 +35,18 @@ std::string escape(const std::string& s) {
     }
   }
   return out;
+}
+
+/// A complete <spatialrefsys>: QGIS 3.22 rebuilds the CRS from <wkt> (an <authid> alone reads as an
+/// invalid CRS unless <srsid>, QGIS's own database key, is also right; it is left out).
+std::string spatialrefsys(const CrsDefinition& d) {
+  std::ostringstream x;
+  x << "<spatialrefsys><wkt>" << escape(d.wkt) << "</wkt><proj4>" << escape(d.proj4) << "</proj4>";
+  if (d.epsg) x << "<srid>" << *d.epsg << "</srid><authid>EPSG:" << *d.epsg << "</authid>";
+  x << "<description>" << escape(d.description) << "</description><projectionacronym>" << escape(d.projection_acronym)
+    << "</projectionacronym><ellipsoidacronym>" << escape(d.ellipsoid_acronym) << "</ellipsoidacronym><geographicflag>"
+    << (d.geographic ? "true" : "false") << "</geographicflag></spatialrefsys>";
+  return x.str();
 }
 
 std::string num(double v) {
@@ -216,11 +229,8 @@ std::string qgis_style_body(const OutputFile& o, const RunState& state) {
 }
 
 void write_qgis_styles_and_project(const RunState& state) {
-  const Crs& crs = state.dem.georef().crs;
-  // With an EPSG code, QGIS takes the official definition (its axis order); otherwise the WKT.
-  const std::string srs = crs.epsg ? "<spatialrefsys><authid>EPSG:" + std::to_string(*crs.epsg) + "</authid></spatialrefsys>"
-                                   : "<spatialrefsys><wkt>" + escape(crs.wkt) + "</wkt><description>" + escape(crs.name) + "</description></spatialrefsys>";
-  const std::string srs_lonlat = "<spatialrefsys><authid>EPSG:4326</authid></spatialrefsys>";
+  const std::string srs = spatialrefsys(crs_definition(state.dem.georef().crs));
+  const std::string srs_lonlat = spatialrefsys(crs_definition(wgs84()));
 
   std::vector<const OutputFile*> layers;
   for (const auto& o : state.outputs) layers.push_back(&o);
@@ -263,7 +273,9 @@ void write_qgis_styles_and_project(const RunState& state) {
       << "<projectCrs>" << srs << "</projectCrs>"
       << "<layer-tree-group><customproperties/>" << tree.str() << "<custom-order enabled=\"0\">" << order.str() << "</custom-order></layer-tree-group>"
       << "<projectlayers>" << project_layers.str() << "</projectlayers>"
-      << "<properties><Paths><Absolute type=\"bool\">false</Absolute></Paths></properties></qgis>\n";
+      // QGIS reads <projectCrs> only when SpatialRefSys/ProjectionsEnabled is set.
+      << "<properties><Paths><Absolute type=\"bool\">false</Absolute></Paths>"
+      << "<SpatialRefSys><ProjectionsEnabled type=\"int\">1</ProjectionsEnabled></SpatialRefSys></properties></qgis>\n";
   if (!out) throw processing_error((state.folder / "project.qgs").string() + ": cannot write");
 }
 

@@ -7,10 +7,10 @@
 #include <valijson/schema_parser.hpp>
 #include <valijson/validator.hpp>
 
-#include <fstream>
 #include <sstream>
 
 #include "core/error.hpp"
+#include "core/json_input.hpp"
 #include "core/text.hpp"
 
 namespace terrapolis::pipeline {
@@ -54,17 +54,21 @@ void apply_set(json& doc, const std::string& set) {
   const auto eq = set.find('=');
   if (eq == std::string::npos || eq == 0) throw bad_input("--set " + set + ": expected stage.field=value");
   const std::string key = set.substr(0, eq), text = set.substr(eq + 1);
+  check_json_text(text, "--set " + key);
   json value;
   try {
     value = json::parse(text);
   } catch (const json::parse_error&) {
     value = text;  // a bare word is a string
+  } catch (const json::exception& e) {
+    throw bad_input("--set " + set + ": " + json_error_text(e.what()));
   }
   json* node = &doc;
   std::stringstream parts(key);
   std::string part;
   std::vector<std::string> path;
   while (std::getline(parts, part, '.')) path.push_back(part);
+  if (path.size() > std::size_t(kMaxJsonDepth)) throw bad_input("--set " + key + ": nests deeper than " + std::to_string(kMaxJsonDepth) + " levels");
   for (std::size_t i = 0; i + 1 < path.size(); ++i) {
     json& next = (*node)[path[i]];
     if (next.is_null()) next = json::object();
@@ -113,23 +117,11 @@ std::string validate_scenario(const json& scenario) {
   return json_pointer_of(best.context) + ": " + best.description;
 }
 
-Scenario load_scenario(const std::string& file, const std::vector<std::string>& sets, std::optional<std::uint64_t> seed) {
-  Scenario s;
-  json doc = json::object();
-  if (file.empty()) {
-    s.source = "(default scenario)";
-  } else {
-    s.source = file;
-    std::ifstream in(file);
-    if (!in) throw bad_input(file + ": no such scenario file");
-    try {
-      doc = json::parse(in);
-    } catch (const json::parse_error& e) {
-      throw bad_input(file + ": not valid JSON (" + std::string(e.what()) + ")");
-    }
-    if (!doc.is_object()) throw bad_input(file + ": /: a scenario is a JSON object");
-    s.base_dir = std::filesystem::path(file).parent_path();
-  }
+namespace {
+
+/// Overrides, validation and defaults over a parsed document.
+void resolve(Scenario& s, json doc, const std::vector<std::string>& sets, std::optional<std::uint64_t> seed) {
+  if (!doc.is_object()) throw bad_input(s.source + ": /: a scenario is a JSON object");
   for (const auto& set : sets) apply_set(doc, set);
   if (seed) doc["seed"] = *seed;
   const std::string problem = validate_scenario(doc);
@@ -152,6 +144,36 @@ Scenario load_scenario(const std::string& file, const std::vector<std::string>& 
         for (const auto& [field, value] : item_defaults.items())
           if (!item.contains(field)) item[field] = value;
     }
+}
+
+}  // namespace
+
+Scenario scenario_from_text(const std::string& text, const std::string& source, const std::vector<std::string>& sets,
+                            std::optional<std::uint64_t> seed) {
+  Scenario s;
+  s.source = source;
+  check_json_text(text, source);
+  json doc;
+  try {
+    doc = json::parse(text);
+  } catch (const json::exception& e) {
+    throw bad_input(source + ": not valid JSON (" + json_error_text(e.what()) + ")");
+  }
+  resolve(s, std::move(doc), sets, seed);
+  return s;
+}
+
+Scenario load_scenario(const std::string& file, const std::vector<std::string>& sets, std::optional<std::uint64_t> seed) {
+  if (file.empty()) {
+    Scenario s;
+    s.source = "(default scenario)";
+    resolve(s, json::object(), sets, seed);
+    return s;
+  }
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec)) throw bad_input(file + ": no such scenario file");
+  Scenario s = scenario_from_text(read_json_file(file), file, sets, seed);
+  s.base_dir = std::filesystem::path(file).parent_path();
   return s;
 }
 

@@ -34,6 +34,11 @@ struct Scenario {
 Scenario load_scenario(const std::string& file, const std::vector<std::string>& sets = {},
                        std::optional<std::uint64_t> seed = std::nullopt);
 
+/// The same from the scenario's JSON text; `source` names it in errors (base_dir is left empty).
+/// Bounded before parsing (core/json_input.hpp). The scenario fuzz harness's entry point.
+Scenario scenario_from_text(const std::string& text, const std::string& source, const std::vector<std::string>& sets = {},
+                            std::optional<std::uint64_t> seed = std::nullopt);
+
 /// The object of all defaults declared in the schema (the embedded default scenario).
 nlohmann::ordered_json schema_defaults();
 

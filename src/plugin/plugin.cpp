@@ -19,6 +19,7 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "core/json_input.hpp"
 #include "core/text.hpp"
 #include "core/geodesy.hpp"
 #include "plugin/terrapolis_plugin.h"
@@ -180,18 +181,17 @@ PluginSpec parse_plugin_option(const std::string& text) {
   if (rest.front() == '{') {
     body = rest;
   } else {
-    std::ifstream in(rest);
-    if (!in) throw bad_input(option + ": " + rest + ": no such parameter file");
-    std::stringstream ss;
-    ss << in.rdbuf();
-    body = ss.str();
+    std::error_code ec;
+    if (!fs::is_regular_file(rest, ec)) throw bad_input(option + ": " + rest + ": no such parameter file");
+    body = read_json_file(rest);
     origin = rest;
     s.base_dir = fs::path(rest).parent_path().string();
   }
+  check_json_text(body, origin);
   try {
     s.params = json::parse(body);
   } catch (const json::exception& e) {
-    throw bad_input(origin + ": parameters are not valid JSON (" + std::string(e.what()) + ")");
+    throw bad_input(origin + ": parameters are not valid JSON (" + json_error_text(e.what()) + ")");
   }
   if (!s.params.is_object()) throw bad_input(origin + ": parameters must be a JSON object");
   return s;
@@ -367,11 +367,13 @@ std::vector<RoadTerm> road_terms(const PluginSet& set, const Dem& dem, Progress&
     });
     transfer.back() = '\0';
     const std::string origin = where(p) + ": transfer functions";
+    const std::string text(transfer.data());
+    check_json_text(text, origin);
     json j;
     try {
-      j = json::parse(std::string(transfer.data()));
+      j = json::parse(text);
     } catch (const json::exception& e) {
-      throw bad_input(origin + ": not valid JSON (" + std::string(e.what()) + ")");
+      throw bad_input(origin + ": not valid JSON (" + json_error_text(e.what()) + ")");
     }
     if (!j.is_object()) throw bad_input(origin + ": expected an object with road, bridge, tunnel keys");
     for (auto it = j.begin(); it != j.end(); ++it) {

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "core/json_input.hpp"
 
 namespace terrapolis::roads {
 
@@ -82,6 +83,16 @@ CostModel default_cost_model() {
 }
 
 namespace {
+
+/// JSON text bounded (size, depth, number range) then parsed; one-line errors naming `origin`.
+nlohmann::json parse_bounded(const std::string& text, const std::string& origin) {
+  check_json_text(text, origin);
+  try {
+    return nlohmann::json::parse(text);
+  } catch (const nlohmann::json::exception& e) {
+    throw bad_input(origin + ": not valid JSON (" + json_error_text(e.what()) + ")");
+  }
+}
 
 using nlohmann::json;
 
@@ -182,24 +193,14 @@ json structure_json(const StructureCosts& s, bool bridge, bool tunnel) {
 }  // namespace
 
 TransferFunction parse_transfer_function(const std::string& text, const std::string& origin) {
-  json j;
-  try {
-    j = json::parse(text);
-  } catch (const json::exception& e) {
-    throw bad_input(origin + ": not valid JSON (" + std::string(e.what()) + ")");
-  }
+  const json j = parse_bounded(text, origin);
   TransferFunction f;
   read_transfer(j, f, origin, "transfer function");
   return f;
 }
 
 CostModel parse_cost_model(const std::string& text, const std::string& origin, CostModel m) {
-  json j;
-  try {
-    j = json::parse(text);
-  } catch (const json::exception& e) {
-    throw bad_input(origin + ": not valid JSON (" + std::string(e.what()) + ")");
-  }
+  const json j = parse_bounded(text, origin);
   if (!j.is_object()) throw bad_input(origin + ": expected a JSON object");
   for (auto it = j.begin(); it != j.end(); ++it) {
     const std::string& key = it.key();
@@ -224,11 +225,7 @@ CostModel parse_cost_model(const std::string& text, const std::string& origin, C
 }
 
 CostModel load_cost_model(const std::string& path, CostModel base) {
-  std::ifstream in(path);
-  if (!in) throw bad_input(path + ": cannot open the cost file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parse_cost_model(ss.str(), path, std::move(base));
+  return parse_cost_model(read_json_file(path), path, std::move(base));
 }
 
 std::string cost_model_json(const CostModel& m) {

@@ -181,15 +181,17 @@ double step_of(const TerrainField& terrain, const CostModel& model) {
   return model.sample_step_m > 0 ? model.sample_step_m : 0.5 * terrain.min_cell_m();
 }
 
-/// Classifies each segment by the deck height against the surface (Peytavie §4.4.2).
+/// Classifies each segment by the deck height against the surface (Peytavie §4.4.2). A disabled
+/// structure is never built: its segments stay roads (the search already kept roads off deep water
+/// and away from heights a structure would need; what is left is the smoothing's corridor).
 void classify(const TerrainField& terrain, const CostModel& model, RoadGeometry& road) {
   road.segments.assign(road.points.size() > 0 ? road.points.size() - 1 : 0, Structure::road);
   for (std::size_t i = 0; i + 1 < road.points.size(); ++i) {
     const GridPoint m = lerp(road.points[i], road.points[i + 1], 0.5);
     const double dz = 0.5 * (road.z[i] + road.z[i + 1]) - terrain.surface_at(m.col, m.row);
     const bool over_water = terrain.depth_at(m.col, m.row) > model.road.water_depth_m.threshold;
-    if (dz > model.structure_min_m || over_water) road.segments[i] = Structure::bridge;
-    else if (dz < -model.structure_min_m) road.segments[i] = Structure::tunnel;
+    if (model.bridge.enabled && (dz > model.structure_min_m || over_water)) road.segments[i] = Structure::bridge;
+    else if (model.tunnel.enabled && dz < -model.structure_min_m) road.segments[i] = Structure::tunnel;
   }
 }
 
