@@ -601,6 +601,27 @@ class RelaxedDistance {
     const CostModel& m = graph.model();
     fixed_[1] = m.bridge.height_m.min_value() + m.bridge.water_depth_m.min_value() + m.bridge.vegetation.min_value();
     fixed_[2] = m.tunnel.depth_m.min_value() + m.tunnel.water_depth_m.min_value() + m.tunnel.vegetation.min_value();
+    // Deck slope cost against the grade as a table of lower bounds: entry i is the smallest cost at
+    // any grade >= i x step. Each piece of the curve is monotone in the grade, so that minimum is at
+    // i x step or at a breakpoint beyond it.
+    for (int st = 1; st < 3; ++st) {
+      const TransferFunction& f = st == 1 ? m.bridge.slope_deg : m.tunnel.slope_deg;
+      tan_max_[st] = f.threshold < 90 ? std::tan(f.threshold / kDeg) : kInfinity;
+      const double gmax = f.threshold < 90 ? tan_max_[st] : std::tan(89.5 / kDeg);
+      constexpr std::size_t kSteps = 2048;
+      grade_step_[st] = gmax / kSteps;
+      auto& table = slope_floor_[st];
+      table.assign(kSteps + 1, kInfinity);
+      double beyond = f(std::min(f.threshold, std::atan(gmax) * kDeg));
+      for (std::size_t i = kSteps + 1; i-- > 0;) {
+        const double lo_deg = std::min(f.threshold, std::atan(double(i) * grade_step_[st]) * kDeg), hi_deg = std::atan(double(i + 1) * grade_step_[st]) * kDeg;
+        for (const auto& p : f.points)
+          if (p[0] >= lo_deg && (p[0] < hi_deg || i == kSteps) && p[0] <= f.threshold) beyond = std::min(beyond, p[1]);
+        beyond = std::min(beyond, f(lo_deg));
+        table[i] = beyond;
+      }
+      if (f.points.empty()) table.assign(kSteps + 1, 0.0);
+    }
     relax(t_.index(target.col, target.row), 0.0);
   }
   ~RelaxedDistance() {
@@ -690,16 +711,20 @@ class RelaxedDistance {
     // Sampled pairs are unordered: the long arcs out of v list the cells w whose arc w -> v exists.
     for (std::size_t r = 0; r < graph_.rings().size(); ++r) {
       const Structure st = graph_.rings()[r].structure;
-      const StructureCosts& sc = st == Structure::bridge ? graph_.model().bridge : graph_.model().tunnel;
       for (int a : graph_.arcs_from(v, 0, int(r) + 1)) {
         const Cell w{v.col + arcs[std::size_t(a)].dcol, v.row + arcs[std::size_t(a)].drow};
         if (!t_.inside(w.col, w.row) || t_.water(w.col, w.row)) continue;
         const std::size_t wi = t_.index(w.col, w.row);
         if (scratch().closed[wi]) continue;
-        // As arc_cost prices the arc w -> v: the deck slope from the two surfaces over its length.
+        // As arc_cost prices the arc w -> v: the deck slope from the two surfaces over its length,
+        // here bounded from the table (no atan, no curve lookup per arc).
         const double length = t_.length_m({double(w.col), double(w.row)}, {double(v.col), double(v.row)});
-        const double slope = sc.slope_deg(std::atan(std::fabs(zv - double(t_.surface(w.col, w.row))) / length) * kDeg);
-        if (slope == kInfinity) continue;
+        const double floor = fixed_[int(st)] + slope_floor_[int(st)].front();
+        if (d + (1 - 1e-6) * length * floor >= scratch().g[wi]) continue;  // cannot improve w
+        const double grade = std::fabs(zv - double(t_.surface(w.col, w.row))) / length;
+        if (grade > tan_max_[int(st)] * (1 + 1e-9)) continue;  // the deck breaks the slope threshold
+        const auto& table = slope_floor_[int(st)];
+        const double slope = table[std::min(table.size() - 1, std::size_t(grade / grade_step_[int(st)]))];
         // 1e-6 covers the float rounding of the priced long arcs.
         relax(wi, d + (1 - 1e-6) * length * (slope + fixed_[int(st)]));
       }
@@ -713,6 +738,8 @@ class RelaxedDistance {
   std::optional<Scratch> own_;
   std::vector<Entry> heap_;
   double fixed_[3] = {0, 0, 0};
+  std::vector<double> slope_floor_[3];  ///< per structure: lower bounds of the deck slope cost by grade step
+  double grade_step_[3] = {1, 1, 1}, tan_max_[3] = {kInfinity, kInfinity, kInfinity};
   std::size_t settled_ = 0;
 };
 
