@@ -24,7 +24,8 @@ struct FlatWater {
 /// Flat water: 8-connected components of land cells above the sea level whose elevation differs
 /// from a neighbour's by at most `tolerance_m`, seeded only by cells all of whose 8 neighbours are on
 /// the same level (so a lone flat pair in noisy terrain never grows), kept when their geodesic area
-/// reaches `min_area_km2`. Real terrain of SRTM's 1 m resolution varies by metres between 30-90 m
+/// reaches `min_area_km2` and at most a quarter of the cells around it lie below its level (water sits
+/// in a basin; a dead-level valley floor falls away downstream). Real terrain of SRTM's 1 m resolution varies by metres between 30-90 m
 /// cells; a water level is one value over square kilometres.
 FlatWater detect_flat_water(const Dem& dem, const FlatWaterOptions& options);
 

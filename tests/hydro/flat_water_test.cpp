@@ -78,3 +78,14 @@ TEST(FlatWater, RoadsGoAroundOrBridgeTheLakeNeverOnIt) {
     EXPECT_TRUE(crossed);
   }
 }
+
+TEST(FlatWater, ALevelValleyFloorThatFallsAwayIsNotALake) {
+  // A dead-level plain at 100 m (40 x 40 cells) rising to the north and west but falling away to
+  // the east and south, as an alluvial floor does downstream: half its surroundings lie below it.
+  const Dem dem = roads::test::make_dem(60, 60, 10.0, [](int c, int r) {
+    if (c >= 10 && c < 50 && r >= 10 && r < 50) return 100.0;
+    if (c >= 50 || r >= 50) return 90.0 - double((c + r) % 3);
+    return 110.0 + double((c * 7 + r * 3) % 4);
+  });
+  EXPECT_EQ(hydro::detect_flat_water(dem, {0.02, 0.0, 0.0}).lakes, 0u);
+}
