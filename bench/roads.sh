@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Roads benchmark: one long road on the SRTM3 Alps tile (k = 5, m = 8), surface only and with
-# bridges and tunnels, by A* and bidirectional A*, against GRASS r.walk + r.drain between the same
+# bridges and tunnels, by A* (relaxed-distance heuristic), A* with the straight-line bound and
+# bidirectional A*, against GRASS r.walk + r.drain between the same
 # points; prints time, nodes expanded, long-arc rings priced, peak memory and each path's cost under
 # the Terrapolis cost model. Then a shorter road in the same tile, and a network on an island.
 # Usage: bench/roads.sh [BUILD_DIR]   (run from the repository root)
@@ -19,8 +20,10 @@ run() {  # label, extra arguments (the end points are $from and $to)
   grep -o 'corners:.*' "$out/$label.log" | sed "s/^/  $label /"
 }
 run surface_astar --no-bridges --no-tunnels
+run surface_astar_distance --no-bridges --no-tunnels --search astar-distance
 run surface_bidir --no-bridges --no-tunnels --search bidir
 run structures_astar
+run structures_astar_distance --search astar-distance
 run structures_bidir --search bidir
 
 if command -v grass >/dev/null; then

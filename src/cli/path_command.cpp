@@ -29,7 +29,8 @@ class PathCommand final : public Command {
     app.add_option("--to", to_, "End point LON,LAT (or X,Y with --crs dem)")->required();
     app.add_option("OUT", out_, "Output road (.geojson or .gpkg)")->required();
     app.add_option("--crs", crs_, "CRS of --from/--to: lonlat (WGS 84) or dem (the DEM's CRS)")->check(CLI::IsMember({"lonlat", "dem"}));
-    app.add_option("--search", search_, "Search: astar, bidir (bidirectional A*), dijkstra")->check(CLI::IsMember({"astar", "bidir", "dijkstra"}));
+    app.add_option("--search", search_, "Search: astar (heuristic: relaxed 2-D distance), astar-distance (heuristic: straight-line bound), bidir (bidirectional A*, straight-line bound), dijkstra")
+        ->check(CLI::IsMember({"astar", "astar-distance", "bidir", "dijkstra"}));
     app.add_option("--sections", sections_, "Also write the road/bridge/tunnel sections to this file");
     app.add_option("--evaluate", evaluate_, "Instead of routing, print the cost under the cost model of the first line of this file "
                                             "(e.g. another tool's path), walked cell by cell; OUT is not written");
@@ -38,14 +39,18 @@ class PathCommand final : public Command {
 
   void run(Context& context) override {
     roads::RoutingOptions routing = options_.routing();
-    routing.search = search_ == "bidir" ? roads::SearchMethod::bidirectional : search_ == "dijkstra" ? roads::SearchMethod::dijkstra : roads::SearchMethod::astar;
+    routing.search = search_ == "bidir"            ? roads::SearchMethod::bidirectional
+                     : search_ == "dijkstra"       ? roads::SearchMethod::dijkstra
+                     : search_ == "astar-distance" ? roads::SearchMethod::astar_distance
+                                                   : roads::SearchMethod::astar;
     if (evaluate_.empty()) check_output_path(out_, options_.overwrite);
     if (!sections_.empty()) check_output_path(sections_, options_.overwrite);
     if (evaluate_.empty() && !options_.earthworks.empty()) check_output_path(options_.earthworks, options_.overwrite);
     const roads::CostModel model = options_.cost_model();
     const plugin::PluginSet plugins = options_.plugins.load(context.log);
     const Dem dem = read_dem(dem_);
-    roads::TerrainField terrain(dem, options_.sea_level, model.unknown_water_depth_m, model.road_radius_m);
+    const hydro::FlatWater lakes = options_.flat_water(dem);
+    roads::TerrainField terrain(dem, options_.sea_level, model.unknown_water_depth_m, model.road_radius_m, &lakes.mask);
     options_.load_layers(terrain, plugins, dem, context.progress, context.log);
     const auto a = locate("--from", from_, terrain), b = locate("--to", to_, terrain);
     if (a == b) throw bad_input("--from/--to: both points fall in the same cell");
@@ -63,6 +68,10 @@ class PathCommand final : public Command {
     const auto road = roads::route_road(terrain, graph, a, b, routing, &context.progress);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (!road) throw processing_error("path: no road joins the two points under the cost model (slope or water thresholds)");
+    if (road->over_budget) {
+      context.log.warn("not routed: budget (--max-seconds); nothing written");
+      return;
+    }
     std::vector<roads::Road> roads{*road};
     roads[0].from = 0;
     roads[0].to = 1;
@@ -78,9 +87,9 @@ class PathCommand final : public Command {
     if (road->cost) std::snprintf(cost, sizeof cost, "%.1f", *road->cost);
     char line[512];
     std::snprintf(line, sizeof line,
-                  "%s: %.0f m, cost %s, max grade %.1f %%, mean grade %.1f %%, bridges %.0f m, tunnels %.0f m; %zu nodes expanded, %zu rings of long arcs priced, %zu stored, %.2f s",
+                  "%s: %.0f m, cost %s, max grade %.1f %%, mean grade %.1f %%, bridges %.0f m, tunnels %.0f m; %zu nodes expanded, %zu rings of long arcs priced, %zu stored, %zu relaxed cells settled, %.2f s",
                   road->router.c_str(), s.length_m, cost, s.max_grade_pct, s.mean_grade_pct, s.bridge_m, s.tunnel_m,
-                  road->expanded, road->rings_priced, road->nodes, seconds);
+                  road->expanded, road->rings_priced, road->nodes, road->relaxed_settled, seconds);
     context.log.info(line);
     const auto& g = road->geometry;
     if (g.clothoid_corners + g.g1_corners + g.sharp_corners > 0)

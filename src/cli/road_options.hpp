@@ -7,6 +7,7 @@
 #include <string>
 
 #include "cli/plugin_options.hpp"
+#include "hydro/flat_water.hpp"
 #include "io/raster_io.hpp"
 #include "roads/earthworks.hpp"
 #include "roads/road_network.hpp"
@@ -22,6 +23,8 @@ struct RoadOptions {
   std::string router = "galin";
   int bezier_evaluations = 1000, bezier_tries = 20;
   double bezier_threshold = 0.1;
+  double max_seconds = 0;
+  double flat_water_km2 = 1;  ///< the schema's water.flat_water_min_km2
   PluginOptions plugins;
 
   void setup(CLI::App& app) {
@@ -38,6 +41,10 @@ struct RoadOptions {
     app.add_option("--bezier-evaluations", bezier_evaluations, "Bézier router budget: curve evaluations per road (replaces the thesis' 1000 ms, for reproducible roads)")->check(CLI::Range(1, 1000000));
     app.add_option("--bezier-threshold", bezier_threshold, "Bézier router: stop when the worst position costs less (0..1)")->check(CLI::Range(0.0, 1.0));
     app.add_option("--bezier-tries", bezier_tries, "Bézier router: control points drawn per worst position")->check(CLI::Range(1, 100000));
+    app.add_option("--flat-water-km2", flat_water_km2, "Lakes the DEM shows flat (SRTM): a level surface of at least this area is water (0 = off)")
+        ->check(CLI::Range(0.0, 1e6));
+    app.add_option("--max-seconds", max_seconds, "Per-road search budget in seconds (wall clock; 0 = none): a road that takes longer is reported 'not routed: budget'")
+        ->check(CLI::Range(0.0, 86400.0));
     app.add_option("--earthworks", earthworks, "Also write the DEM after cut-and-fill along the surface roads (GeoTIFF; 8 m carriageway, 2:3 sides)");
     plugins.setup(app, "adds its road cost term (characteristic priced by its transfer functions; galin router)");
     app.add_flag("--overwrite", overwrite, "Replace existing outputs");
@@ -57,6 +64,9 @@ struct RoadOptions {
     w.description = "terrain after cut-and-fill along the roads (m)";
     write_raster(earthworks, levelled, w);
   }
+
+  /// Lakes the DEM flattens (hydro::detect_flat_water), for the TerrainField.
+  hydro::FlatWater flat_water(const Dem& dem) const { return hydro::detect_flat_water(dem, {flat_water_km2, 0.0, sea_level}); }
 
   roads::CostModel cost_model() const {
     roads::CostModel m = costs.empty() ? roads::default_cost_model() : roads::load_cost_model(costs);
@@ -79,6 +89,7 @@ struct RoadOptions {
     r.bezier.max_evaluations = bezier_evaluations;
     r.bezier.threshold = bezier_threshold;
     r.bezier.tries = bezier_tries;
+    r.max_seconds = max_seconds;
     return r;
   }
 };

@@ -47,7 +47,8 @@ class RoadsCommand final : public Command {
     const roads::CostModel model = options_.cost_model();
     const plugin::PluginSet plugins = options_.plugins.load(context.log);
     const Dem dem = read_dem(dem_);
-    roads::TerrainField terrain(dem, options_.sea_level, model.unknown_water_depth_m, model.road_radius_m);
+    const hydro::FlatWater lakes = options_.flat_water(dem);
+    roads::TerrainField terrain(dem, options_.sea_level, model.unknown_water_depth_m, model.road_radius_m, &lakes.mask);
     options_.load_layers(terrain, plugins, dem, context.progress, context.log);
     VectorLayer network = read_vector(network_, dem.georef().crs);
     network.name = network_;  // errors name the file
@@ -69,6 +70,7 @@ class RoadsCommand final : public Command {
         roads::route_network(terrain, graph, network, cities ? &*cities : nullptr, options_.routing(), context.progress);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     for (const std::string& f : result.failed) context.log.warn("no road under the cost model for edge " + f + " (left out)");
+    for (const std::string& f : result.over_budget) context.log.warn("not routed: budget (--max-seconds) for edge " + f);
     const Dem levelled = options_.earthworks_dem(dem, terrain, result.roads);
     if (create_folder) {
       std::error_code ec;
@@ -85,8 +87,8 @@ class RoadsCommand final : public Command {
       km += r.stats.length_m / 1000;
     }
     char line[256];
-    std::snprintf(line, sizeof line, "%zu roads (%zu maritime links, %zu failed), %.1f km, %.2f s", result.roads.size(), ferries,
-                  result.failed.size(), km, seconds);
+    std::snprintf(line, sizeof line, "%zu roads (%zu maritime links, %zu failed, %zu not routed: budget), %.1f km, %.2f s",
+                  result.roads.size(), ferries, result.failed.size(), result.over_budget.size(), km, seconds);
     context.log.info(line);
   }
 

@@ -12,6 +12,7 @@
 #include "network/network.hpp"
 #include "pipeline/scenario.hpp"
 #include "roads/cost_model.hpp"
+#include "hydro/flat_water.hpp"
 #include "roads/road_network.hpp"
 #include "sites/sites.hpp"
 
@@ -40,6 +41,8 @@ struct RoadsSettings {
   roads::CostModel model;
   roads::RoutingOptions routing;
   std::string vegetation;  ///< resolved path, "" for none
+  std::string water_mask;  ///< water.water_mask: resolved path, "" for none
+  hydro::FlatWaterOptions flat_water;  ///< water.flat_water_*: lakes the DEM flattens
 };
 RoadsSettings roads_settings(const Scenario& scenario);
 

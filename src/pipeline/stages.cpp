@@ -251,22 +251,28 @@ void network_load(RunState& s) { s.network = read_vector(saved(s, "network.geojs
 
 void roads_run(RunState& s, Progress& progress, const Log& log) {
   const RoadsSettings settings = roads_settings(s.scenario);
-  // Reservoir cells become nodata, which the road search takes as water of unknown depth.
-  Dem with_reservoirs;
-  if (!reservoir_specs(s.scenario).empty()) {
-    with_reservoirs = s.dem;
-    const Raster<float> water = read_resampled(saved(s, kReservoirs), s.dem.georef(), s.dem.cols(), s.dem.rows(), Resampling::nearest);
+  // Inland water: lakes the DEM flattens (hydro::detect_flat_water), the user's water layer and the
+  // scenario's reservoirs (reservoirs.tif already holds water_mask when reservoirs are declared).
+  hydro::FlatWater lakes = hydro::detect_flat_water(s.dem, settings.flat_water);
+  const bool reservoirs = !reservoir_specs(s.scenario).empty();
+  if (reservoirs || !settings.water_mask.empty()) {
+    const Raster<float> water = read_resampled(reservoirs ? saved(s, kReservoirs) : settings.water_mask, s.dem.georef(), s.dem.cols(), s.dem.rows(),
+                                               Resampling::nearest);
     for (std::size_t i = 0; i < water.size(); ++i)
-      if (water[i] == 1) with_reservoirs[i] = NAN;
+      if (std::isfinite(water[i]) && water[i] != 0) lakes.mask[i] = 1;
   }
-  roads::TerrainField terrain(with_reservoirs.size() ? with_reservoirs : s.dem, s.scenario.resolved["water"]["sea_level_m"].get<double>(), settings.model.unknown_water_depth_m,
-                              settings.model.road_radius_m);
+  roads::TerrainField terrain(s.dem, settings.flat_water.sea_level_m, settings.model.unknown_water_depth_m, settings.model.road_radius_m,
+                              &lakes.mask);
   if (!settings.vegetation.empty())
     terrain.set_vegetation(read_resampled(settings.vegetation, s.dem.georef(), s.dem.cols(), s.dem.rows(), Resampling::bilinear));
   plugin::add_to_terrain(plugin::road_terms(s.plugins, s.dem, progress, log), terrain);
   const roads::RoadGraph graph(terrain, settings.model, settings.routing.graph);
   const roads::NetworkResult r = roads::route_network(terrain, graph, *s.network, &*s.cities, settings.routing, progress);
+  if (settings.flat_water.min_area_km2 > 0 || !settings.water_mask.empty())
+    s.write("roads", "inland_water.tif", lakes.mask, "inland water the roads bridge or avoid: flat lakes of the DEM and water.water_mask (1)",
+            Style::mask);
   for (const auto& f : r.failed) log.warn("no road: " + f);
+  for (const auto& f : r.over_budget) log.warn("not routed: budget (roads.max_seconds): " + f);
   s.write("roads", "roads.geojson", roads::roads_layer(terrain, r.roads), "roads with class, router, length, cost, grades, structures",
           Style::roads);
   s.write("roads", "road_sections.geojson", roads::sections_layer(terrain, r.roads), "road, bridge, tunnel and ferry sections",
@@ -280,7 +286,8 @@ void roads_run(RunState& s, Progress& progress, const Log& log) {
   }
   json per_class = json::object();
   for (const char* c : {"motorway", "national", "departmental", "maritime"}) per_class[c] = round_to(km[c], 0.01);
-  s.summary["roads"] = {{"roads", r.roads.size()}, {"failed", r.failed.size()}, {"length_km", per_class},
+  s.summary["roads"] = {{"roads", r.roads.size()}, {"failed", r.failed.size()}, {"not_routed_budget", r.over_budget.size()},
+                        {"flat_lakes", lakes.lakes}, {"flat_lake_km2", round_to(lakes.area_km2, 0.01)}, {"length_km", per_class},
                         {"bridge_m", round_to(bridge_m, 0.1)}, {"tunnel_m", round_to(tunnel_m, 0.1)}};
 }
 

@@ -4,9 +4,11 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <string>
 
 #include "core/error.hpp"
@@ -46,6 +48,22 @@ RoadGraph::RoadGraph(const TerrainField& terrain, const CostModel& model, const 
     for (std::size_t i = 0; i < slope_lut_.size(); ++i)
       slope_lut_[i] = model.road.slope_deg(std::min(std::atan(double(i) * lut_step_) * kDeg, thr < 90 ? thr : 90.0));
   }
+  // The table's lower convex hull (a piecewise-linear table lies above the hull of its points).
+  for (std::size_t i = 0; i < slope_lut_.size() && slope_lut_[i] < kInfinity; ++i) {
+    const double t = double(i) * lut_step_, c = slope_lut_[i];
+    while (road_hull_t_.size() >= 2) {
+      const std::size_t k = road_hull_t_.size();
+      const double ax = road_hull_t_[k - 2], ay = road_hull_c_[k - 2], bx = road_hull_t_[k - 1], by = road_hull_c_[k - 1];
+      if ((bx - ax) * (c - ay) - (by - ay) * (t - ax) <= 0) road_hull_t_.pop_back(), road_hull_c_.pop_back();
+      else break;
+    }
+    road_hull_t_.push_back(t);
+    road_hull_c_.push_back(c);
+  }
+  // Increasing costs give an increasing hull; guard a user's decreasing curve (the bound must not
+  // fall with the grade: a path of mean grade t may be steeper in places).
+  for (std::size_t i = road_hull_c_.size(); i-- > 1;) road_hull_c_[i - 1] = std::min(road_hull_c_[i - 1], road_hull_c_[i]);
+  road_floor_ = model.road.water_depth_m.min_value() + model.road.vegetation.min_value();
   step_m_ = model.sample_step_m > 0 ? model.sample_step_m : 0.5 * terrain.min_cell_m();
   cheapest_ = model.cheapest_per_metre();
   // Orientation layers: one block of m sectors per enabled structure, then the "start" orientation.
@@ -270,6 +288,30 @@ double RoadGraph::road_slope_cost(double grade) const {
   if (i + 1 >= slope_lut_.size()) return model_.road.slope_deg(std::atan(grade) * kDeg);
   const double f = x - double(i);
   return slope_lut_[i] + f * (slope_lut_[i + 1] - slope_lut_[i]);
+}
+
+double RoadGraph::surface_arc_bound(Cell from, int arc) const {
+  const Arc& a = arcs_[std::size_t(arc)];
+  const int c1 = from.col + a.dcol, r1 = from.row + a.drow;
+  if (!terrain_.inside(c1, r1)) return kInfinity;
+  const double length = terrain_.length_m({double(from.col), double(from.row)}, {double(c1), double(r1)});
+  const double grade = std::fabs(double(terrain_.surface(c1, r1)) - double(terrain_.surface(from.col, from.row))) / length;
+  // Some step is at least as steep as the mean (1e-9: the steps' own rounding).
+  if (grade > tan_slope_max_ * (1 + 1e-9) || road_hull_t_.empty()) return kInfinity;
+  // The middle sample exactly as arc_cost takes it: water deeper than the threshold closes the arc.
+  const int n = std::max(1, int(std::ceil(length / step_m_))), i = (n + 1) / 2;
+  const double dc = double(a.dcol) / n, dr = double(a.drow) / n;
+  const double depth = terrain_.depth_at(from.col + dc * (i - 0.5), from.row + dr * (i - 0.5));
+  if (depth > 0 && model_.road.water_depth_m(depth) == kInfinity) return kInfinity;
+  double h = road_hull_c_.back();
+  if (grade <= road_hull_t_.front()) {
+    h = road_hull_c_.front();
+  } else if (grade < road_hull_t_.back()) {
+    const std::size_t j = std::size_t(std::upper_bound(road_hull_t_.begin(), road_hull_t_.end(), grade) - road_hull_t_.begin());
+    const double f = (grade - road_hull_t_[j - 1]) / (road_hull_t_[j] - road_hull_t_[j - 1]);
+    h = road_hull_c_[j - 1] + f * (road_hull_c_[j] - road_hull_c_[j - 1]);
+  }
+  return (1 - 1e-6) * length * (h + road_floor_);  // 1e-6: the float rounding of the cached costs
 }
 
 double RoadGraph::surface_cost_per_m(double slope_deg, double depth_m) const {
@@ -534,10 +576,184 @@ class LongArcCache {
   std::vector<float> values_;
 };
 
+/// Distances to the target on a relaxed 2-D graph: nodes are cells (the orientation dropped, so no
+/// turn is priced), arcs are every surface arc at its exact cost and every sampled bridge or tunnel
+/// arc at a lower bound of its cost (its deck slope term exact, the height or depth, water and
+/// vegetation terms at their minima). Every arc of the oriented graph costs at least its relaxed
+/// arc, so the relaxed distance is an admissible and consistent heuristic for it, and on relief it
+/// is far tighter than the straight-line bound: it knows where the valleys and passes are.
+/// Computed lazily by a reverse A* from the target guided by the straight-line bound towards the
+/// source and resumed on demand (Reverse Resumable A*, Silver 2005): `exact(v)` settles v; `bound(v)`
+/// never searches and returns the exact distance when v is settled, else the A* bound
+/// F - lower_bound(v, source) (F the smallest key still queued), which only grows.
+class RelaxedDistance {
+ public:
+  RelaxedDistance(const RoadGraph& graph, Cell target, Cell source, ArcCache& cache)
+      : graph_(graph), t_(graph.terrain()), source_(source), cache_(cache) {
+    if (scratch_in_use_) own_.emplace();  // a nested search on this thread gets its own arrays
+    else scratch_in_use_ = true;
+    Scratch& s = scratch();
+    if (s.g.size() != t_.size()) {
+      s.g.assign(t_.size(), kInfinity);
+      s.closed.assign(t_.size(), 0);
+      s.touched.clear();
+    }
+    const CostModel& m = graph.model();
+    fixed_[1] = m.bridge.height_m.min_value() + m.bridge.water_depth_m.min_value() + m.bridge.vegetation.min_value();
+    fixed_[2] = m.tunnel.depth_m.min_value() + m.tunnel.water_depth_m.min_value() + m.tunnel.vegetation.min_value();
+    // Deck slope cost against the grade as a table of lower bounds: entry i is the smallest cost at
+    // any grade >= i x step. Each piece of the curve is monotone in the grade, so that minimum is at
+    // i x step or at a breakpoint beyond it.
+    for (int st = 1; st < 3; ++st) {
+      const TransferFunction& f = st == 1 ? m.bridge.slope_deg : m.tunnel.slope_deg;
+      tan_max_[st] = f.threshold < 90 ? std::tan(f.threshold / kDeg) : kInfinity;
+      const double gmax = f.threshold < 90 ? tan_max_[st] : std::tan(89.5 / kDeg);
+      constexpr std::size_t kSteps = 2048;
+      grade_step_[st] = gmax / kSteps;
+      auto& table = slope_floor_[st];
+      table.assign(kSteps + 1, kInfinity);
+      double beyond = f(std::min(f.threshold, std::atan(gmax) * kDeg));
+      for (std::size_t i = kSteps + 1; i-- > 0;) {
+        const double lo_deg = std::min(f.threshold, std::atan(double(i) * grade_step_[st]) * kDeg), hi_deg = std::atan(double(i + 1) * grade_step_[st]) * kDeg;
+        for (const auto& p : f.points)
+          if (p[0] >= lo_deg && (p[0] < hi_deg || i == kSteps) && p[0] <= f.threshold) beyond = std::min(beyond, p[1]);
+        beyond = std::min(beyond, f(lo_deg));
+        table[i] = beyond;
+      }
+      if (f.points.empty()) table.assign(kSteps + 1, 0.0);
+    }
+    relax(t_.index(target.col, target.row), 0.0);
+  }
+  ~RelaxedDistance() {
+    Scratch& s = scratch();
+    for (std::size_t i : s.touched) s.g[i] = kInfinity, s.closed[i] = 0;
+    s.touched.clear();
+    if (!own_) scratch_in_use_ = false;
+  }
+  RelaxedDistance(const RelaxedDistance&) = delete;
+  RelaxedDistance& operator=(const RelaxedDistance&) = delete;
+
+  /// The relaxed distance from v to the target (infinity when none), settling v if needed.
+  double exact(Cell v) {
+    const std::size_t i = t_.index(v.col, v.row);
+    Scratch& s = scratch();
+    while (!s.closed[i] && settle_next()) {
+    }
+    return s.closed[i] ? s.g[i] : kInfinity;
+  }
+  /// A lower bound of the relaxed distance from v without searching (exact when v is settled).
+  double bound(Cell v) {
+    const std::size_t i = t_.index(v.col, v.row);
+    Scratch& s = scratch();
+    if (s.closed[i]) return s.g[i];
+    if (heap_.empty()) return kInfinity;
+    return std::max(0.0, heap_.front().f - graph_.lower_bound(v, source_));
+  }
+  bool settled(Cell v) { return scratch().closed[t_.index(v.col, v.row)] != 0; }
+  std::size_t settled_cells() const { return settled_; }
+
+ private:
+  struct Entry {
+    double f, g;
+    std::size_t cell;
+    bool operator<(const Entry& o) const { return f != o.f ? f > o.f : cell > o.cell; }  // min-heap, fixed ties
+  };
+  struct Scratch {
+    std::vector<double> g;
+    std::vector<std::uint8_t> closed;
+    std::vector<std::size_t> touched;
+  };
+  static inline thread_local Scratch shared_;
+  static inline thread_local bool scratch_in_use_ = false;
+  Scratch& scratch() { return own_ ? *own_ : shared_; }
+
+  void relax(std::size_t i, double g) {
+    Scratch& s = scratch();
+    if (s.closed[i] || g >= s.g[i]) return;
+    if (s.g[i] == kInfinity) s.touched.push_back(i);
+    s.g[i] = g;
+    const Cell c{int(i % std::size_t(t_.cols())), int(i / std::size_t(t_.cols()))};
+    heap_.push_back({g + graph_.lower_bound(c, source_), g, i});
+    std::push_heap(heap_.begin(), heap_.end());
+  }
+  /// Settles the next cell; false when the queue is empty.
+  bool settle_next() {
+    Scratch& s = scratch();
+    while (!heap_.empty()) {
+      std::pop_heap(heap_.begin(), heap_.end());
+      const Entry e = heap_.back();
+      heap_.pop_back();
+      if (s.closed[e.cell] || e.g > s.g[e.cell]) continue;
+      s.closed[e.cell] = 1;
+      ++settled_;
+      expand(e.cell, e.g);
+      return true;
+    }
+    return false;
+  }
+  /// Relaxes the arcs into cell i (settled at distance d).
+  void expand(std::size_t i, double d) {
+    const Cell v{int(i % std::size_t(t_.cols())), int(i / std::size_t(t_.cols()))};
+    const auto& arcs = graph_.arcs();
+    for (std::size_t a = 0; a < graph_.surface_arcs(); ++a) {
+      const Cell u{v.col - arcs[a].dcol, v.row - arcs[a].drow};
+      if (!t_.inside(u.col, u.row)) continue;
+      const std::size_t ui = t_.index(u.col, u.row);
+      if (scratch().closed[ui]) continue;
+      // The cheap bound first: most arcs into v cannot improve u, and need no integral.
+      const double lb = graph_.surface_arc_bound(u, int(a));
+      if (lb == kInfinity || d + lb >= scratch().g[ui]) continue;
+      const double e = cache_.get(u, ui, int(a));
+      if (e < kInfinity) relax(ui, d + e);
+    }
+    if (graph_.rings().empty() || t_.water(v.col, v.row)) return;  // long arcs join two land cells
+    const double zv = t_.surface(v.col, v.row);
+    // Sampled pairs are unordered: the long arcs out of v list the cells w whose arc w -> v exists.
+    for (std::size_t r = 0; r < graph_.rings().size(); ++r) {
+      const Structure st = graph_.rings()[r].structure;
+      for (int a : graph_.arcs_from(v, 0, int(r) + 1)) {
+        const Cell w{v.col + arcs[std::size_t(a)].dcol, v.row + arcs[std::size_t(a)].drow};
+        if (!t_.inside(w.col, w.row) || t_.water(w.col, w.row)) continue;
+        const std::size_t wi = t_.index(w.col, w.row);
+        if (scratch().closed[wi]) continue;
+        // As arc_cost prices the arc w -> v: the deck slope from the two surfaces over its length,
+        // here bounded from the table (no atan, no curve lookup per arc).
+        const double length = t_.length_m({double(w.col), double(w.row)}, {double(v.col), double(v.row)});
+        const double floor = fixed_[int(st)] + slope_floor_[int(st)].front();
+        if (d + (1 - 1e-6) * length * floor >= scratch().g[wi]) continue;  // cannot improve w
+        const double grade = std::fabs(zv - double(t_.surface(w.col, w.row))) / length;
+        if (grade > tan_max_[int(st)] * (1 + 1e-9)) continue;  // the deck breaks the slope threshold
+        const auto& table = slope_floor_[int(st)];
+        const double slope = table[std::min(table.size() - 1, std::size_t(grade / grade_step_[int(st)]))];
+        // 1e-6 covers the float rounding of the priced long arcs.
+        relax(wi, d + (1 - 1e-6) * length * (slope + fixed_[int(st)]));
+      }
+    }
+  }
+
+  const RoadGraph& graph_;
+  const TerrainField& t_;
+  Cell source_;
+  ArcCache& cache_;
+  std::optional<Scratch> own_;
+  std::vector<Entry> heap_;
+  double fixed_[3] = {0, 0, 0};
+  std::vector<double> slope_floor_[3];  ///< per structure: lower bounds of the deck slope cost by grade step
+  double grade_step_[3] = {1, 1, 1}, tan_max_[3] = {kInfinity, kInfinity, kInfinity};
+  std::size_t settled_ = 0;
+};
+
 }  // namespace
 
 SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMethod method, std::size_t max_nodes,
-                           Progress* progress) {
+                           Progress* progress, double max_seconds) {
+  const auto started = std::chrono::steady_clock::now();
+  std::size_t pops = 0;
+  // The clock is read every 1024 pops (about a millisecond of search).
+  auto out_of_time = [&]() {
+    return max_seconds > 0 && (pops++ & 1023) == 0 &&
+           std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count() > max_seconds;
+  };
   const TerrainField& t = graph.terrain();
   if (!t.inside(from.col, from.row) || !t.inside(to.col, to.row)) throw bad_input("path: an end point lies outside the DEM");
   SearchResult result;
@@ -550,6 +766,7 @@ SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMet
   auto orient_of = [&](std::uint64_t key) { return int(key % O); };
   const bool use_h = method != SearchMethod::dijkstra;
   const bool bidir = method == SearchMethod::bidirectional;
+  const bool relaxed = method == SearchMethod::astar;
   const std::size_t goal_index = t.index(to.col, to.row);
   if (from == to) {
     result.found = true;
@@ -572,19 +789,24 @@ SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMet
   // reduced arc costs l(u,v) - p(u) + p(v) are >= 0 in both directions and the search may stop as
   // soon as top_f + top_b >= mu, the best meeting cost (the bidirectional Dijkstra rule on the
   // reduced costs).
+  ArcCache cache(graph);
+  std::optional<RelaxedDistance> rel;
+  if (relaxed) rel.emplace(graph, to, from, cache);
   auto potential = [&](Cell v) {
     if (!use_h) return 0.0;
+    if (relaxed) return std::max(graph.lower_bound(v, to), rel->bound(v));
     if (!bidir) return graph.lower_bound(v, to);
     return 0.5 * (graph.lower_bound(v, to) - graph.lower_bound(v, from));
   };
   auto ring_offset = [&](int r) {
     const RoadGraph::Ring& ring = graph.rings()[std::size_t(r)];
-    return use_h ? ring.with_heuristic : ring.without_heuristic;
+    // The relaxed distance is consistent but leaves no margin to add (its long arcs are already
+    // bounded by their structure's floor), so a ring waits only behind its node.
+    return relaxed ? 0.0 : use_h ? ring.with_heuristic : ring.without_heuristic;
   };
   const std::vector<RoadGraph::Arc>& arcs = graph.arcs();
 
   Frontier fw(t.size(), O), bw(bidir ? t.size() : 0, O);
-  ArcCache cache(graph);
   LongArcCache long_cache(t.size(), graph.rings().size(), std::size_t(1) << 25);  // at most 128 MB
   // Long arcs are priced as floats in both directions, cached or not, so every search sees the same costs.
   auto long_cost = [&](Cell from_cell, int a) { return double(float(graph.arc_cost(from_cell, a))); };
@@ -632,7 +854,9 @@ SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMet
       bool improved;
       const std::uint32_t idx = fw.relax(key_of(n, arc.orientation), g, q.node, a, improved);
       if (improved) {
-        fw.push({g + potential(n), fw.key(idx), idx, -1, g});
+        const double f = g + potential(n);
+        if (f == kInfinity) continue;  // the target cannot be reached from n
+        fw.push({f, fw.key(idx), idx, -1, g});
         try_meet(fw.key(idx), g, bw);
       }
     }
@@ -669,6 +893,15 @@ SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMet
     const QueueItem q = me.pop();
     if (q.g > me.nodes[q.node].g) return true;  // stale: the node was reached more cheaply since
     const Cell c = cell_of(q.key);
+    if (relaxed && q.ring < 0 && !rel->settled(c)) {
+      // Queued with a bound of the relaxed distance: settle it, and queue the node again if its
+      // key grew (keys only grow to admissible values, so the search stays exact).
+      const double f = q.g + std::max(graph.lower_bound(c, to), rel->exact(c));
+      if (f > q.f) {
+        if (f < kInfinity) me.push({f, q.key, q.node, -1, q.g});
+        return true;
+      }
+    }
     const double node_key = forward ? q.g + potential(c) : q.g - potential(c);
     if (q.ring >= 0) {
       forward ? expand_forward(q, q.ring + 1) : expand_backward(q, q.ring + 1);
@@ -701,10 +934,16 @@ SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMet
     fw.push({potential(from), fw.key(s), s, -1, 0.0});
   }
   if (!bidir) {
-    while (!fw.heap.empty())
+    while (!fw.heap.empty()) {
+      if (out_of_time()) {
+        result.over_budget = true;
+        break;
+      }
       if (!step_once(true)) break;
+    }
     result.nodes = fw.stored;
-    if (goal_node == Frontier::kNone) return result;
+    if (rel) result.relaxed_settled = rel->settled_cells();
+    if (goal_node == Frontier::kNone || result.over_budget) return result;
     result.found = true;
     result.cost = fw.nodes[goal_node].g;
     for (std::uint32_t n = goal_node; n != Frontier::kNone; n = fw.nodes[n].parent) {
@@ -723,6 +962,11 @@ SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMet
   }
   while (!fw.heap.empty() && !bw.heap.empty()) {
     if (fw.top() + bw.top() >= mu) break;
+    if (out_of_time()) {
+      result.over_budget = true;
+      mu = kInfinity;
+      break;
+    }
     step_once(fw.top() <= bw.top());
   }
   result.nodes = fw.stored + bw.stored;

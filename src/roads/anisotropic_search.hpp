@@ -18,10 +18,11 @@ struct Cell {
   bool operator==(const Cell&) const = default;
 };
 
-/// Which search runs on the graph. All three return the same optimal cost on the same graph.
+/// Which search runs on the graph. All four return the same optimal cost on the same graph.
 enum class SearchMethod {
   dijkstra,       ///< plain Dijkstra, kept as the reference for tests
-  astar,          ///< A* with h = straight-line distance x cheapest cost per metre (Peytavie §4.1.2.2)
+  astar,          ///< A* with h = the distance on a relaxed 2-D graph (orientation dropped, long arcs bounded below)
+  astar_distance, ///< A* with h = straight-line distance x cheapest cost per metre (Peytavie §4.1.2.2)
   bidirectional,  ///< bidirectional A* with balanced potentials (Ikeda et al. 1994; Goldberg & Harrelson 2005)
 };
 
@@ -95,6 +96,11 @@ class RoadGraph {
   /// and the height difference Z, min over L >= D of L g(Z/L), where g is the lower convex envelope
   /// of the per-metre cost against the grade (Z = 0 gives the paper's D x cheapest cost per metre).
   double lower_bound(Cell a, Cell b) const;
+  /// A lower bound of arc_cost(from, arc) for a surface arc, from its two ends and one sample only:
+  /// by Jensen's inequality on the lower convex envelope of the road's slope cost, an arc that climbs
+  /// Z over L costs at least L x envelope(Z / L), and infinity when Z / L passes the threshold (some
+  /// step would) or its middle sample lies on water too deep. Ten times cheaper than the arc's cost.
+  double surface_arc_bound(Cell from, int arc) const;
   /// Per-metre cost of a surface road at a point with a given slope (deg) (for reports).
   double surface_cost_per_m(double slope_deg, double depth_m) const;
 
@@ -113,6 +119,8 @@ class RoadGraph {
   double lut_step_ = 1, tan_slope_max_ = kInfinity;
   double road_slope_cost(double grade) const;
   std::vector<double> hull_t_, hull_c_;  ///< lower convex envelope of cost per metre vs grade
+  std::vector<double> road_hull_t_, road_hull_c_;  ///< the same for surface roads alone (the slope table)
+  double road_floor_ = 0;                ///< surface roads' water and vegetation terms at their minima
   double kappa_ = 0, best_grade_ = 0;    ///< cheapest cost per metre of climb, and its grade
   void build_rings();
   double envelope(double grade) const;   ///< the lower convex envelope g at a grade
@@ -138,6 +146,8 @@ struct SearchResult {
   std::size_t expanded = 0;            ///< nodes expanded (both directions)
   std::size_t nodes = 0;               ///< nodes stored (memory is about 80 bytes per node)
   std::size_t rings_priced = 0;        ///< rings of long arcs priced (the others were never needed)
+  std::size_t relaxed_settled = 0;     ///< astar: cells settled by the relaxed reverse search
+  bool over_budget = false;            ///< stopped by max_seconds (found = false)
 };
 
 /// Shortest path from `from` to `to` (any final orientation). Nodes are stored per touched cell so
@@ -146,8 +156,9 @@ struct SearchResult {
 /// if that entry comes to the top of the queue (an exact search: the key never exceeds the key of a
 /// node the ring would reach). Throws processing_error when more than `max_nodes` would be
 /// stored. Returns found = false when no finite-cost path exists.
+/// `max_seconds` > 0: give up after that long (wall clock) and return over_budget = true.
 SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMethod method,
-                           std::size_t max_nodes = 60'000'000, Progress* progress = nullptr);
+                           std::size_t max_nodes = 60'000'000, Progress* progress = nullptr, double max_seconds = 0);
 
 /// Cost under `graph` of a given chain of cells joined by straight surface arcs (each step must be
 /// an arc of the graph's mask), the turns priced as the search prices them; infinity when the chain

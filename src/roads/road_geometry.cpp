@@ -210,7 +210,16 @@ RoadGeometry build_road_geometry(const TerrainField& terrain, const CostModel& m
       std::vector<GridPoint> run{gp(path.cells[i])};
       std::size_t j = i;
       while (j + 1 < path.cells.size() && path.structures[j] == Structure::road) run.push_back(gp(path.cells[++j]));
-      const auto pts = smooth_run(terrain, model, run, step, road);
+      auto pts = smooth_run(terrain, model, run, step, road);
+      // The search priced the grid path sampled exactly as `raw` is, so raw keeps under the slope
+      // threshold; a smoothed run must too, whatever its curves and the short legs between them
+      // sample (bilinear heights are steeper over short chords than over the search's steps).
+      if (steepest(terrain, pts) > model.road.slope_deg.threshold) {
+        std::vector<GridPoint> raw{run.front()};
+        for (std::size_t p = 1; p < run.size(); ++p) densify(raw, terrain, run[p - 1], run[p], step);
+        pts = std::move(raw);
+        ++road.unsmoothed_runs;
+      }
       for (std::size_t p = 1; p < pts.size(); ++p) {
         road.points.push_back(pts[p]);
         road.z.push_back(terrain.surface_at(pts[p].col, pts[p].row));

@@ -18,6 +18,8 @@ struct RoadGeometry {
   std::vector<Structure> segments;
   /// How the corners of the surface runs were rounded: clothoid pairs, G1 fallback, left sharp.
   int clothoid_corners = 0, g1_corners = 0, sharp_corners = 0;
+  /// Surface runs left as the grid path because their smoothed curve broke the slope threshold.
+  int unsmoothed_runs = 0;
 };
 
 /// A point of a local metric plane (metres).

@@ -76,9 +76,15 @@ std::optional<Road> route_road(const TerrainField& t, const RoadGraph& graph, Ce
   // Two land masses: only bridges can join them on the ground (an archipelago), else a ferry.
   if (!a || !b || (apart && (options.router == Router::bezier || !graph.model().bridge.enabled))) return ferry();
   if (options.router == Router::galin) {
-    const SearchResult s = shortest_path(graph, *a, *b, options.search, options.max_nodes, progress);
+    const SearchResult s = shortest_path(graph, *a, *b, options.search, options.max_nodes, progress, options.max_seconds);
+    if (s.over_budget) {
+      road.over_budget = true;
+      road.router = "galin";
+      return road;
+    }
     road.expanded = s.expanded;
     road.rings_priced = s.rings_priced;
+    road.relaxed_settled = s.relaxed_settled;
     road.nodes = s.nodes;
     if (!s.found) {
       if (apart) return ferry();
@@ -173,6 +179,10 @@ NetworkResult route_network(const TerrainField& t, const RoadGraph& graph, const
     const Edge& e = edges[i];
     if (!out[i]) {
       if (!(e.a == e.b)) result.failed.push_back(std::to_string(e.from) + "-" + std::to_string(e.to));
+      continue;
+    }
+    if (out[i]->over_budget) {
+      result.over_budget.push_back(std::to_string(e.from) + "-" + std::to_string(e.to));
       continue;
     }
     Road r = std::move(*out[i]);

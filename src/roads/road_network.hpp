@@ -23,6 +23,7 @@ struct RoutingOptions {
   BezierOptions bezier;
   std::size_t max_nodes = 60'000'000;
   int snap_cells = 3;  ///< an end on water moves to the nearest land cell within this many cells
+  double max_seconds = 0;  ///< per-road search budget (wall clock; 0 = none): past it the link is not routed
 };
 
 /// One routed road with everything the outputs need.
@@ -35,7 +36,9 @@ struct Road {
   RoadStats stats;
   std::size_t expanded = 0, nodes = 0;
   std::size_t rings_priced = 0;  ///< rings of long bridge/tunnel arcs priced by the search
+  std::size_t relaxed_settled = 0;  ///< cells settled by the heuristic's relaxed reverse search
   bool ferry = false;
+  bool over_budget = false;  ///< the search ran out of max_seconds: no geometry, not written
   std::vector<GridPoint> ferry_line;  ///< for maritime links: the straight crossing
 };
 
@@ -53,6 +56,7 @@ std::optional<Road> route_road(const TerrainField& terrain, const RoadGraph& gra
 struct NetworkResult {
   std::vector<Road> roads;
   std::vector<std::string> failed;
+  std::vector<std::string> over_budget;  ///< links not routed within roads.max_seconds ("from-to")
 };
 NetworkResult route_network(const TerrainField& terrain, const RoadGraph& graph, const VectorLayer& network,
                             const VectorLayer* cities, const RoutingOptions& options, Progress& progress);

@@ -11,7 +11,8 @@
 
 namespace terrapolis::roads {
 
-TerrainField::TerrainField(const Dem& dem, double sea_level_m, double unknown_depth_m, double road_radius_m)
+TerrainField::TerrainField(const Dem& dem, double sea_level_m, double unknown_depth_m, double road_radius_m,
+                           const Raster<std::uint8_t>* inland_water)
     : cols_(dem.cols()), rows_(dem.rows()), georef_(dem.georef()), metrics_(cell_metrics(dem.georef(), dem.cols(), dem.rows())),
       sea_level_(sea_level_m) {
   const std::size_t n = dem.size();
@@ -37,6 +38,12 @@ TerrainField::TerrainField(const Dem& dem, double sea_level_m, double unknown_de
       raw_depth[i] = float(d);
       surface_[i] = float(sea_level_m);
       ground_[i] = float(sea_level_m - d);
+    } else if (inland_water && (*inland_water)[i]) {
+      // A lake the DEM shows as its level: the surface is the water level, its depth unknown.
+      water_[i] = 1;
+      raw_depth[i] = float(unknown_depth_m);
+      surface_[i] = dem[i];
+      ground_[i] = float(dem[i] - unknown_depth_m);
     } else {
       surface_[i] = dem[i];
       ground_[i] = dem[i];

@@ -26,7 +26,10 @@ struct GridPoint {
 class TerrainField {
  public:
   /// `road_radius_m`: water depth is the maximum over the cells within that distance.
-  TerrainField(const Dem& dem, double sea_level_m, double unknown_depth_m, double road_radius_m);
+  /// `inland_water` (same grid, optional): non-zero cells are lakes above the sea level (a user's
+  /// water layer or hydro::detect_flat_water), water `unknown_depth_m` deep under their DEM level.
+  TerrainField(const Dem& dem, double sea_level_m, double unknown_depth_m, double road_radius_m,
+               const Raster<std::uint8_t>* inland_water = nullptr);
 
   int cols() const { return cols_; }
   int rows() const { return rows_; }

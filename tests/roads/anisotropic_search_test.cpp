@@ -50,7 +50,7 @@ CostModel random_model(std::mt19937_64& rng) {
 TEST(AnisotropicSearch, AStarBidirectionalAndDijkstraAgreeOnRandomProblems) {
   std::mt19937_64 rng(42);
   int found = 0;
-  for (int trial = 0; trial < 24; ++trial) {
+  for (int trial = 0; trial < 80; ++trial) {
     const Dem dem = random_dem(rng, 16);
     const CostModel model = random_model(rng);
     const TerrainField terrain(dem, 0.0, 10.0, 0.0);
@@ -60,22 +60,26 @@ TEST(AnisotropicSearch, AStarBidirectionalAndDijkstraAgreeOnRandomProblems) {
     const SearchResult d = shortest_path(graph, a, b, SearchMethod::dijkstra);
     const SearchResult s = shortest_path(graph, a, b, SearchMethod::astar);
     const SearchResult bi = shortest_path(graph, a, b, SearchMethod::bidirectional);
+    const SearchResult sd = shortest_path(graph, a, b, SearchMethod::astar_distance);
     ASSERT_EQ(d.found, s.found) << trial;
+    ASSERT_EQ(d.found, sd.found) << trial;
     ASSERT_EQ(d.found, bi.found) << trial;
     if (!d.found) continue;
     ++found;
     EXPECT_NEAR(s.cost, d.cost, 1e-9 * (1 + d.cost)) << trial;
     EXPECT_NEAR(bi.cost, d.cost, 1e-9 * (1 + d.cost)) << trial;
+    EXPECT_NEAR(sd.cost, d.cost, 1e-9 * (1 + d.cost)) << trial;
     EXPECT_LE(s.expanded, d.expanded) << trial;
+    EXPECT_LE(sd.expanded, d.expanded) << trial;
     EXPECT_LE(graph.lower_bound(a, b), d.cost * (1 + 1e-12)) << trial;  // the heuristic is admissible
     // The returned paths cost what the searches say (every arc finite, turns included).
-    for (const SearchResult* r : {&d, &s, &bi}) {
+    for (const SearchResult* r : {&d, &s, &bi, &sd}) {
       ASSERT_EQ(r->cells.front(), a);
       ASSERT_EQ(r->cells.back(), b);
       ASSERT_EQ(r->structures.size() + 1, r->cells.size());
     }
   }
-  EXPECT_GE(found, 12);
+  EXPECT_GE(found, 40);
 }
 
 TEST(AnisotropicSearch, NoSurfaceArcSteeperThanTheThresholdAndNoInfiniteArc) {
@@ -303,4 +307,19 @@ TEST(AnisotropicSearch, LongArcsStayUnderTheirLongestLength) {
   EXPECT_GT(longest(460, Structure::bridge), 2000);
   EXPECT_EQ(longest(1000, Structure::bridge), 0);           // 5 cells already exceed 3 km: no bridges
   EXPECT_LE(longest(1000, Structure::tunnel), 5000);
+}
+
+TEST(AnisotropicSearch, ABudgetStopsTheSearchAndSaysSo) {
+  std::mt19937_64 rng(3);
+  const Dem dem = random_dem(rng, 40);
+  const TerrainField terrain(dem, -100.0, 10.0, 0.0);
+  const RoadGraph graph(terrain, default_cost_model(), {3, 8, 1});
+  for (SearchMethod m : {SearchMethod::astar, SearchMethod::bidirectional, SearchMethod::dijkstra}) {
+    const SearchResult over = shortest_path(graph, {1, 1}, {38, 37}, m, 60'000'000, nullptr, 1e-9);
+    EXPECT_TRUE(over.over_budget);
+    EXPECT_FALSE(over.found);
+    const SearchResult r = shortest_path(graph, {1, 1}, {38, 37}, m, 60'000'000, nullptr, 3600);
+    EXPECT_FALSE(r.over_budget);
+    EXPECT_TRUE(r.found);
+  }
 }

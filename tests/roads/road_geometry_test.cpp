@@ -102,3 +102,29 @@ TEST(RoadGeometry, ClothoidSmoothingStaysInTheCorridorAndKeepsTheEnds) {
     EXPECT_LT(std::fabs(wrap(heading(p1, p2) - heading(p0, p1))), 0.35) << i;
   }
 }
+
+TEST(RoadGeometry, NoRoadSteeperThanTheSlopeThresholdOnACone) {
+  // A cone 30 deg steep (twice the 15 deg threshold) with a rounded cap and a bumpy skirt: roads
+  // across it must wind up and around; neither their smoothing nor the structures' ends may leave
+  // the threshold the search kept to (grades are measured on the built geometry, deck included).
+  const Dem dem = test::make_dem(64, 64, 10.0, [](int c, int r) {
+    const double d = std::hypot(c - 31.5, r - 31.5) * 10.0;
+    return 20.0 + std::max(0.0, 250.0 - d * std::tan(30.0 * std::numbers::pi / 180)) + 3.0 * std::sin(c * 0.9) * std::cos(r * 0.7);
+  });
+  const TerrainField terrain(dem, 0.0, 10.0, 0.0);
+  for (const bool structures : {false, true}) {
+    CostModel model = default_cost_model();
+    model.bridge.enabled = model.tunnel.enabled = structures;
+    const RoadGraph graph(terrain, model, {5, 8, 7});
+    const double limit_pct = 100.0 * std::tan(model.road.slope_deg.threshold * std::numbers::pi / 180);
+    int routed = 0;
+    for (const auto& [a, b] : std::vector<std::pair<Cell, Cell>>{{{2, 31}, {61, 33}}, {{31, 2}, {33, 61}}, {{5, 5}, {58, 58}}, {{31, 20}, {60, 40}}}) {
+      const SearchResult path = shortest_path(graph, a, b, SearchMethod::astar);
+      if (!path.found) continue;
+      ++routed;
+      const RoadGeometry road = build_road_geometry(terrain, model, path);
+      EXPECT_LE(road_stats(terrain, road).max_grade_pct, limit_pct + 1e-6) << a.col << "," << a.row << " structures " << structures;
+    }
+    EXPECT_GE(routed, 3);
+  }
+}

@@ -154,3 +154,23 @@ TEST(BezierRouter, DeterministicAndNeverWorseThanTheStraightCurve) {
   EXPECT_EQ(a.polyline.front().col, 5);
   EXPECT_EQ(a.polyline.back().col, 45);
 }
+
+TEST(RoadNetwork, ABudgetMarksLinksNotRoutedAndKeepsTheOthers) {
+  const Dem dem = islands();
+  const TerrainField terrain(dem, 0.0, 10.0, 0.0);
+  CostModel model = default_cost_model();
+  model.bridge.enabled = model.tunnel.enabled = false;
+  const RoadGraph graph(terrain, model, {3, 8, 1});
+  const VectorLayer net = network(dem, {{6, 20, 22, 20}, {14, 12, 14, 28}, {10, 17, 47, 20}});
+  SilentProgress silent;
+  RoutingOptions o;
+  o.graph = {3, 8, 1};
+  o.max_seconds = 1e-9;  // every search runs out at its first check
+  const NetworkResult r = route_network(terrain, graph, net, nullptr, o, silent);
+  EXPECT_EQ(r.over_budget.size(), 2u);  // the two land links
+  ASSERT_EQ(r.roads.size(), 1u);        // the maritime link needs no search
+  EXPECT_TRUE(r.roads[0].ferry);
+  EXPECT_TRUE(r.failed.empty());
+  o.max_seconds = 3600;
+  EXPECT_TRUE(route_network(terrain, graph, net, nullptr, o, silent).over_budget.empty());
+}
