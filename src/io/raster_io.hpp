@@ -60,7 +60,4 @@ struct WriteOptions {
 template <class T>
 void write_raster(const std::string& path, const Raster<T>& raster, const WriteOptions& options = {});
 
-/// Refuses an output path that exists (unless overwrite) or whose folder is missing or read-only.
-void check_output_path(const std::string& path, bool overwrite);
-
 }  // namespace terrapolis

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "io/text_io.hpp"
 
 namespace terrapolis::pipeline {
 namespace {
@@ -249,7 +250,7 @@ void write_qgis_styles_and_project(const RunState& state) {
     const std::string body = qgis_style_body(*o, state);
     const std::string qml = "<!DOCTYPE qgis PUBLIC 'http://mrcc.com/qgis.dtd' 'SYSTEM'>\n<qgis version=\"3.22.16\" styleCategories=\"AllStyleCategories\">" +
                             body + "<blendMode>0</blendMode></qgis>\n";
-    std::ofstream(state.folder / (stem(o->name) + ".qml")) << qml;
+    write_text_file((state.folder / (stem(o->name) + ".qml")).string(), qml, true);
     project_layers << "<maplayer type=\"" << (o->raster ? "raster" : "vector") << "\""
                    << (o->raster ? "" : " geometry=\"\"") << "><id>" << layer_id(*o) << "</id><datasource>./" << o->name
                    << "</datasource><layername>" << escape(stem(o->name)) << "</layername><srs>" << (o->raster ? srs : srs_lonlat)
@@ -257,14 +258,14 @@ void write_qgis_styles_and_project(const RunState& state) {
                    << "</provider>" << body << "<blendMode>0</blendMode></maplayer>";
     order << "<item>" << layer_id(*o) << "</item>";
   }
-  std::ofstream out(state.folder / "project.qgs");
+  std::ostringstream out;
   out << "<!DOCTYPE qgis PUBLIC 'http://mrcc.com/qgis.dtd' 'SYSTEM'>\n"
       << "<qgis projectname=\"Terrapolis run\" version=\"3.22.16\"><title>Terrapolis run</title>"
       << "<projectCrs>" << srs << "</projectCrs>"
       << "<layer-tree-group><customproperties/>" << tree.str() << "<custom-order enabled=\"0\">" << order.str() << "</custom-order></layer-tree-group>"
       << "<projectlayers>" << project_layers.str() << "</projectlayers>"
       << "<properties><Paths><Absolute type=\"bool\">false</Absolute></Paths></properties></qgis>\n";
-  if (!out) throw processing_error((state.folder / "project.qgs").string() + ": cannot write");
+  write_text_file((state.folder / "project.qgs").string(), out.str(), true);
 }
 
 }  // namespace terrapolis::pipeline
