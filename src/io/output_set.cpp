@@ -172,13 +172,18 @@ fs::path OutputSet::make_staging(const fs::path& path) {
   const fs::path abs = absolute_path(path.string());
   remove_stale_staging(abs);
   const fs::path staging = abs.parent_path() / (abs.filename().string() + ".tmp-" + std::to_string(::getpid()));
+  staging_names().emplace_back(staging.string(), path.string());  // before anything can fail in it
   std::error_code ec;
   fs::remove_all(staging, ec);
   fs::create_directory(staging, ec);
-  if (!ec) write_text_file((staging / kStagingMarker).string(), command_ + "\n", true);
+  try {
+    if (!ec) write_text_file((staging / kStagingMarker).string(), command_ + "\n", true);
+  } catch (...) {
+    fs::remove_all(staging, ec);  // not a target yet: the destructor would not remove it
+    throw;
+  }
   if (ec) throw processing_error(path.string() + ": cannot create a temporary folder beside it (" + ec.message() + ")");
   targets_.push_back({abs, staging, false});
-  staging_names().emplace_back(staging.string(), path.string());
   return staging;
 }
 
