@@ -117,7 +117,7 @@ std::vector<std::string> scenario_inputs(const Scenario& scenario) {
     } else if (j.is_string() && !j.get<std::string>().empty()) {
       const fs::path p = fs::path(j.get<std::string>()).is_absolute() ? fs::path(j.get<std::string>()) : scenario.base_dir / j.get<std::string>();
       std::error_code ec;
-      if (fs::exists(p, ec)) inputs.push_back(p.string());
+      if (fs::is_regular_file(p, ec)) inputs.push_back(p.string());  // inputs are files; "grass" may name a folder
     }
   };
   walk(scenario.resolved);
