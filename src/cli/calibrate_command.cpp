@@ -6,7 +6,6 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <random>
 
 #include <nlohmann/json.hpp>
@@ -16,7 +15,9 @@
 #include "core/error.hpp"
 #include "density/calibration.hpp"
 #include "hydro/hydro.hpp"
+#include "io/output_set.hpp"
 #include "io/raster_io.hpp"
+#include "io/text_io.hpp"
 #include "pipeline/scenario.hpp"
 #include "pipeline/stage_options.hpp"
 #include "sites/sites.hpp"
@@ -110,8 +111,12 @@ class CalibrateCommand final : public Command {
   void run(Context& context) override {
     if (dems_.size() != places_.size())
       throw bad_input("--settlements: give one places file per DEM (" + std::to_string(dems_.size()) + " DEMs, " + std::to_string(places_.size()) + " files)");
-    for (const std::string& out : {fragment_, report_})
-      if (!out.empty() && std::filesystem::exists(out) && !overwrite_) throw bad_input(out + ": output exists (use --overwrite)");
+    std::vector<std::string> inputs = dems_;
+    inputs.insert(inputs.end(), places_.begin(), places_.end());
+    inputs.insert(inputs.end(), scenarios_.begin(), scenarios_.end());
+    OutputSet outputs("calibrate", inputs, overwrite_);  // refused before any work
+    const std::string fragment_file = fragment_.empty() ? "" : outputs.file(fragment_);
+    const std::string report_file = report_.empty() ? "" : outputs.file(report_);
     if (scenarios_.size() > 1 && scenarios_.size() != dems_.size())
       throw bad_input("--scenario: give one scenario, or one per DEM (" + std::to_string(dems_.size()) + " DEMs)");
     std::vector<Region> regions;
@@ -172,8 +177,9 @@ class CalibrateCommand final : public Command {
     std::printf("\n(fit: in-sample AUC; held: %s AUC, w.: population-weighted; thesis: the belhadj2007 weights; q: rank-size exponent of the places)\n",
                 n > 1 ? "leave-one-region-out" : "cross-validated");
     const json fragment = {{"density", {{"weights", weights}}}};
-    if (!fragment_.empty()) write_json(fragment_, fragment);
-    if (!report_.empty()) write_json(report_, report);
+    if (!fragment_file.empty()) write_text_file(fragment_file, fragment.dump(2) + "\n", false);
+    if (!report_file.empty()) write_text_file(report_file, report.dump(2) + "\n", false);
+    outputs.commit();
   }
 
  private:
@@ -239,19 +245,6 @@ class CalibrateCommand final : public Command {
     json weights = json::object();
     for (std::size_t j = 0; j < kTerms; ++j) weights[kTermNames[j]] = largest > 0 ? std::round(beta[j + 1] / largest * 1e4) / 1e4 : 0.0;
     return weights;
-  }
-
-  void write_json(const std::string& path, const json& value) {
-    const std::string temp = path + ".tmp-calibrate";
-    {
-      std::ofstream out(temp);
-      out << value.dump(2) << "\n";
-      if (!out) {
-        std::filesystem::remove(temp);
-        throw processing_error(path + ": cannot write");
-      }
-    }
-    std::filesystem::rename(temp, path);
   }
 
   std::vector<std::string> dems_, places_, scenarios_;

@@ -15,6 +15,7 @@
 #include "hydro/depressions.hpp"
 #include "hydro/flow_directions.hpp"
 #include "io/crs.hpp"
+#include "io/output_set.hpp"
 #include "io/raster_io.hpp"
 #include "io/vector_io.hpp"
 #include "terrapolis/version.hpp"
@@ -41,7 +42,7 @@ class CatchmentCommand final : public Command {
         ->check(CLI::IsMember({"priority-flood", "epsilon", "breach", "none"}))->capture_default_str();
     app.add_option("--sea-level", sea_level_, "Cells at or below this elevation (m) are outlets (default: off)");
     app.add_option("--assume-crs", assume_crs_, "CRS for a DEM file that carries none");
-    app.add_flag("--overwrite", overwrite_, "Replace existing outputs");
+    app.add_flag("--overwrite", overwrite_, "Replace the outputs a previous terrapolis command wrote");
   }
 
   void run(Context& context) override {
@@ -49,8 +50,9 @@ class CatchmentCommand final : public Command {
     if (!(snap_m_ >= 0) || !std::isfinite(snap_m_)) throw bad_input("--snap-radius: must be >= 0 metres");
     const std::string ext = std::filesystem::path(out_path_).extension().string();
     if (ext != ".geojson" && ext != ".json" && ext != ".gpkg") throw bad_input(out_path_ + ": output must end in .geojson or .gpkg");
-    check_output_path(out_path_, overwrite_);
-    if (!mask_path_.empty()) check_output_path(mask_path_, overwrite_);
+    OutputSet outputs("catchment", {dem_path_}, overwrite_);
+    const std::string out = outputs.file(out_path_);
+    const std::string mask = mask_path_.empty() ? "" : outputs.file(mask_path_);
     ReadOptions read;
     if (!assume_crs_.empty()) read.assume_crs = assume_crs_;
     const Dem dem = read_dem(dem_path_, read);
@@ -75,21 +77,15 @@ class CatchmentCommand final : public Command {
     const FlowRouter router(filled, d8, metrics, FlowMethod::d8);
     const auto area = accumulate(filled, router, metrics, {}, context.progress);
     const Catchment c = delineate_catchment(d8, area, metrics, x, y, snap_m_, context.progress);
-    // The vector first, then the mask; remove the vector if the mask fails.
-    write_vector(out_path_, c.polygon, overwrite_);
-    if (!mask_path_.empty()) {
-      try {
-        WriteOptions w;
-        w.overwrite = overwrite_;
-        w.description = "Catchment mask: 1 inside, 0 outside";
-        w.metadata = {{"TERRAPOLIS_VERSION", version}, {"TERRAPOLIS_COMMAND", "catchment"}, {"OUTLET", outlet_},
-                      {"AREA_KM2", std::to_string(c.area_km2)}};
-        write_raster(mask_path_, c.mask, w);
-      } catch (...) {
-        std::filesystem::remove(out_path_);
-        throw;
-      }
+    write_vector(out, c.polygon);
+    if (!mask.empty()) {
+      WriteOptions w;
+      w.description = "Catchment mask: 1 inside, 0 outside";
+      w.metadata = {{"TERRAPOLIS_VERSION", version}, {"TERRAPOLIS_COMMAND", "catchment"}, {"OUTLET", outlet_},
+                    {"AREA_KM2", std::to_string(c.area_km2)}};
+      write_raster(mask, c.mask, w);
     }
+    outputs.commit();
     const GridLocator locator(dem.georef());
     const auto ll = locator.crs_to_lonlat(c.outlet_x, c.outlet_y);
     char line[256];

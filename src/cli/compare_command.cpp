@@ -6,6 +6,7 @@
 
 #include "cli/command.hpp"
 #include "cli/commands_list.hpp"
+#include "io/output_set.hpp"
 #include "io/text_io.hpp"
 #include "pipeline/compare.hpp"
 
@@ -27,7 +28,11 @@ class CompareCommand final : public Command {
     const auto c = pipeline::compare_runs(pipeline::load_manifest(a_), pipeline::load_manifest(b_));
     const std::string text =
         json_ ? c.dump(2) + "\n" : "A: " + a_ + "\nB: " + b_ + "\n\n" + pipeline::format_comparison(c);
-    if (!save_.empty()) write_text_file(save_, text, overwrite_);
+    if (!save_.empty()) {
+      OutputSet outputs("compare", {a_, b_}, overwrite_);
+      write_text_file(outputs.file(save_), text, false);
+      outputs.commit();
+    }
     std::fputs(text.c_str(), stdout);
   }
 

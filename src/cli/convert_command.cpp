@@ -5,6 +5,7 @@
 #include "cli/command.hpp"
 #include "cli/commands_list.hpp"
 #include "cli/dem_input.hpp"
+#include "io/output_set.hpp"
 #include "io/raster_io.hpp"
 #include "terrapolis/version.hpp"
 
@@ -24,14 +25,15 @@ class ConvertCommand final : public Command {
     app.add_flag("--overwrite", overwrite_, "Replace OUT if it exists");
   }
   void run(Context& context) override {
-    check_output_path(out_, overwrite_);
+    OutputSet outputs("convert", {input_.path}, overwrite_);
+    const std::string out = outputs.file(out_);
     const Dem dem = input_.read();
     WriteOptions options;
     options.cog = cog_;
-    options.overwrite = overwrite_;
     options.description = "elevation in metres";
     options.metadata = {{"TERRAPOLIS_VERSION", terrapolis::version}, {"TERRAPOLIS_SOURCE", input_.path}};
-    write_raster(out_, dem, options);
+    write_raster(out, dem, options);
+    outputs.commit();
     context.log.info("wrote " + out_);
   }
 

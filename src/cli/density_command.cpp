@@ -18,6 +18,7 @@
 #include "core/text.hpp"
 #include "density/density.hpp"
 #include "hydro/hydrometry.hpp"
+#include "io/output_set.hpp"
 #include "io/raster_io.hpp"
 #include "terrapolis/version.hpp"
 
@@ -95,21 +96,13 @@ class DensityCommand final : public Command {
   void run(Context& context) override {
     density::DensityOptions options = options_;
     parse_options(options);
-    // Refuse existing outputs before any work; the folder itself is created only at the end.
-    // hydrometry.tif is written only when used, and never over the --hydrometry file it came from.
-    const fs::path dir(out_dir_);
-    const fs::path hydro_out = dir / "hydrometry.tif";
-    const bool reuse = !hydrometry_path_.empty() && fs::exists(hydro_out) && fs::equivalent(hydrometry_path_, hydro_out);
-    const bool write_hydro = (options.weights[1] != 0 || options.river_bed_cap.has_value()) && !reuse;
-    std::vector<std::string> names = {"coast", "plateau", "plain", "buildable", "density"};
-    if (write_hydro) names.push_back("hydrometry");
-    if (fs::exists(dir)) {
-      if (!fs::is_directory(dir)) throw bad_input(out_dir_ + ": exists and is not a folder");
-      for (const auto& n : names) check_output_path((dir / (n + ".tif")).string(), overwrite_);
-    } else {
-      const fs::path parent = dir.has_parent_path() ? dir.parent_path() : fs::path(".");
-      if (!fs::is_directory(parent)) throw bad_input(out_dir_ + ": its parent folder does not exist");
-    }
+    // Outputs refused before any work; hydrometry.tif is written only when used.
+    std::vector<std::string> inputs = {dem_.path, hydrometry_path_, options.water_mask};
+    for (const auto& layer : options.layers) inputs.push_back(layer.first);
+    inputs.insert(inputs.end(), options.exclusions.begin(), options.exclusions.end());
+    OutputSet outputs("density", inputs, overwrite_);
+    const fs::path dir = outputs.folder(out_dir_);
+    const bool write_hydro = options.weights[1] != 0 || options.river_bed_cap.has_value();
 
     using clock = std::chrono::steady_clock;
     const auto seconds = [](clock::time_point a, clock::time_point b) { return format(std::chrono::duration<double>(b - a).count(), 3); };
@@ -124,14 +117,12 @@ class DensityCommand final : public Command {
     const std::clock_t cpu2 = std::clock();
     const auto t2 = clock::now();
 
-    fs::create_directories(dir);
     const auto metadata = provenance(options);
     std::vector<std::function<void()>> writes;
     auto write = [&](const std::string& n, const auto& raster) {
       writes.emplace_back([&, n] {
         WriteOptions w;
         w.cog = cog_;
-        w.overwrite = overwrite_;
         w.description = density::describe_output(n);
         w.metadata = metadata;
         write_raster((dir / (n + ".tif")).string(), raster, w);
@@ -144,6 +135,7 @@ class DensityCommand final : public Command {
     write("buildable", result.buildable);
     write("density", result.density);
     write_concurrently(writes);
+    outputs.commit();
     const auto t3 = clock::now();
     context.log.detail("density: read " + seconds(t0, t1) + " s, model " + seconds(t1, t2) + " s (cpu " +
                        format(double(cpu2 - cpu1) / CLOCKS_PER_SEC, 3) + " s), write " + seconds(t2, t3) + " s");

@@ -8,6 +8,7 @@
 #include "cli/commands_list.hpp"
 #include "cli/terrain_options.hpp"
 #include "core/error.hpp"
+#include "io/output_set.hpp"
 #include "io/raster_io.hpp"
 #include "terrain/fill.hpp"
 
@@ -32,7 +33,8 @@ class FillCommand final : public Command {
 
   void run(Context& context) override {
     const terrain::FillParams params = options_.params();
-    check_output_path(output_, overwrite_);
+    OutputSet outputs("fill", {input_}, overwrite_);
+    const std::string out = outputs.file(output_);
     ReadOptions read;
     if (!assume_crs_.empty()) read.assume_crs = assume_crs_;
     Dem dem = read_dem(input_, read);
@@ -46,11 +48,11 @@ class FillCommand final : public Command {
                      std::to_string(report.cells_filled) + " cells), " + std::to_string(report.too_large) + " larger than the limit left as nodata");
     terrain::fill_voids(dem, voids, params, &context.progress);
     WriteOptions write;
-    write.overwrite = overwrite_;
     write.description = "elevation with voids filled (m)";
     write.metadata = options_.metadata(true);
     write.metadata.emplace_back("TERRAPOLIS_VOIDS_FILLED", std::to_string(report.voids_filled));
-    write_raster(output_, dem, write);
+    write_raster(out, dem, write);
+    outputs.commit();
   }
 
  private:

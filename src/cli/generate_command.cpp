@@ -8,6 +8,7 @@
 #include "cli/commands_list.hpp"
 #include "cli/terrain_options.hpp"
 #include "core/error.hpp"
+#include "io/output_set.hpp"
 #include "io/raster_io.hpp"
 #include "terrain/subdivision.hpp"
 
@@ -31,7 +32,8 @@ class GenerateCommand final : public Command {
   void run(Context& context) override {
     terrain::FillParams params = options_.params();
     Raster<float> grid = grid_.make();
-    check_output_path(output_, overwrite_);
+    OutputSet outputs("generate", {sketch_}, overwrite_);
+    const std::string out = outputs.file(output_);
     if (!sketch_.empty()) {
       const RasterHeader header = read_header(sketch_, ReadOptions{std::nullopt, std::string("EPSG:4326")});
       Raster<float> sketch;
@@ -52,10 +54,10 @@ class GenerateCommand final : public Command {
     params.dmmc.low_pass = false;  // generation wants the fractal detail, not the smoothest surface
     terrain::dmmc(grid, params.dmmc, &context.progress);
     WriteOptions write;
-    write.overwrite = overwrite_;
     write.description = "generated elevation (m)";
     write.metadata = options_.metadata(false);
-    write_raster(output_, grid, write);
+    write_raster(out, grid, write);
+    outputs.commit();
   }
 
  private:

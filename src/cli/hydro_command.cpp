@@ -16,6 +16,7 @@
 #include "hydro/hydro.hpp"
 #include "hydro/option_names.hpp"
 #include "hydro/river_types.hpp"
+#include "io/output_set.hpp"
 #include "io/raster_io.hpp"
 #include "io/text_io.hpp"
 #include "io/vector_io.hpp"
@@ -42,7 +43,7 @@ class HydroCommand final : public Command {
 
   void setup(CLI::App& app) override {
     app.add_option("DEM", dem_path_, "Elevation model (any GDAL raster)")->required();
-    app.add_option("OUTDIR", out_dir_, "Output folder (created if missing)")->required();
+    app.add_option("OUTDIR", out_dir_, "Output folder (its parent must exist)")->required();
     app.add_option("--fill", fill_, "Depression handling: priority-flood, epsilon, breach, none")
         ->check(CLI::IsMember(kFillMethods))->capture_default_str();
     app.add_option("--flow", flow_, "Routing for the accumulation: d8, dinf, mfd")
@@ -77,7 +78,7 @@ class HydroCommand final : public Command {
     app.add_option("--tile-size", tile_size_, "Work tile by tile, tiles of at most N x N cells (writes one GeoTIFF a tile + a VRT)");
     app.add_option("--memory-limit", memory_limit_mb_, "Work tile by tile within this much memory (MB), tiles sized to fit");
     app.add_flag("--cog", cog_, "Write Cloud Optimized GeoTIFFs");
-    app.add_flag("--overwrite", overwrite_, "Replace existing outputs");
+    app.add_flag("--overwrite", overwrite_, "Replace the outputs a previous terrapolis command wrote in OUTDIR");
   }
 
   void run(Context& context) override {
@@ -115,7 +116,8 @@ class HydroCommand final : public Command {
     o.with_streams = wanted[4];
     if (classify_ && !wanted[4]) throw bad_input("--classify: needs the streams output (--outputs ... ,streams)");
     if (classify_) check(types_);
-    const std::string qml_path = (fs::path(out_dir_) / "streams.qml").string();
+    OutputSet outputs("hydro", {dem_path_, weights_}, overwrite_);  // refused before any work
+    const fs::path dir = outputs.folder(out_dir_);
 
     std::vector<std::pair<std::string, std::string>> provenance = {
         {"TERRAPOLIS_VERSION", version}, {"TERRAPOLIS_COMMAND", "hydro"}, {"SOURCE_DEM", fs::path(dem_path_).filename().string()},
@@ -125,7 +127,6 @@ class HydroCommand final : public Command {
     auto opts = [&](const std::string& description, std::vector<std::pair<std::string, std::string>> extra = {}) {
       WriteOptions w;
       w.cog = cog_;
-      w.overwrite = overwrite_;
       w.description = description;
       w.deflate_level = 1;  // 13 M-cell float rasters: a third of the compression time, files ~4 % larger
       w.metadata = provenance;
@@ -150,7 +151,8 @@ class HydroCommand final : public Command {
       if (memory_limit_mb_ < 0) throw bad_input("--memory-limit: must be a positive number of MB");
       TiledHydroRequest q;
       q.dem_path = dem_path_;
-      q.out_dir = out_dir_;
+      q.out_dir = dir.string();
+      q.out_name = out_dir_;
       q.read = read;
       q.tile_size = tile_size_;
       q.memory_limit_mb = memory_limit_mb_ > 0 ? memory_limit_mb_ : 1024;
@@ -164,19 +166,13 @@ class HydroCommand final : public Command {
       q.filled_file = opts("Conditioned elevation (m), " + fill_ + " depression handling");
       q.flowdir_file = opts(flowdir_description, flowdir_metadata);
       q.accumulation_file = opts(acc_description, {{"UNIT", acc_unit}});
-      context.log.info(run_tiled_hydro_command(q, context));
+      const std::string done = run_tiled_hydro_command(q, context);
+      outputs.commit();
+      context.log.info(done);
       return;
     }
     const Dem dem = read_dem(dem_path_, read);
     if (!weights_.empty()) o.weights = read_resampled(weights_, dem.georef(), dem.cols(), dem.rows(), Resampling::bilinear);
-
-    // Refuse existing outputs before any work.
-    const bool created = !fs::exists(out_dir_);
-    if (!created && !fs::is_directory(out_dir_)) throw bad_input(out_dir_ + ": exists and is not a folder");
-    if (!created)
-      for (int i = 0; i < 5; ++i)
-        if (wanted[i]) check_output_path((fs::path(out_dir_) / names[i]).string(), overwrite_);
-    if (!created && classify_) check_output_path(qml_path, overwrite_);
 
     HydroResult result = run_hydro(dem, o, context.progress);
     if (classify_) classify_streams(result.streams, result.filled, o.sea_level, types_);
@@ -195,41 +191,21 @@ class HydroCommand final : public Command {
       for (std::size_t i = 0; i < acc.size(); ++i) acc[i] = float(result.accumulation[i] * scale);
       result.accumulation = Raster<double>();  // release before writing
     }
-    std::vector<std::string> written;
-    try {
-      if (created) fs::create_directories(out_dir_);
-      auto path = [&](int i) {
-        written.push_back((fs::path(out_dir_) / names[i]).string());
-        return written.back();
-      };
-      std::vector<std::function<void()>> writes;
-      if (wanted[0])
-        writes.push_back([&, p = path(0)] {
-          write_raster(p, result.filled, opts("Conditioned elevation (m), " + fill_ + " depression handling"));
-        });
-      if (wanted[1])
-        writes.push_back([&, p = path(1)] {
-          write_raster(p, encode_d8(result.d8, codes), opts(flowdir_description, flowdir_metadata));
-        });
-      if (wanted[2])
-        writes.push_back([&, p = path(2)] {
-          write_raster(p, acc, opts(acc_description, {{"UNIT", acc_unit}}));
-        });
-      if (wanted[3])
-        writes.push_back([&, p = path(3)] { write_raster(p, result.hydrometry, opts("Hydrometry in [0,1] (" + hydrometry_ + ")")); });
-      if (wanted[4]) writes.push_back([&, p = path(4)] { write_vector(p, result.streams, overwrite_); });
-      if (classify_) {
-        written.push_back(qml_path);
-        writes.push_back([&] { write_text_file(qml_path, river_types_qml(), overwrite_); });
-      }
-      write_concurrently(writes);
-    } catch (...) {
-      // No partial result: new files go, and the folder if this run made it.
-      if (!overwrite_ || created)
-        for (const auto& p : written) fs::remove(p);
-      if (created) fs::remove_all(out_dir_);
-      throw;
-    }
+    auto path = [&](int i) { return (dir / names[i]).string(); };
+    std::vector<std::function<void()>> writes;
+    if (wanted[0])
+      writes.push_back([&, p = path(0)] {
+        write_raster(p, result.filled, opts("Conditioned elevation (m), " + fill_ + " depression handling"));
+      });
+    if (wanted[1])
+      writes.push_back([&, p = path(1)] { write_raster(p, encode_d8(result.d8, codes), opts(flowdir_description, flowdir_metadata)); });
+    if (wanted[2]) writes.push_back([&, p = path(2)] { write_raster(p, acc, opts(acc_description, {{"UNIT", acc_unit}})); });
+    if (wanted[3])
+      writes.push_back([&, p = path(3)] { write_raster(p, result.hydrometry, opts("Hydrometry in [0,1] (" + hydrometry_ + ")")); });
+    if (wanted[4]) writes.push_back([&, p = path(4)] { write_vector(p, result.streams); });
+    if (classify_) writes.push_back([&] { write_text_file((dir / "streams.qml").string(), river_types_qml(), false); });
+    write_concurrently(writes);
+    outputs.commit();
     context.log.info("hydro: wrote " + out_dir_ + (wanted[4] ? " (" + std::to_string(result.streams.features.size()) + " stream reaches)" : ""));
   }
 

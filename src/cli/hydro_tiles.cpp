@@ -33,9 +33,7 @@ double peak_resident_mb() {
 std::string run_tiled_hydro_command(const TiledHydroRequest& q, Context& context) {
   const DemWindowReader reader(q.dem_path, q.read);
   const RasterHeader& h = reader.header();
-  const fs::path out(q.out_dir);
-  const bool created = !fs::exists(out);
-  if (!created && !fs::is_directory(out)) throw bad_input(q.out_dir + ": exists and is not a folder");
+  const fs::path out(q.out_dir);  // a fresh staging folder (OutputSet): no earlier tiles in it
   struct Layer {
     std::string name;
     bool wanted;
@@ -45,8 +43,6 @@ std::string run_tiled_hydro_command(const TiledHydroRequest& q, Context& context
   Layer layers[3] = {{"filled", q.filled, &q.filled_file, {}},
                      {"flowdir", q.flowdir, &q.flowdir_file, {}},
                      {"accumulation", q.accumulation, &q.accumulation_file, {}}};
-  for (const Layer& l : layers)
-    if (l.wanted && !created) check_output_path((out / (l.name + ".vrt")).string(), q.filled_file.overwrite);
   hydro::tiled::TiledOptions o;
   o.tile_size = q.tile_size;
   o.memory_limit_mb = q.memory_limit_mb;
@@ -54,29 +50,12 @@ std::string run_tiled_hydro_command(const TiledHydroRequest& q, Context& context
   o.unit = q.unit;
   const int threads = context.threads > 0 ? context.threads : int(std::max(1L, sysconf(_SC_NPROCESSORS_ONLN)));
   o.concurrent_tiles = threads;
-  std::vector<std::string> made;  // files and folders of this run, removed on failure
-  std::mutex made_mutex;
-  try {
-    if (created) {
-      fs::create_directories(out);
-      made.push_back(out.string());
-    }
-    for (Layer& l : layers) {
-      if (!l.wanted) continue;
-      if (!fs::exists(out / l.name)) {
-        fs::create_directory(out / l.name);
-        made.push_back((out / l.name).string());
-      } else if (q.filled_file.overwrite) {
-        // The tiles of an earlier run (perhaps of another tile size) go: the VRT lists only this run's.
-        for (const auto& entry : fs::directory_iterator(out / l.name)) {
-          const std::string n = entry.path().filename().string();
-          if (n.size() == 18 && n.rfind("tile_", 0) == 0 && n.substr(14) == ".tif") fs::remove(entry.path());
-        }
-      }
-    }
+  std::mutex tiles_mutex;
+  {
+    for (Layer& l : layers)
+      if (l.wanted) fs::create_directory(out / l.name);
     const fs::path scratch = out / (".scratch-" + std::to_string(getpid()));
     fs::create_directory(scratch);
-    made.push_back(scratch.string());
     o.scratch_dir = scratch.string();
     o.tile_size = q.tile_size > 0 ? q.tile_size : hydro::tiled::tile_size_for(h.cols, h.rows, q.memory_limit_mb, threads);
     const int across = hydro::tiled::TileGrid(h.cols, h.rows, o.tile_size).across();
@@ -84,9 +63,8 @@ std::string run_tiled_hydro_command(const TiledHydroRequest& q, Context& context
       char name[64];
       std::snprintf(name, sizeof name, "tile_%04d_%04d.tif", t / across, t % across);
       const std::string p = (out / l.name / name).string();
-      std::lock_guard lock(made_mutex);
+      std::lock_guard lock(tiles_mutex);
       l.tiles.push_back(p);
-      made.push_back(p);
       return p;
     };
     hydro::tiled::TileSinks sinks;
@@ -107,8 +85,7 @@ std::string run_tiled_hydro_command(const TiledHydroRequest& q, Context& context
       if (l.wanted) {
         std::sort(l.tiles.begin(), l.tiles.end());
         const std::string vrt = (out / (l.name + ".vrt")).string();
-        write_vrt(vrt, l.tiles, q.filled_file.overwrite);
-        made.push_back(vrt);
+        write_vrt(vrt, l.tiles, false);
       }
     char line[400];
     std::snprintf(line, sizeof line,
@@ -119,12 +96,7 @@ std::string run_tiled_hydro_command(const TiledHydroRequest& q, Context& context
                   (unsigned long long)report.links, report.tile_state_bytes / 1e6, report.global_state_bytes / 1e6,
                   peak_resident_mb());
     context.log.detail(line);
-    return "hydro: wrote " + q.out_dir + " (" + std::to_string(report.tiles) + " tiles)";
-  } catch (...) {
-    // No partial result: what this run wrote goes, newest first (files before their folders).
-    std::error_code ec;
-    for (auto it = made.rbegin(); it != made.rend(); ++it) fs::remove_all(*it, ec);
-    throw;
+    return "hydro: wrote " + q.out_name + " (" + std::to_string(report.tiles) + " tiles)";
   }
 }
 

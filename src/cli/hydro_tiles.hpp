@@ -14,7 +14,8 @@
 namespace terrapolis::cli {
 
 struct TiledHydroRequest {
-  std::string dem_path, out_dir;
+  std::string dem_path, out_dir;  ///< out_dir: the (staging) folder to write into
+  std::string out_name;           ///< the output folder as the user named it
   ReadOptions read;
   int tile_size = 0;             ///< 0: from memory_limit_mb
   double memory_limit_mb = 1024;

@@ -13,9 +13,10 @@
 #include "cli/command.hpp"
 #include "cli/commands_list.hpp"
 #include "cli/dem_input.hpp"
-#include "cli/output_dir.hpp"
 #include "core/error.hpp"
 #include "lake/lake.hpp"
+#include "io/output_set.hpp"
+#include "io/raster_io.hpp"
 #include "io/text_io.hpp"
 #include "io/vector_io.hpp"
 #include "terrapolis/version.hpp"
@@ -82,7 +83,8 @@ class LakeCommand final : public Command {
     if (!dam_.empty()) spec.dam_lonlat = parse_linestring(dam_);
     const std::string roads_path = (fs::path(run_dir_) / "roads.geojson").string(), cities_path = (fs::path(run_dir_) / "cities.geojson").string();
     if (!run_dir_.empty() && !fs::is_directory(run_dir_)) throw bad_input(run_dir_ + ": --run: not a folder");
-    OutputDir outputs(out_dir_, {"depth.tif", "shoreline.geojson", "lake.json"}, overwrite_);
+    OutputSet outputs("lake", {dem_.path, run_dir_}, overwrite_);  // refused before any work
+    const fs::path dir = outputs.folder(out_dir_);
     const Dem dem = dem_.read();
     const CellMetrics metrics = cell_metrics(dem.georef(), dem.cols(), dem.rows());
     const lake::Lake lake = lake::flood(dem, metrics, spec, context.progress);
@@ -109,21 +111,17 @@ class LakeCommand final : public Command {
         throw bad_input(run_dir_ + ": --run: holds neither roads.geojson nor cities.geojson");
     }
     const VectorLayer shoreline = lake::shoreline_layer(lake);
-    outputs.write_all([&](std::size_t i, const std::string& path, bool overwrite) {
-      if (i == 0) {
-        WriteOptions w;
-        w.cog = cog_;
-        w.overwrite = overwrite;
-        w.description = "Water depth (m) of a lake at " + fixed(lake.level_m, 2) + " m";
-        w.metadata = {{"TERRAPOLIS_VERSION", version}, {"TERRAPOLIS_COMMAND", "lake"}, {"SOURCE_DEM", fs::path(dem_.path).filename().string()},
-                      {"AT", at_}, {"LEVEL_M", fixed(lake.level_m, 3)}, {"UNIT", "m"}};
-        write_raster(path, lake.depth, w);
-      } else if (i == 1) {
-        write_vector(path, shoreline, overwrite);
-      } else {
-        write_text_file(path, report.dump(2) + "\n", overwrite);
-      }
-    });
+    {
+      WriteOptions w;
+      w.cog = cog_;
+      w.description = "Water depth (m) of a lake at " + fixed(lake.level_m, 2) + " m";
+      w.metadata = {{"TERRAPOLIS_VERSION", version}, {"TERRAPOLIS_COMMAND", "lake"}, {"SOURCE_DEM", fs::path(dem_.path).filename().string()},
+                    {"AT", at_}, {"LEVEL_M", fixed(lake.level_m, 3)}, {"UNIT", "m"}};
+      write_raster((dir / "depth.tif").string(), lake.depth, w);
+    }
+    write_vector((dir / "shoreline.geojson").string(), shoreline);
+    write_text_file((dir / "lake.json").string(), report.dump(2) + "\n", false);
+    outputs.commit();
     if (lake.spills) context.log.warn("lake: the water reaches the DEM's edge or nodata: it would spill beyond, area and volume are lower bounds");
     context.log.info("lake: level " + fixed(lake.level_m, 2) + " m, " + fixed(lake.area_km2, 4) + " km2, " + fixed(lake.volume_m3 / 1e6, 4) +
                      " million m3, max depth " + fixed(lake.max_depth_m, 2) + " m" + extra + "; wrote " + out_dir_);

@@ -13,6 +13,8 @@
 #include "cli/command.hpp"
 #include "cli/describe.hpp"
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
+#include "io/output_set.hpp"
 #include "io/raster_io.hpp"
 #include "terrapolis/version.hpp"
 
@@ -87,17 +89,23 @@ int main(int argc, char** argv) {
                                                           : static_cast<Progress&>(console);
   cli::Context context{Log(quiet ? LogLevel::quiet : verbose ? LogLevel::verbose : LogLevel::normal), progress, threads};
   init_gdal();
+  catch_interrupts();
   try {
     for (auto& [sub, command] : subs)
       if (sub->parsed()) command->run(context);
   } catch (const Error& e) {
-    std::fprintf(stderr, "terrapolis: error: %s\n", e.what());
+    if (e.kind() == ErrorKind::cancelled && interrupt_signal()) {
+      // The outputs' temporary folders are gone (removed while the error unwound): say so, exit 128 + signal.
+      std::fprintf(stderr, "terrapolis: %s: stopped, no output written\n", e.what());
+      return 128 + interrupt_signal();
+    }
+    std::fprintf(stderr, "terrapolis: error: %s\n", with_output_names(e.what()).c_str());
     return e.exit_code();
   } catch (const std::bad_alloc&) {
     std::fprintf(stderr, "terrapolis: error: out of memory\n");
     return 1;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "terrapolis: error: %s\n", e.what());
+    std::fprintf(stderr, "terrapolis: error: %s\n", with_output_names(e.what()).c_str());
     return 1;
   }
   return 0;

@@ -7,8 +7,9 @@
 
 #include "cli/command.hpp"
 #include "cli/commands_list.hpp"
-#include "cli/output_dir.hpp"
+#include "core/error.hpp"
 #include "io/crs.hpp"
+#include "io/output_set.hpp"
 #include "io/vector_io.hpp"
 #include "network/layers.hpp"
 #include "network/network.hpp"
@@ -32,7 +33,8 @@ class NetworkCommand final : public Command {
 
   void run(Context& context) override {
     if (!(options_.k > 1)) throw bad_input("--k: must be greater than 1");
-    OutputDir outputs(out_, {"network.geojson"}, overwrite_);
+    OutputSet outputs("network", {cities_}, overwrite_);
+    const std::string network_path = (outputs.folder(out_) / "network.geojson").string();
     // Lengths are geodesic whatever the file's CRS: work in WGS 84 longitude/latitude.
     const Crs crs = wgs84();
     const auto t0 = std::chrono::steady_clock::now();
@@ -42,7 +44,8 @@ class NetworkCommand final : public Command {
     const network::SiteGraph graph = network::build_network(sites, crs, options_, context.progress);
     const auto t2 = std::chrono::steady_clock::now();
     const VectorLayer lines = network::network_layer(graph, sites, crs);
-    outputs.write_all([&](std::size_t, const std::string& path, bool overwrite) { write_vector(path, lines, overwrite); });
+    write_vector(network_path, lines);
+    outputs.commit();
     const auto t3 = std::chrono::steady_clock::now();
     const auto seconds = [](auto a, auto b) { return std::to_string(std::chrono::duration<double>(b - a).count()); };
     context.log.detail("network: read " + seconds(t0, t1) + " s, network " + seconds(t1, t2) + " s, write " + seconds(t2, t3) + " s");

@@ -11,6 +11,7 @@
 #include "cli/road_options.hpp"
 #include "core/error.hpp"
 #include "io/crs.hpp"
+#include "io/output_set.hpp"
 #include "io/raster_io.hpp"
 #include "io/vector_io.hpp"
 #include "roads/road_network.hpp"
@@ -43,9 +44,12 @@ class PathCommand final : public Command {
                      : search_ == "dijkstra"       ? roads::SearchMethod::dijkstra
                      : search_ == "astar-distance" ? roads::SearchMethod::astar_distance
                                                    : roads::SearchMethod::astar;
-    if (evaluate_.empty()) check_output_path(out_, options_.overwrite);
-    if (!sections_.empty()) check_output_path(sections_, options_.overwrite);
-    if (evaluate_.empty() && !options_.earthworks.empty()) check_output_path(options_.earthworks, options_.overwrite);
+    std::vector<std::string> inputs = options_.inputs();
+    inputs.insert(inputs.end(), {dem_, evaluate_});
+    OutputSet outputs("path", inputs, options_.overwrite);
+    const std::string out = evaluate_.empty() ? outputs.file(out_) : "";
+    const std::string sections = evaluate_.empty() && !sections_.empty() ? outputs.file(sections_) : "";
+    const std::string earthworks = evaluate_.empty() && !options_.earthworks.empty() ? outputs.file(options_.earthworks) : "";
     const roads::CostModel model = options_.cost_model();
     const plugin::PluginSet plugins = options_.plugins.load(context.log);
     const Dem dem = read_dem(dem_);
@@ -77,11 +81,12 @@ class PathCommand final : public Command {
     roads[0].to = 1;
     roads[0].road_class = "departmental";
     const VectorLayer layer = roads::roads_layer(terrain, roads);
-    const VectorLayer sections = roads::sections_layer(terrain, roads);
+    const VectorLayer sections_layer = roads::sections_layer(terrain, roads);
     const Dem levelled = options_.earthworks_dem(dem, terrain, roads);
-    write_vector(out_, layer, options_.overwrite);
-    if (!sections_.empty()) write_vector(sections_, sections, options_.overwrite);
-    options_.write_earthworks(levelled);
+    write_vector(out, layer);
+    if (!sections.empty()) write_vector(sections, sections_layer);
+    options_.write_earthworks(earthworks, levelled);
+    outputs.commit();
     const auto& s = road->stats;
     char cost[64] = "none (it breaks a threshold of the cost model)";  // Bézier roads may
     if (road->cost) std::snprintf(cost, sizeof cost, "%.1f", *road->cost);

@@ -13,6 +13,7 @@
 #include "cli/terrain_options.hpp"
 #include "core/error.hpp"
 #include "io/crs.hpp"
+#include "io/output_set.hpp"
 #include "io/raster_io.hpp"
 #include "io/vector_io.hpp"
 #include "terrain/fill.hpp"
@@ -71,7 +72,8 @@ class ReconstructCommand final : public Command {
   void run(Context& context) override {
     const terrain::FillParams params = options_.params();
     if (!like_.empty() && grid_.given()) throw bad_input("--like and --size: give one grid, not both");
-    check_output_path(output_, overwrite_);
+    OutputSet outputs("reconstruct", {input_, like_}, overwrite_);
+    const std::string out = outputs.file(output_);
     const std::string ext = lower_extension(input_);
     const bool points = ext == "csv" || ext == "txt" || ext == "geojson" || ext == "json" || ext == "gpkg" || ext == "shp";
     Raster<float> grid;
@@ -97,11 +99,11 @@ class ReconstructCommand final : public Command {
                      std::to_string(100.0 * double(known) / double(grid.size())).substr(0, 5) + " %), method " + options_.method);
     terrain::reconstruct(grid, params, &context.progress);
     WriteOptions write;
-    write.overwrite = overwrite_;
     write.description = "elevation reconstructed from samples (m)";
     write.metadata = options_.metadata(true);
     write.metadata.emplace_back("TERRAPOLIS_SAMPLES", std::to_string(known));
-    write_raster(output_, grid, write);
+    write_raster(out, grid, write);
+    outputs.commit();
   }
 
  private:

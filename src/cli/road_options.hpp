@@ -47,8 +47,11 @@ struct RoadOptions {
         ->check(CLI::Range(0.0, 86400.0));
     app.add_option("--earthworks", earthworks, "Also write the DEM after cut-and-fill along the surface roads (GeoTIFF; 8 m carriageway, 2:3 sides)");
     plugins.setup(app, "adds its road cost term (characteristic priced by its transfer functions; galin router)");
-    app.add_flag("--overwrite", overwrite, "Replace existing outputs");
+    app.add_flag("--overwrite", overwrite, "Replace the outputs a previous terrapolis command wrote");
   }
+
+  /// The files these options read (the outputs may not replace them).
+  std::vector<std::string> inputs() const { return {costs, vegetation}; }
 
   /// The DEM after the earthworks of the roads (empty when --earthworks is not given).
   Dem earthworks_dem(const Dem& dem, const roads::TerrainField& terrain, const std::vector<roads::Road>& roads) const {
@@ -57,12 +60,12 @@ struct RoadOptions {
     for (const roads::Road& r : roads) geometries.push_back(&r.geometry);
     return roads::earthworks(dem, terrain, geometries);
   }
-  void write_earthworks(const Dem& levelled) const {
+  /// Writes the levelled DEM to `path` (where the command's OutputSet stages --earthworks).
+  void write_earthworks(const std::string& path, const Dem& levelled) const {
     if (earthworks.empty()) return;
     WriteOptions w;
-    w.overwrite = overwrite;
     w.description = "terrain after cut-and-fill along the roads (m)";
-    write_raster(earthworks, levelled, w);
+    write_raster(path, levelled, w);
   }
 
   /// Lakes the DEM flattens (hydro::detect_flat_water), for the TerrainField.

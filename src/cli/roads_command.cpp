@@ -10,6 +10,7 @@
 #include "cli/commands_list.hpp"
 #include "cli/road_options.hpp"
 #include "core/error.hpp"
+#include "io/output_set.hpp"
 #include "io/raster_io.hpp"
 #include "io/vector_io.hpp"
 #include "roads/road_network.hpp"
@@ -25,7 +26,7 @@ class RoadsCommand final : public Command {
   void setup(CLI::App& app) override {
     app.add_option("DEM", dem_, "Elevation model")->required();
     app.add_option("NETWORK", network_, "network.geojson from the network stage (LineStrings: from, to, kept)")->required();
-    app.add_option("OUTDIR", outdir_, "Folder for roads.geojson and road_sections.geojson (created if missing)")->required();
+    app.add_option("OUTDIR", outdir_, "Folder for roads.geojson and road_sections.geojson (its parent must exist)")->required();
     app.add_option("--cities", cities_, "Cities (Points: id, class); default: cities.geojson beside NETWORK when present");
     options_.setup(app);
   }
@@ -33,16 +34,16 @@ class RoadsCommand final : public Command {
   void run(Context& context) override {
     namespace fs = std::filesystem;
     if (!fs::exists(network_)) throw bad_input(network_ + ": no such file");
-    // The folder is created only once the roads are computed: a failed run leaves nothing behind.
-    const bool create_folder = !fs::exists(outdir_);
-    if (!create_folder && !fs::is_directory(outdir_)) throw bad_input(outdir_ + ": not a folder");
-    const std::string roads_path = (fs::path(outdir_) / "roads.geojson").string();
-    const std::string sections_path = (fs::path(outdir_) / "road_sections.geojson").string();
-    if (!create_folder) {
-      check_output_path(roads_path, options_.overwrite);
-      check_output_path(sections_path, options_.overwrite);
+    std::string cities_path = cities_;
+    if (cities_path.empty()) {
+      const fs::path beside = fs::path(network_).parent_path() / "cities.geojson";
+      if (fs::exists(beside)) cities_path = beside.string();
     }
-    if (!options_.earthworks.empty()) check_output_path(options_.earthworks, options_.overwrite);
+    std::vector<std::string> inputs = options_.inputs();
+    inputs.insert(inputs.end(), {dem_, network_, cities_path});
+    OutputSet outputs("roads", inputs, options_.overwrite);
+    const fs::path dir = outputs.folder(outdir_);
+    const std::string earthworks_path = options_.earthworks.empty() ? "" : outputs.file(options_.earthworks);
 
     const roads::CostModel model = options_.cost_model();
     const plugin::PluginSet plugins = options_.plugins.load(context.log);
@@ -52,11 +53,6 @@ class RoadsCommand final : public Command {
     options_.load_layers(terrain, plugins, dem, context.progress, context.log);
     VectorLayer network = read_vector(network_, dem.georef().crs);
     network.name = network_;  // errors name the file
-    std::string cities_path = cities_;
-    if (cities_path.empty()) {
-      const fs::path beside = fs::path(network_).parent_path() / "cities.geojson";
-      if (fs::exists(beside)) cities_path = beside.string();
-    }
     std::optional<VectorLayer> cities;
     if (!cities_path.empty()) {
       cities = read_vector(cities_path, dem.georef().crs);
@@ -72,14 +68,10 @@ class RoadsCommand final : public Command {
     for (const std::string& f : result.failed) context.log.warn("no road under the cost model for edge " + f + " (left out)");
     for (const std::string& f : result.over_budget) context.log.warn("not routed: budget (--max-seconds) for edge " + f);
     const Dem levelled = options_.earthworks_dem(dem, terrain, result.roads);
-    if (create_folder) {
-      std::error_code ec;
-      fs::create_directories(outdir_, ec);
-      if (ec) throw bad_input(outdir_ + ": cannot create the output folder (" + ec.message() + ")");
-    }
-    write_vector(roads_path, roads::roads_layer(terrain, result.roads), options_.overwrite);
-    write_vector(sections_path, roads::sections_layer(terrain, result.roads), options_.overwrite);
-    options_.write_earthworks(levelled);
+    write_vector((dir / "roads.geojson").string(), roads::roads_layer(terrain, result.roads));
+    write_vector((dir / "road_sections.geojson").string(), roads::sections_layer(terrain, result.roads));
+    options_.write_earthworks(earthworks_path, levelled);
+    outputs.commit();
     std::size_t ferries = 0;
     double km = 0;
     for (const auto& r : result.roads) {

@@ -10,10 +10,10 @@
 
 #include "cli/command.hpp"
 #include "cli/commands_list.hpp"
-#include "cli/output_dir.hpp"
 #include "core/error.hpp"
 #include "density/density.hpp"
 #include "hydro/hydrometry.hpp"
+#include "io/output_set.hpp"
 #include "io/raster_io.hpp"
 #include "sites/layers.hpp"
 #include "sites/sites.hpp"
@@ -112,7 +112,8 @@ class SitesCommand final : public Command {
     options_.mode = mode_ == "manhattan" ? sites::SitesOptions::Mode::manhattan : sites::SitesOptions::Mode::paris;
     options_.quotas = quotas_ == "belhadj2007" ? sites::SitesOptions::Quotas::belhadj2007 : sites::SitesOptions::Quotas::rank_size;
     options_.disc_test = disc_test_ == "perimeter" ? sites::SitesOptions::DiscTest::perimeter : sites::SitesOptions::DiscTest::exact;
-    OutputDir outputs(out_, {"cities.geojson", "city_extents.geojson"}, overwrite_);
+    OutputSet outputs("sites", {dir_}, overwrite_);
+    const std::filesystem::path out_dir = outputs.folder(out_);
     const auto t0 = std::chrono::steady_clock::now();
     const bool dem = std::filesystem::is_regular_file(dir_);
     const DensityInputs in = dem ? density_from_dem(dir_, context.progress) : read_density_dir(dir_);
@@ -122,7 +123,9 @@ class SitesCommand final : public Command {
     const Crs& crs = in.density.georef().crs;
     const VectorLayer cities = sites::cities_layer(result, crs);
     const VectorLayer extents = sites::city_extents_layer(result, crs);
-    outputs.write_all([&](std::size_t i, const std::string& path, bool overwrite) { write_vector(path, i == 0 ? cities : extents, overwrite); });
+    write_vector((out_dir / "cities.geojson").string(), cities);
+    write_vector((out_dir / "city_extents.geojson").string(), extents);
+    outputs.commit();
     const auto t3 = std::chrono::steady_clock::now();
     const auto seconds = [](auto a, auto b) { return std::to_string(std::chrono::duration<double>(b - a).count()); };
     context.log.detail("sites: read " + seconds(t0, t1) + " s, placement " + seconds(t1, t2) + " s, write " + seconds(t2, t3) + " s");

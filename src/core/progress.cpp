@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 
 namespace terrapolis {
 
@@ -23,7 +24,7 @@ bool ConsoleProgress::update(double fraction) {
     else std::fputc('.', stderr);
   }
   std::fflush(stderr);
-  return true;
+  return interrupt_signal() == 0;
 }
 
 void ConsoleProgress::end() {
@@ -44,12 +45,15 @@ bool JsonProgress::update(double fraction) {
     std::fprintf(stderr, "{\"step\":\"%s\",\"progress\":%.2f}\n", step_.c_str(), percent / 100.0);
     std::fflush(stderr);
   }
-  return true;
+  return interrupt_signal() == 0;
 }
 
 void JsonProgress::end() { update(1.0); }
 
+bool SilentProgress::update(double) { return interrupt_signal() == 0; }
+
 void ProgressStep::update(double fraction) {
+  stop_if_interrupted();
   if (!progress_.update(fraction)) throw Error(ErrorKind::cancelled, "cancelled");
 }
 

@@ -12,7 +12,8 @@ class Progress {
   virtual ~Progress() = default;
   /// A new step starts (e.g. "fill"); fraction restarts at 0.
   virtual void begin(std::string_view step) = 0;
-  /// Fraction of the current step done, in [0,1]. Returns false to ask the work to stop.
+  /// Fraction of the current step done, in [0,1]. Returns false to ask the work to stop (every
+  /// sink does after SIGINT/SIGTERM, see core/interrupt.hpp).
   virtual bool update(double fraction) = 0;
   /// The current step is finished.
   virtual void end() = 0;
@@ -21,7 +22,7 @@ class Progress {
 class SilentProgress final : public Progress {
  public:
   void begin(std::string_view) override {}
-  bool update(double) override { return true; }
+  bool update(double) override;
   void end() override {}
 };
 

@@ -5,7 +5,9 @@
 #include <cpl_error.h>
 #include <ogr_spatialref.h>
 
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <cstdio>
 #include <filesystem>
 #include <limits>
@@ -77,8 +79,16 @@ void commit_file(const std::string& temporary, const std::string& path) {
   std::filesystem::rename(temporary, path, ec);
   if (ec) {
     discard_file(temporary);
-    throw bad_input(path + ": cannot write output (" + ec.message() + ")");
+    throw write_failure(path, ec.value(), "");
   }
+}
+
+Error write_failure(const std::string& path, int error_number, const std::string& message) {
+  const bool full = error_number == ENOSPC || message.find("No space left") != std::string::npos ||
+                    message.find("Free disk space available") != std::string::npos;  // GTiff's own check
+  std::string why = full ? "no space left on the device" : message;
+  if (why.empty()) why = error_number ? std::strerror(error_number) : "write failed";
+  return processing_error(path + ": cannot write output (" + why + ")");
 }
 
 void discard_file(const std::string& temporary) {

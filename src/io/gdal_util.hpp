@@ -5,6 +5,7 @@
 
 #include <string>
 
+#include "core/error.hpp"
 #include "core/raster.hpp"
 
 namespace terrapolis::detail {
@@ -22,6 +23,14 @@ std::string last_gdal_error(const std::string& fallback);
 std::string temporary_name(const std::string& path);
 void commit_file(const std::string& temporary, const std::string& path);
 void discard_file(const std::string& temporary);
+
+/// Writes `size` bytes to a new file `path`, checking every write, the last flush and the close.
+/// Returns 0, or the errno of the first failure (ENOSPC on a full disk).
+int write_bytes(const std::string& path, const void* data, std::size_t size);
+
+/// The error of a failed write of `path` (exit 1): "no space left on the device" when `error_number`
+/// is ENOSPC or GDAL's message says so, else `message` (GDAL's) or the system's text for the number.
+Error write_failure(const std::string& path, int error_number, const std::string& message);
 
 /// Refuses an existing output unless `overwrite`, and an output whose folder does not exist or is not writable.
 void check_output(const std::string& path, bool overwrite);

@@ -10,6 +10,7 @@
 #include <tbb/global_control.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -20,6 +21,7 @@
 #include <unistd.h>
 
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 #include "io/gdal_util.hpp"
 
 namespace terrapolis {
@@ -347,8 +349,6 @@ Raster<float> read_resampled(const std::string& path, const Georef& like, int co
   return out;
 }
 
-void check_output_path(const std::string& path, bool overwrite) { detail::check_output(path, overwrite); }
-
 template <class T>
 void write_raster(const std::string& path, const Raster<T>& raster, const WriteOptions& options) {
   init_gdal();
@@ -396,13 +396,19 @@ void write_raster(const std::string& path, const Raster<T>& raster, const WriteO
   const std::string tmp = detail::temporary_name(path);
   {
     QuietGdal quiet;
-    GDALDataset* out = driver->CreateCopy(tmp.c_str(), src.get(), FALSE, co.List(), nullptr, nullptr);
-    const bool ok = out && CPLGetLastErrorType() < CE_Failure;
+    // GDAL's progress callback stops a long write at an interrupt (SIGINT/SIGTERM).
+    const auto keep_going = [](double, const char*, void*) -> int { return interrupt_signal() == 0; };
+    errno = 0;
+    GDALDataset* out = driver->CreateCopy(tmp.c_str(), src.get(), FALSE, co.List(), keep_going, nullptr);
     if (out) GDALClose(GDALDataset::ToHandle(out));
+    // Errors of the last blocks' flush are raised by the close: check after it.
+    const bool ok = out && CPLGetLastErrorType() < CE_Failure;
     if (!ok) {
+      const int error = errno;
       const std::string msg = detail::last_gdal_error("write failed");
       detail::discard_file(tmp);
-      throw bad_input(path + ": cannot write output (" + msg + ")");
+      stop_if_interrupted();
+      throw detail::write_failure(path, error, msg);
     }
   }
   detail::commit_file(tmp, path);

@@ -88,7 +88,4 @@ class DemWindowReader {
 /// temporary name, then renames it.
 void write_vrt(const std::string& path, const std::vector<std::string>& tiles, bool overwrite);
 
-/// Refuses an output path that exists (unless overwrite) or whose folder is missing or read-only.
-void check_output_path(const std::string& path, bool overwrite);
-
 }  // namespace terrapolis

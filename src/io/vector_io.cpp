@@ -3,10 +3,12 @@
 #include "io/vector_io.hpp"
 
 #include <cpl_error.h>
+#include <cpl_vsi.h>
 #include <gdal_priv.h>
 #include <ogrsf_frmts.h>
 
 #include <algorithm>
+#include <atomic>
 #include <filesystem>
 #include <memory>
 
@@ -73,17 +75,20 @@ void write_vector(const std::string& path, const VectorLayer& layer, bool overwr
   const bool geojson = ext == ".geojson" || ext == ".json";
   if (!geojson && ext != ".gpkg") throw bad_input(path + ": unknown vector format (use .geojson or .gpkg)");
   GDALDriver* driver = GetGDALDriverManager()->GetDriverByName(geojson ? "GeoJSON" : "GPKG");
-  const std::string tmp = detail::temporary_name(path);
+  // OGR's GeoJSON writer does not check its writes: build the file in memory, then write its bytes
+  // with every write checked (a full disk fails the command instead of leaving a cut file).
+  static std::atomic<int> serial{0};
+  const std::string mem = "/vsimem/terrapolis-" + std::to_string(serial++) + ext;
   CPLPushErrorHandler(CPLQuietErrorHandler);
   CPLErrorReset();
   auto fail = [&](GDALDataset* ds, const std::string& what) {
     const std::string msg = detail::last_gdal_error(what);
     if (ds) GDALClose(GDALDataset::ToHandle(ds));
     CPLPopErrorHandler();
-    detail::discard_file(tmp);
-    throw bad_input(path + ": cannot write output (" + msg + ")");
+    VSIUnlink(mem.c_str());
+    throw processing_error(path + ": cannot write output (" + msg + ")");
   };
-  GDALDataset* ds = driver->Create(tmp.c_str(), 0, 0, 0, GDT_Unknown, nullptr);
+  GDALDataset* ds = driver->Create(mem.c_str(), 0, 0, 0, GDT_Unknown, nullptr);
   if (!ds) fail(ds, "create failed");
   OGRSpatialReference srs = detail::to_ogr(layer.crs);
   CPLStringList lco;
@@ -114,9 +119,20 @@ void write_vector(const std::string& path, const VectorLayer& layer, bool overwr
     }
     if (out->CreateFeature(&feature) != OGRERR_NONE) fail(ds, "feature write failed");
   }
-  if (!geojson) ds->CommitTransaction();
+  if (!geojson && ds->CommitTransaction() != OGRERR_NONE) fail(ds, "commit failed");
   GDALClose(GDALDataset::ToHandle(ds));
+  const bool closed = CPLGetLastErrorType() < CE_Failure;
+  const std::string msg = detail::last_gdal_error("write failed");
   CPLPopErrorHandler();
+  vsi_l_offset size = 0;
+  GByte* bytes = closed ? VSIGetMemFileBuffer(mem.c_str(), &size, FALSE) : nullptr;
+  const std::string tmp = detail::temporary_name(path);
+  const int error = bytes ? detail::write_bytes(tmp, bytes, std::size_t(size)) : 0;
+  VSIUnlink(mem.c_str());
+  if (!bytes || error) {
+    detail::discard_file(tmp);
+    throw detail::write_failure(path, error, bytes ? "" : msg);
+  }
   detail::commit_file(tmp, path);
 }
 

@@ -13,6 +13,7 @@
 
 #include "core/error.hpp"
 #include "io/crs.hpp"
+#include "io/text_io.hpp"
 
 namespace terrapolis::pipeline {
 namespace {
@@ -259,7 +260,7 @@ void write_qgis_styles_and_project(const RunState& state) {
     const std::string body = qgis_style_body(*o, state);
     const std::string qml = "<!DOCTYPE qgis PUBLIC 'http://mrcc.com/qgis.dtd' 'SYSTEM'>\n<qgis version=\"3.22.16\" styleCategories=\"AllStyleCategories\">" +
                             body + "<blendMode>0</blendMode></qgis>\n";
-    std::ofstream(state.folder / (stem(o->name) + ".qml")) << qml;
+    write_text_file((state.folder / (stem(o->name) + ".qml")).string(), qml, true);
     project_layers << "<maplayer type=\"" << (o->raster ? "raster" : "vector") << "\""
                    << (o->raster ? "" : " geometry=\"\"") << "><id>" << layer_id(*o) << "</id><datasource>./" << o->name
                    << "</datasource><layername>" << escape(stem(o->name)) << "</layername><srs>" << (o->raster ? srs : srs_lonlat)
@@ -267,7 +268,7 @@ void write_qgis_styles_and_project(const RunState& state) {
                    << "</provider>" << body << "<blendMode>0</blendMode></maplayer>";
     order << "<item>" << layer_id(*o) << "</item>";
   }
-  std::ofstream out(state.folder / "project.qgs");
+  std::ostringstream out;
   out << "<!DOCTYPE qgis PUBLIC 'http://mrcc.com/qgis.dtd' 'SYSTEM'>\n"
       << "<qgis projectname=\"Terrapolis run\" version=\"3.22.16\"><title>Terrapolis run</title>"
       << "<projectCrs>" << srs << "</projectCrs>"
@@ -276,7 +277,7 @@ void write_qgis_styles_and_project(const RunState& state) {
       // QGIS reads <projectCrs> only when SpatialRefSys/ProjectionsEnabled is set.
       << "<properties><Paths><Absolute type=\"bool\">false</Absolute></Paths>"
       << "<SpatialRefSys><ProjectionsEnabled type=\"int\">1</ProjectionsEnabled></SpatialRefSys></properties></qgis>\n";
-  if (!out) throw processing_error((state.folder / "project.qgs").string() + ": cannot write");
+  write_text_file((state.folder / "project.qgs").string(), out.str(), true);
 }
 
 }  // namespace terrapolis::pipeline

@@ -8,10 +8,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <fstream>
+#include <functional>
 
 #include "core/error.hpp"
 #include "io/checksum.hpp"
+#include "io/output_set.hpp"
+#include "io/text_io.hpp"
 #include "io/raster_io.hpp"
 #include "pipeline/compare.hpp"
 #include "pipeline/publish.hpp"
@@ -102,6 +104,27 @@ void reuse_saved(RunState& state, const json& saved, const std::string& stage, j
     }
 }
 
+/// Every file the scenario names (its strings that name an existing file, resolved as its paths
+/// are), and the scenario file itself: the run folder may not hold them.
+std::vector<std::string> scenario_inputs(const Scenario& scenario) {
+  namespace fs = std::filesystem;
+  std::vector<std::string> inputs;
+  if (fs::path source = scenario.source; fs::is_regular_file(source)) inputs.push_back(source.string());
+  std::function<void(const json&)> walk = [&](const json& j) {
+    if (j.is_object() || j.is_array()) {
+      for (const auto& [key, value] : j.items())
+        if (!(j.is_object() && &j == &scenario.resolved && key == "output")) walk(value);
+    } else if (j.is_string() && !j.get<std::string>().empty()) {
+      const fs::path p = fs::path(j.get<std::string>()).is_absolute() ? fs::path(j.get<std::string>()) : scenario.base_dir / j.get<std::string>();
+      std::error_code ec;
+      if (fs::is_regular_file(p, ec)) inputs.push_back(p.string());  // inputs are files; "grass" may name a folder
+    }
+  };
+  walk(scenario.resolved);
+  inputs.push_back(scenario.path("dem"));
+  return inputs;
+}
+
 }  // namespace
 
 std::vector<std::string> stage_names() {
@@ -115,15 +138,11 @@ json run_scenario(const Scenario& scenario, const RunOptions& options, Progress&
   const fs::path output = scenario.path("output");
   const std::vector<Action> plan = plan_stages(options);
   const bool rerun = std::any_of(plan.begin(), plan.end(), [](Action a) { return a != Action::run; });
-  std::error_code ec;
   json saved;
-  if (rerun) {
-    saved = load_manifest(output.string());
-  } else if (fs::exists(output, ec) && !options.overwrite) {
-    throw bad_input(output.string() + ": run folder exists (use --overwrite to replace it)");
-  }
-  const fs::path parent = output.parent_path().empty() ? fs::path(".") : output.parent_path();
-  if (!fs::is_directory(parent, ec)) throw bad_input(output.string() + ": folder " + parent.string() + " does not exist");
+  if (rerun) saved = load_manifest(output.string());
+  // A rerun replaces its own run folder; the new run is built beside it and swapped in at the end.
+  OutputSet run_folder("run", scenario_inputs(scenario), options.overwrite || rerun);
+  const fs::path temp = run_folder.folder(output.string(), rerun);
 
   const std::string dem_path = scenario.path("dem");
   ReadOptions read;
@@ -135,15 +154,7 @@ json run_scenario(const Scenario& scenario, const RunOptions& options, Progress&
   plugin::PluginSet plugins = plugin::load_plugins(nlohmann::json::parse(scenario.resolved["plugins"].dump()), log,
                                                    scenario.base_dir.string());
   if (rerun) check_reusable(output, saved, scenario, dem_sha256, plan);
-  const fs::path temp = output.string() + ".tmp-" + std::to_string(::getpid());
-  fs::remove_all(temp, ec);
-  if (rerun) {
-    fs::copy(output, temp, fs::copy_options::recursive, ec);
-  } else {
-    fs::create_directory(temp, ec);
-  }
-  if (ec) throw bad_input(output.string() + ": cannot create the run folder (" + ec.message() + ")");
-  try {
+  {
     RunState state(scenario, temp, dem_sha256, std::move(dem));
     state.plugins = std::move(plugins);
     json timings = json::array();
@@ -191,17 +202,9 @@ json run_scenario(const Scenario& scenario, const RunOptions& options, Progress&
     manifest["timings"] = timings;
     if (rerun) manifest["rerun"] = {{"ran", ran}, {"reused", reused}, {"stale", stale}};
     publish(state, manifest, log.stage("publish"));
-    {
-      std::ofstream out(temp / "run.json");
-      out << manifest.dump(2) << "\n";
-      if (!out) throw processing_error((temp / "run.json").string() + ": cannot write");
-    }
-    if (fs::exists(output, ec)) fs::remove_all(output);
-    fs::rename(temp, output);
+    write_text_file((temp / "run.json").string(), manifest.dump(2) + "\n", true);
+    run_folder.commit();
     return manifest;
-  } catch (...) {
-    fs::remove_all(temp, ec);
-    throw;
   }
 }
 

@@ -68,11 +68,14 @@ gdal_translate -q -ot Byte -scale 212 1233 0 1.6 "$dem" "$tmp/lake.tif"   # 0 be
 "$bin" --quiet density "$dem" "$tmp/vermont" --weights 1,0,0,0 --water-mask "$tmp/lake.tif" --overwrite
 read -r lo hi < <(minmax "$tmp/vermont/coast.tif")
 [[ $hi == 1.000 ]] || fail "vermont: water mask gave no coast ($hi)"
-# 6. A hydrometry.tif already in OUTDIR is reused as input and left as it is.
+# 6. An OUTDIR holding an input (its --hydrometry) is refused, the input left as it is.
 mkdir "$tmp/reuse"
 cp "$tmp/hydro.tif" "$tmp/reuse/hydrometry.tif"
 before=$(md5sum < "$tmp/reuse/hydrometry.tif")
-"$bin" --quiet density "$dem" "$tmp/reuse" --weights 0,1,1,0 --hydrometry "$tmp/reuse/hydrometry.tif"
+set +e
+"$bin" --quiet density "$dem" "$tmp/reuse" --weights 0,1,1,0 --hydrometry "$tmp/reuse/hydrometry.tif" --overwrite 2> "$tmp/err"
+code=$?
+set -e
+[[ $code == 2 ]] && grep -q "holds the input" "$tmp/err" || fail "an OUTDIR holding the input: exit $code, $(cat "$tmp/err")"
 [[ $(md5sum < "$tmp/reuse/hydrometry.tif") == "$before" ]] || fail "reuse: hydrometry.tif was rewritten"
-[[ -f $tmp/reuse/density.tif ]] || fail "reuse: no density.tif"
 echo "density CLI cases passed"

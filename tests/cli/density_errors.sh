@@ -32,7 +32,7 @@ expect_error "expected FILE:WEIGHT" "$dem" "$tmp/out" --weights 1,0,1,0 --layer 
 expect_error "not a number" "$dem" "$tmp/out" --weights 1,0,1,0 --layer "$dem:heavy"
 gdal_translate -q -ot Float32 -scale -2601 1829 0 7 "$dem" "$tmp/hydro.tif"
 expect_error "values must lie in \[0,1\]" "$dem" "$tmp/out" --hydrometry "$tmp/hydro.tif"
-expect_error "parent folder does not exist" "$dem" "$tmp/no/such/out" --weights 1,0,1,0
+expect_error "output folder .*no/such does not exist" "$dem" "$tmp/no/such/out" --weights 1,0,1,0
 
 # Existing outputs are kept unless --overwrite.
 "$bin" --quiet density "$dem" "$tmp/done" --weights 1,0,1,0

@@ -31,7 +31,7 @@ gdalinfo run1/elevation.tif | grep -q "TERRAPOLIS_INPUT_SHA256=" || fail "no pro
 /usr/bin/python3 -c "import json,sys; m=json.load(open('run1/run.json')); assert m['input']['sha256'] and m['timings'], m" || fail "run.json"
 
 # Existing folder refused; invalid scenarios fail with the pointer and leave nothing.
-expect_fail 2 "run1: run folder exists.*--overwrite" "$TP" run -o run1
+expect_fail 2 "run1: output folder exists.*--overwrite" "$TP" run -o run1
 expect_fail 2 "/outputs/cog" "$TP" run -o bad --set outputs.cog=3
 [[ ! -e bad ]] || fail "an invalid scenario left a folder"
 echo '{"dem": "nowhere.tif", "output": "bad2"}' > s.json

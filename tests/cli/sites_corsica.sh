@@ -46,7 +46,7 @@ set +e
 rc=$?
 set -e
 test $rc -eq 2
-grep -q "cities.geojson" "$T/err.txt"
+grep -q "a: output folder exists" "$T/err.txt"
 cmp "$T/a/cities.geojson" "$T/b/cities.geojson"
 "$BIN" --quiet sites "$T/in" "$T/a" --seed 9 --overwrite
 grep -q '"seed": 9' "$T/a/cities.geojson"
