@@ -9,7 +9,7 @@ bin=$TP samples=$SAMPLES work=$WORK
 "$bin" -q hydro "$samples/gebco2022_15s_north_corsica_capcorse.asc" "$work/corsica" --sea-level 0 --classify \
   --outputs filled,streams
 [[ -s $work/corsica/streams.qml ]] || fail "no streams.qml"
-python3 - "$work/corsica" <<'EOF'
+/usr/bin/python3 - "$work/corsica" <<'EOF'
 import json, sys, xml.dom.minidom
 folder = sys.argv[1]
 xml.dom.minidom.parse(folder + "/streams.qml")  # well-formed
@@ -57,7 +57,7 @@ EOF
 # Without a sea level there is no coast: no D and no delta, no distance to a mouth.
 "$bin" -q hydro "$samples/spDataLarge_srtm_zion.tif" "$work/zion" --classify --outputs streams --streams-threshold 2 \
   --braided-discharge 0.1 --delta-discharge 0.1
-python3 - "$work/zion/streams.geojson" <<'EOF'
+/usr/bin/python3 - "$work/zion/streams.geojson" <<'EOF'
 import json, sys
 for f in json.load(open(sys.argv[1]))["features"]:
     p = f["properties"]

@@ -5,7 +5,7 @@
 source "$(dirname "$0")/lib.sh" "$@"
 bin=$TP samples=$SAMPLES work=$WORK
 zion=$samples/spDataLarge_srtm_zion.tif
-json() { python3 -c "import json,sys; print(json.load(open(sys.argv[1]))$2)" "$1"; }
+json() { /usr/bin/python3 -c "import json,sys; print(json.load(open(sys.argv[1]))$2)" "$1"; }
 
 # The documented example (docs/lakes.md): a dam with a 1172 m crest across a valley of 255 km²
 # south-west of Zion (Utah), the reservoir filled to 1167 m.
@@ -19,7 +19,7 @@ gdalinfo "$work/reservoir/depth.tif" | grep -q "Size is 465, 457" || fail "grid 
 gdalinfo "$work/reservoir/depth.tif" | grep -q "LEVEL_M=1167.000" || fail "no LEVEL_M"
 # The report's area and volume are the depth raster's: cells times their geodesic areas (checked
 # independently with pyproj's geodesic areas of each row's cell).
-python3 - "$work/reservoir" <<'EOF'
+/usr/bin/python3 - "$work/reservoir" <<'EOF'
 import json, sys, math
 from osgeo import gdal
 folder = sys.argv[1]
@@ -57,7 +57,7 @@ EOF
 grep -q "spill beyond" "$work/undammed.log" || fail "no spill warning"
 grass_cells=8348
 cells=$(json "$work/undammed/lake.json" "['cells']")
-python3 -c "import sys; c, g = $cells, $grass_cells; sys.exit(0 if abs(c - g) <= 0.005 * g else 1)" \
+/usr/bin/python3 -c "import sys; c, g = $cells, $grass_cells; sys.exit(0 if abs(c - g) <= 0.005 * g else 1)" \
   || fail "lake cells $cells differ from r.lake's $grass_cells by more than 0.5 %"
 
 # --depth: the level is the seed's ground (1107 m) plus the depth; with a dam and no level, the crest.
@@ -80,7 +80,7 @@ cat >"$work/run/cities.geojson" <<'EOF'
  {"type": "Feature", "properties": {"id": 2, "radius_m": 500.0}, "geometry": {"type": "Point", "coordinates": [-112.90, 37.20]}}]}
 EOF
 "$bin" -q lake "$zion" "$work/reservoir_run" --at=$at --dam "$dam" --crest 1172 --level 1167 --run "$work/run"
-python3 - "$work/reservoir_run/lake.json" "$work/reservoir/depth.tif" <<'EOF'
+/usr/bin/python3 - "$work/reservoir_run/lake.json" "$work/reservoir/depth.tif" <<'EOF'
 import json, sys, math
 from osgeo import gdal
 r = json.load(open(sys.argv[1]))

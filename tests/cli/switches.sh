@@ -20,11 +20,11 @@ import json, sys
 f = json.load(open(sys.argv[1]))["features"]
 print(sum(x["properties"]["structure"] == "bridge" for x in f), sum(x["properties"]["structure"] == "tunnel" for x in f))' "$1"
 }
-# The default run on the Corsica sample (its coast and valleys), with and without structures.
-"$TP" --quiet run -o with
+# The thesis's dense network on the Corsica sample (its coast and valleys: bridges), with and without structures.
+"$TP" --quiet run -o with --set sites.quotas=belhadj2007
 read -r bridges tunnels < <(count_structures with/road_sections.geojson)
-[[ $bridges -gt 0 ]] || fail "the default run builds no bridge: this case would not test the switch"
-"$TP" --quiet run -o without --set roads.bridges=false --set roads.tunnels=false
+[[ $bridges -gt 0 ]] || fail "the thesis run builds no bridge: this case would not test the switch"
+"$TP" --quiet run -o without --set sites.quotas=belhadj2007 --set roads.bridges=false --set roads.tunnels=false
 read -r bridges tunnels < <(count_structures without/road_sections.geojson)
 [[ $bridges -eq 0 && $tunnels -eq 0 ]] || fail "roads.bridges=false, roads.tunnels=false built $bridges bridges and $tunnels tunnels"
 /usr/bin/python3 -c '
