@@ -137,7 +137,7 @@ int draw_rank(Style s) {
     case Style::hillshade: return 0;
     case Style::elevation: return 1;
     case Style::flow_direction: case Style::accumulation: case Style::unit_ramp: return 2;
-    case Style::mask: return 3;
+    case Style::mask: case Style::water: return 3;
     case Style::density: return 4;
     case Style::city_extents: return 5;
     case Style::streams: return 6;
@@ -183,6 +183,7 @@ std::string qgis_style_body(const OutputFile& o, const RunState& state) {
       return pseudocolor({{0, "#ffffb2", "0 (empty)"}, {0.25, "#fecc5c", ""}, {0.5, "#fd8d3c", ""}, {0.75, "#f03b20", ""}, {1, "#bd0026", "1 (most attractive)"}},
                          "INTERPOLATED", 0.7);
     case Style::mask: return paletted({{0, "#000000", "not buildable"}, {1, "#4daf4a", "buildable"}}, 0.4);
+    case Style::water: return paletted({{0, "#000000", "land"}, {1, "#2171b5", "inland water"}}, 0.8);
     case Style::flow_direction:
     {
       // The codes of the run's convention (hydro.d8_codes), one colour per direction.

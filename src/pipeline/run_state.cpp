@@ -11,7 +11,7 @@ namespace terrapolis::pipeline {
 namespace {
 constexpr std::pair<Style, const char*> kStyleNames[] = {
     {Style::elevation, "elevation"},   {Style::hillshade, "hillshade"},   {Style::unit_ramp, "unit_ramp"},
-    {Style::density, "density"},       {Style::mask, "mask"},             {Style::flow_direction, "flow_direction"},
+    {Style::density, "density"},       {Style::mask, "mask"}, {Style::water, "water"},             {Style::flow_direction, "flow_direction"},
     {Style::accumulation, "accumulation"}, {Style::streams, "streams"},   {Style::cities, "cities"},
     {Style::city_extents, "city_extents"}, {Style::network, "network"},   {Style::roads, "roads"},
     {Style::road_sections, "road_sections"}};

@@ -149,12 +149,16 @@ RoadsSettings roads_settings(const Scenario& scenario) {
   s.routing.bezier.tries = r["bezier_tries"].get<int>();
   s.vegetation = scenario.path("/roads/vegetation");
   s.routing.max_seconds = r["max_seconds"].get<double>();
-  const json& w = scenario.resolved["water"];
-  s.water_mask = scenario.path("/water/water_mask");
-  s.flat_water.min_area_km2 = w["flat_water_min_km2"].get<double>();
-  s.flat_water.tolerance_m = w["flat_water_tolerance_m"].get<double>();
-  s.flat_water.sea_level_m = w["sea_level_m"].get<double>();
   return s;
+}
+
+hydro::FlatWaterOptions flat_water_options(const Scenario& scenario) {
+  const json& w = scenario.resolved["water"];
+  hydro::FlatWaterOptions o;
+  o.min_area_km2 = w["flat_water_min_km2"].get<double>();
+  o.tolerance_m = w["flat_water_tolerance_m"].get<double>();
+  o.sea_level_m = w["sea_level_m"].get<double>();
+  return o;
 }
 
 }  // namespace terrapolis::pipeline

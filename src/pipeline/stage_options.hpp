@@ -41,9 +41,10 @@ struct RoadsSettings {
   roads::CostModel model;
   roads::RoutingOptions routing;
   std::string vegetation;  ///< resolved path, "" for none
-  std::string water_mask;  ///< water.water_mask: resolved path, "" for none
-  hydro::FlatWaterOptions flat_water;  ///< water.flat_water_*: lakes the DEM flattens
 };
 RoadsSettings roads_settings(const Scenario& scenario);
+
+/// The water section's detection of lakes the DEM flattens (water.flat_water_*, water.sea_level_m).
+hydro::FlatWaterOptions flat_water_options(const Scenario& scenario);
 
 }  // namespace terrapolis::pipeline

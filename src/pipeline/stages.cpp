@@ -45,38 +45,44 @@ void terrain_run(RunState& s, Progress&, const Log&) {
 
 void terrain_load(RunState&) {}  // the DEM is always read from the input
 
-// ---- reservoirs (Peytavie 2010 §2.4.1; docs/lakes.md) ------------------------------------
+// ---- inland water (docs/lakes.md, docs/roads.md) -----------------------------------------
 
-constexpr const char* kReservoirs = "reservoirs.tif";
+constexpr const char* kInlandWater = "inland_water.tif";
 
-/// The scenario's reservoirs and its water_mask as one raster of added water (1 water, 0 not),
-/// the mask the density and roads stages read; nothing when the scenario declares no reservoir.
-void write_reservoirs(RunState& s, Progress& progress, const Log& log) {
-  const std::vector<lake::LakeSpec> specs = reservoir_specs(s.scenario);
-  if (specs.empty()) return;
-  Raster<float> water = s.dem.like<float>(0.0f);
+/// Water no sea level sees, as one mask (1 water, 0 not) that the density (uninhabitable, lakeshores
+/// as coast) and the roads (bridged or avoided) both read: lakes the DEM flattens
+/// (hydro::detect_flat_water), the user's water.water_mask, and the scenario's reservoirs flooded
+/// to their level (Peytavie 2010 §2.4.1).
+void write_inland_water(RunState& s, Progress& progress, const Log& log) {
+  hydro::FlatWater flat = hydro::detect_flat_water(s.dem, flat_water_options(s.scenario));
+  Raster<std::uint8_t>& water = flat.mask;
   if (const std::string user = s.scenario.path("/water/water_mask"); !user.empty()) {
     const Raster<float> m = read_resampled(user, s.dem.georef(), s.dem.cols(), s.dem.rows(), Resampling::nearest);
     for (std::size_t i = 0; i < m.size(); ++i)
       if (!std::isnan(m[i]) && m[i] != 0) water[i] = 1;
   }
-  const CellMetrics metrics = cell_metrics(s.dem.georef(), s.dem.cols(), s.dem.rows());
-  json lakes = json::array();
-  for (std::size_t k = 0; k < specs.size(); ++k) {
-    lake::Lake l;
-    try {
-      l = lake::flood(s.dem, metrics, specs[k], progress);
-    } catch (const Error& e) {
-      throw bad_input("water.reservoirs[" + std::to_string(k) + "]: " + e.what());
+  const std::vector<lake::LakeSpec> specs = reservoir_specs(s.scenario);
+  json reservoirs = json::array();
+  if (!specs.empty()) {
+    const CellMetrics metrics = cell_metrics(s.dem.georef(), s.dem.cols(), s.dem.rows());
+    for (std::size_t k = 0; k < specs.size(); ++k) {
+      lake::Lake l;
+      try {
+        l = lake::flood(s.dem, metrics, specs[k], progress);
+      } catch (const Error& e) {
+        throw bad_input("water.reservoirs[" + std::to_string(k) + "]: " + e.what());
+      }
+      for (std::size_t i = 0; i < l.mask.size(); ++i)
+        if (l.mask[i] == 1) water[i] = 1;
+      if (l.spills) log.warn("water.reservoirs[" + std::to_string(k) + "]: the water reaches the DEM's edge or nodata");
+      reservoirs.push_back({{"level_m", round_to(l.level_m, 0.01)}, {"area_km2", round_to(l.area_km2, 1e-4)},
+                            {"volume_m3", std::round(l.volume_m3)}, {"max_depth_m", round_to(l.max_depth_m, 0.01)}});
     }
-    for (std::size_t i = 0; i < l.mask.size(); ++i)
-      if (l.mask[i] == 1) water[i] = 1;
-    if (l.spills) log.warn("water.reservoirs[" + std::to_string(k) + "]: the water reaches the DEM's edge or nodata");
-    lakes.push_back({{"level_m", round_to(l.level_m, 0.01)}, {"area_km2", round_to(l.area_km2, 1e-4)},
-                     {"volume_m3", std::round(l.volume_m3)}, {"max_depth_m", round_to(l.max_depth_m, 0.01)}});
   }
-  s.write("hydro", kReservoirs, water, "added water: the scenario's reservoirs and water_mask (1 water, 0 not)", Style::unit_ramp);
-  s.summary["hydro"]["reservoirs"] = lakes;
+  s.write("hydro", kInlandWater, water, "inland water (1): lakes the DEM flattens, water.water_mask and water.reservoirs", Style::water);
+  s.summary["hydro"]["flat_lakes"] = flat.lakes;
+  s.summary["hydro"]["flat_lake_km2"] = round_to(flat.area_km2, 0.01);
+  if (!specs.empty()) s.summary["hydro"]["reservoirs"] = reservoirs;
 }
 
 // ---- hydro (Belhadj 2007 §4.2.2; Barnes et al. 2014; docs/hydro.md) ----------------------
@@ -117,7 +123,7 @@ void hydro_run(RunState& s, Progress& progress, const Log& log) {
                         {"belhadj_iterations", r.hydrometry_iterations}};
   if (r.hydrometry_iterations > 0) log.detail("belhadj: " + std::to_string(r.hydrometry_iterations) + " iterations");
   s.hydrometry = std::move(r.hydrometry);
-  write_reservoirs(s, progress, log);
+  write_inland_water(s, progress, log);
   s.rivers = river_cells(r.accumulation, s.scenario);
 }
 
@@ -133,7 +139,7 @@ void hydro_load(RunState& s) {
 
 void density_run(RunState& s, Progress& progress, const Log& log) {
   density::DensityOptions options = density_options(s.scenario);
-  if (!reservoir_specs(s.scenario).empty()) options.water_mask = saved(s, kReservoirs);  // holds the water_mask too
+  options.water_mask = saved(s, kInlandWater);  // holds water.water_mask too
   plugin::add_to_density(plugin::density_factors(s.plugins, s.dem, progress, log), options);
   if (s.rivers) options.rivers = *s.rivers;
   density::DensityResult r = density::compute_density(s.dem, *s.hydrometry, options, progress);
@@ -251,26 +257,16 @@ void network_load(RunState& s) { s.network = read_vector(saved(s, "network.geojs
 
 void roads_run(RunState& s, Progress& progress, const Log& log) {
   const RoadsSettings settings = roads_settings(s.scenario);
-  // Inland water: lakes the DEM flattens (hydro::detect_flat_water), the user's water layer and the
-  // scenario's reservoirs (reservoirs.tif already holds water_mask when reservoirs are declared).
-  hydro::FlatWater lakes = hydro::detect_flat_water(s.dem, settings.flat_water);
-  const bool reservoirs = !reservoir_specs(s.scenario).empty();
-  if (reservoirs || !settings.water_mask.empty()) {
-    const Raster<float> water = read_resampled(reservoirs ? saved(s, kReservoirs) : settings.water_mask, s.dem.georef(), s.dem.cols(), s.dem.rows(),
-                                               Resampling::nearest);
-    for (std::size_t i = 0; i < water.size(); ++i)
-      if (std::isfinite(water[i]) && water[i] != 0) lakes.mask[i] = 1;
-  }
-  roads::TerrainField terrain(s.dem, settings.flat_water.sea_level_m, settings.model.unknown_water_depth_m, settings.model.road_radius_m,
-                              &lakes.mask);
+  const Raster<float> water = read_resampled(saved(s, kInlandWater), s.dem.georef(), s.dem.cols(), s.dem.rows(), Resampling::nearest);
+  Raster<std::uint8_t> lakes = s.dem.like<std::uint8_t>(0);
+  for (std::size_t i = 0; i < water.size(); ++i) lakes[i] = water[i] == 1;
+  roads::TerrainField terrain(s.dem, s.scenario.resolved["water"]["sea_level_m"].get<double>(), settings.model.unknown_water_depth_m,
+                              settings.model.road_radius_m, &lakes);
   if (!settings.vegetation.empty())
     terrain.set_vegetation(read_resampled(settings.vegetation, s.dem.georef(), s.dem.cols(), s.dem.rows(), Resampling::bilinear));
   plugin::add_to_terrain(plugin::road_terms(s.plugins, s.dem, progress, log), terrain);
   const roads::RoadGraph graph(terrain, settings.model, settings.routing.graph);
   const roads::NetworkResult r = roads::route_network(terrain, graph, *s.network, &*s.cities, settings.routing, progress);
-  if (settings.flat_water.min_area_km2 > 0 || !settings.water_mask.empty())
-    s.write("roads", "inland_water.tif", lakes.mask, "inland water the roads bridge or avoid: flat lakes of the DEM and water.water_mask (1)",
-            Style::mask);
   for (const auto& f : r.failed) log.warn("no road: " + f);
   for (const auto& f : r.over_budget) log.warn("not routed: budget (roads.max_seconds): " + f);
   s.write("roads", "roads.geojson", roads::roads_layer(terrain, r.roads), "roads with class, router, length, cost, grades, structures",
@@ -287,7 +283,7 @@ void roads_run(RunState& s, Progress& progress, const Log& log) {
   json per_class = json::object();
   for (const char* c : {"motorway", "national", "departmental", "maritime"}) per_class[c] = round_to(km[c], 0.01);
   s.summary["roads"] = {{"roads", r.roads.size()}, {"failed", r.failed.size()}, {"not_routed_budget", r.over_budget.size()},
-                        {"flat_lakes", lakes.lakes}, {"flat_lake_km2", round_to(lakes.area_km2, 0.01)}, {"length_km", per_class},
+                        {"length_km", per_class},
                         {"bridge_m", round_to(bridge_m, 0.1)}, {"tunnel_m", round_to(tunnel_m, 0.1)}};
 }
 

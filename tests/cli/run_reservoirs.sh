@@ -8,14 +8,14 @@ dem=$SAMPLES/gebco2022_15s_north_corsica_capcorse.asc
 reservoir='{"at": [9.4187, 42.5187], "level_m": 90, "dam": [[9.4271, 42.4987], [9.4271, 42.5388]], "crest_m": 95}'
 "$TP" --quiet run -o run --set outputs.preview_width=200 --set "water.reservoirs=[$reservoir]" --set hydro.classify=true \
   2>/dev/null
-[[ -s run/reservoirs.tif && -s run/reservoirs.qml ]] || fail "no reservoirs.tif"
+[[ -s run/inland_water.tif && -s run/inland_water.qml ]] || fail "no inland_water.tif"
 /usr/bin/python3 - run <<'PY' || fail "reservoir figures"
 import json, sys
 from osgeo import gdal
 run = sys.argv[1]
 s = json.load(open(run + "/run.json"))["summary"]["hydro"]["reservoirs"]
 assert len(s) == 1 and abs(s[0]["area_km2"] - 2.06) < 0.01 and s[0]["level_m"] == 90, s
-water = gdal.Open(run + "/reservoirs.tif").ReadAsArray()
+water = gdal.Open(run + "/inland_water.tif").ReadAsArray()
 buildable = gdal.Open(run + "/buildable.tif").ReadAsArray()
 assert (water == 1).sum() > 0
 assert ((water == 1) & (buildable == 1)).sum() == 0, "a reservoir cell is buildable"
