@@ -204,28 +204,8 @@ void fill_strips(Dem& z, const std::optional<double>& sea_level, int strips, Pro
           }
           local = 0;
         }
-        const int c = int(i % std::uint32_t(cols)), r = int(i / std::uint32_t(cols));
-        const float zc = z[i];
-        const Label lc = label[i];
-        for (int k = 0; k < 8; ++k) {
-          const int nc = c + dcol[k], nr = r + drow[k];
-          if (nc < 0 || nr < r0 || nc >= cols || nr >= r1) continue;
-          const std::size_t n = z.index(nc, nr);
-          const Label ln = label[n];
-          if (ln == kOpen) {
-            label[n] = lc;
-            if (z[n] <= zc) {
-              z[n] = zc;
-              pit.push_back(std::uint32_t(n));
-            } else {
-              open.push(flood_key(z[n], std::uint32_t(n)));
-            }
-          } else if (ln != lc && ln != kVoid) {
-            // Two watersheds meet. Both values are final (a cell is raised when it is reached),
-            // and every adjacent pair of the strip passes here once its later cell is popped.
-            spill.lower(lc, ln, std::max(zc, z[n]));
-          }
-        }
+        flood_neighbours(i, cols, r0, r1, z, label, kOpen, kVoid, open, pit,
+                         [&](Label a, Label b, float level) { spill.lower(a, b, level); });
       }
     }
   }, tbb::simple_partitioner());

@@ -9,6 +9,8 @@
 #include <deque>
 #include <vector>
 
+#include "core/neighbours.hpp"
+
 namespace terrapolis::hydro {
 
 /// Queue key: the elevation's bits made order-preserving as an unsigned integer, then the cell
@@ -63,6 +65,37 @@ inline std::uint32_t next_cell(Queue& open, std::deque<std::uint32_t>& pit) {
   const std::uint32_t i = pit.front();
   pit.pop_front();
   return i;
+}
+
+/// One step of the labelled Priority-Flood (Barnes 2016, Alg. 2) from cell `i` of a grid of `cols`
+/// columns, within rows [row0, row1): each neighbour not reached yet (`open_label`) takes i's label
+/// and is raised to its level onto the pit queue, or queued at its own; a neighbour of another
+/// watershed (not `void_label`) calls `meet(label_i, label_n, spill elevation)`.
+template <class Z, class Label, class Queue, class Meet>
+inline void flood_neighbours(std::uint32_t i, int cols, int row0, int row1, Z& z, Label* label, Label open_label, Label void_label,
+                             Queue& open, std::deque<std::uint32_t>& pit, Meet&& meet) {
+  const int c = int(i % std::uint32_t(cols)), r = int(i / std::uint32_t(cols));
+  const float zc = z[i];
+  const Label lc = label[i];
+  for (int k = 0; k < 8; ++k) {
+    const int nc = c + dcol[k], nr = r + drow[k];
+    if (nc < 0 || nr < row0 || nc >= cols || nr >= row1) continue;
+    const std::size_t n = std::size_t(nr) * std::size_t(cols) + std::size_t(nc);
+    const Label ln = label[n];
+    if (ln == open_label) {
+      label[n] = lc;
+      if (z[n] <= zc) {
+        z[n] = zc;
+        pit.push_back(std::uint32_t(n));
+      } else {
+        open.push(flood_key(z[n], std::uint32_t(n)));
+      }
+    } else if (ln != lc && ln != void_label) {
+      // Two watersheds meet. Both values are final (a cell is raised when it is reached), and
+      // every adjacent pair passes here once its later cell is popped.
+      meet(lc, ln, std::max(zc, z[n]));
+    }
+  }
 }
 
 }  // namespace terrapolis::hydro

@@ -116,26 +116,8 @@ TileFill fill_tile(const Dem& window, const std::optional<double>& sea_level) {
     }
   while (!open.empty() || !pit.empty()) {
     const std::uint32_t i = next_cell(open, pit);
-    const int c = int(i % std::uint32_t(cols)), r = int(i / std::uint32_t(cols));
-    const float zc = z[i];
-    const std::uint32_t lc = f.label[i];
-    for (int k = 0; k < 8; ++k) {
-      const int nc = c + dcol[k], nr = r + drow[k];
-      if (nc < 0 || nr < 0 || nc >= cols || nr >= rows) continue;
-      const std::size_t n = z.index(nc, nr);
-      const std::uint32_t ln = f.label[n];
-      if (ln == kOpen) {
-        f.label[n] = lc;
-        if (z[n] <= zc) {
-          z[n] = zc;
-          pit.push_back(std::uint32_t(n));
-        } else {
-          open.push(flood_key(z[n], std::uint32_t(n)));
-        }
-      } else if (ln != lc && ln != kVoid) {
-        f.edges.push_back({lc, ln, std::max(zc, z[n])});
-      }
-    }
+    flood_neighbours(i, cols, 0, rows, z, f.label.data(), kOpen, kVoid, open, pit,
+                     [&](std::uint32_t a, std::uint32_t b, float spill) { f.edges.push_back({a, b, spill}); });
     if (f.edges.size() > (std::size_t(1) << 20)) keep_lowest_edges(f.edges);
   }
   keep_lowest_edges(f.edges);
