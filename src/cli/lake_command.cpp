@@ -61,7 +61,7 @@ class LakeCommand final : public Command {
 
   void setup(CLI::App& app) override {
     dem_.add_to(app);
-    app.add_option("OUTDIR", out_dir_, "Output folder (created if missing)")->required();
+    app.add_option("OUTDIR", out_dir_, "Output folder: depth.tif, shoreline.geojson, lake.json (its parent must exist)")->required();
     app.add_option("--at", at_, "Seed LON,LAT (WGS 84) on the lake's floor")->required();
     app.add_option("--level", level_, "Water surface elevation (m)");
     app.add_option("--depth", depth_, "Water depth above the seed's ground (m)");
