@@ -12,6 +12,7 @@
 
 #include "cli/command.hpp"
 #include "cli/commands_list.hpp"
+#include "cli/schema_options.hpp"
 #include "core/error.hpp"
 #include "density/calibration.hpp"
 #include "hydro/hydro.hpp"
@@ -95,12 +96,12 @@ class CalibrateCommand final : public Command {
   }
 
   void setup(CLI::App& app) override {
-    app.add_option("DEM", dems_, "DEM(s) of the region(s), any GDAL raster")->required();
-    app.add_option("--settlements", places_, "Real places of each DEM, in the same order: GeoJSON/GPKG points or CSV (lon,lat) with a population field")
-        ->required();
-    app.add_option("--scenario", scenarios_, "Scenario whose water, hydro and density options are used: one for every DEM, or one per DEM in order (default: the defaults)");
-    app.add_option("--fragment", fragment_, "Write the fitted weights as a scenario fragment (JSON) to this file");
-    app.add_option("--report", report_, "Write the report as JSON to this file");
+    file_kind(app.add_option("DEM", dems_, "DEM(s) of the region(s), any GDAL raster")->required(), FileKind::raster_in);
+    file_kind(app.add_option("--settlements", places_, "Real places of each DEM, in the same order: GeoJSON/GPKG points or CSV (lon,lat) with a population field")
+        ->required(), FileKind::file_in);
+    file_kind(app.add_option("--scenario", scenarios_, "Scenario whose water, hydro and density options are used: one for every DEM, or one per DEM in order (default: the defaults)"), FileKind::file_in);
+    file_kind(app.add_option("--fragment", fragment_, "Write the fitted weights as a scenario fragment (JSON) to this file"), FileKind::file_out);
+    file_kind(app.add_option("--report", report_, "Write the report as JSON to this file"), FileKind::file_out);
     app.add_option("--folds", folds_, "Folds of the cross-validation within a region (one region given)")->check(CLI::Range(2, 100))->capture_default_str();
     app.add_option("--background", background_, "Background cells sampled per region for the fit")->check(CLI::Range(100, 10000000))->capture_default_str();
     app.add_option("--ridge", ridge_, "Ridge penalty on the weights (times the total weight)")->check(CLI::NonNegativeNumber)->capture_default_str();

@@ -8,6 +8,8 @@
 
 #include "cli/command.hpp"
 #include "cli/commands_list.hpp"
+#include "cli/dem_input.hpp"
+#include "cli/schema_options.hpp"
 #include "core/error.hpp"
 #include "core/geodesy.hpp"
 #include "hydro/accumulation.hpp"
@@ -31,17 +33,16 @@ class CatchmentCommand final : public Command {
   std::string summary() const override { return "Catchment of an outlet: polygon (GeoJSON/GeoPackage) and optional mask raster"; }
 
   void setup(CLI::App& app) override {
-    app.add_option("DEM", dem_path_, "Elevation model (any GDAL raster)")->required();
-    app.add_option("OUT", out_path_, "Output polygon: .geojson or .gpkg")->required();
+    dem_.add_to(app);
+    file_kind(app.add_option("OUT", out_path_, "Output polygon: .geojson or .gpkg")->required(), FileKind::vector_out);
     app.add_option("--outlet", outlet_, "Outlet X,Y: lon,lat (default) or DEM CRS coordinates (--outlet-crs dem)")->required();
     app.add_option("--outlet-crs", outlet_crs_, "CRS of --outlet: lonlat or dem")
         ->check(CLI::IsMember({"lonlat", "dem"}))->capture_default_str();
     app.add_option("--snap-radius", snap_m_, "Snap the outlet to the highest accumulation within this radius (m)")->capture_default_str();
-    app.add_option("--mask", mask_path_, "Also write the catchment mask (GeoTIFF: 1 inside, 0 outside, 255 nodata)");
+    file_kind(app.add_option("--mask", mask_path_, "Also write the catchment mask (GeoTIFF: 1 inside, 0 outside, 255 nodata)"), FileKind::raster_out);
     app.add_option("--fill", fill_, "Depression handling: priority-flood, epsilon, breach, none")
         ->check(CLI::IsMember({"priority-flood", "epsilon", "breach", "none"}))->capture_default_str();
     app.add_option("--sea-level", sea_level_, "Cells at or below this elevation (m) are outlets (default: off)");
-    app.add_option("--assume-crs", assume_crs_, "CRS for a DEM file that carries none");
     app.add_flag("--overwrite", overwrite_, "Replace the outputs a previous terrapolis command wrote");
   }
 
@@ -50,12 +51,10 @@ class CatchmentCommand final : public Command {
     if (!(snap_m_ >= 0) || !std::isfinite(snap_m_)) throw bad_input("--snap-radius: must be >= 0 metres");
     const std::string ext = std::filesystem::path(out_path_).extension().string();
     if (ext != ".geojson" && ext != ".json" && ext != ".gpkg") throw bad_input(out_path_ + ": output must end in .geojson or .gpkg");
-    OutputSet outputs("catchment", {dem_path_}, overwrite_);
+    OutputSet outputs("catchment", {dem_.path}, overwrite_);
     const std::string out = outputs.file(out_path_);
     const std::string mask = mask_path_.empty() ? "" : outputs.file(mask_path_);
-    ReadOptions read;
-    if (!assume_crs_.empty()) read.assume_crs = assume_crs_;
-    const Dem dem = read_dem(dem_path_, read);
+    const Dem dem = dem_.read();
     double x = xy[0], y = xy[1];
     if (outlet_crs_ == "lonlat") {
       if (std::abs(y) > 90 || std::abs(x) > 360) throw bad_input("--outlet: '" + outlet_ + "' is not a lon,lat pair");
@@ -95,7 +94,8 @@ class CatchmentCommand final : public Command {
   }
 
  private:
-  std::string dem_path_, out_path_, outlet_, outlet_crs_ = "lonlat", mask_path_, fill_ = "priority-flood", assume_crs_;
+  DemInput dem_;
+  std::string out_path_, outlet_, outlet_crs_ = "lonlat", mask_path_, fill_ = "priority-flood";
   double snap_m_ = 0, sea_level_ = NAN;
   bool overwrite_ = false;
 };

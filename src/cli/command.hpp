@@ -39,6 +39,9 @@ std::vector<std::unique_ptr<Command>> all_commands();
 /// write is atomic by itself (temporary file, then rename); the first failure is rethrown.
 void write_concurrently(const std::vector<std::function<void()>>& writes);
 
+/// Parses a number typed for `option` (core/text.hpp's parse_number). Throws bad_input naming `option`.
+double parse_number_option(const std::string& option, const std::string& text);
+
 /// Parses "X,Y" (either may be negative) into two numbers. Throws bad_input naming `option`.
 std::array<double, 2> parse_pair(const std::string& option, const std::string& text);
 

@@ -6,6 +6,7 @@
 
 #include "cli/command.hpp"
 #include "cli/commands_list.hpp"
+#include "cli/schema_options.hpp"
 #include "io/output_set.hpp"
 #include "io/text_io.hpp"
 #include "pipeline/compare.hpp"
@@ -18,10 +19,10 @@ class CompareCommand final : public Command {
   std::string name() const override { return "compare"; }
   std::string summary() const override { return "Compare two run folders: parameters, cities, roads, structures, density"; }
   void setup(CLI::App& app) override {
-    app.add_option("RUN_A", a_, "First run folder (holds run.json)")->required();
-    app.add_option("RUN_B", b_, "Second run folder")->required();
+    file_kind(app.add_option("RUN_A", a_, "First run folder (holds run.json)")->required(), FileKind::folder_in);
+    file_kind(app.add_option("RUN_B", b_, "Second run folder")->required(), FileKind::folder_in);
     app.add_flag("--json", json_, "Machine-readable output");
-    app.add_option("--save", save_, "Also write the comparison to this file (text, or JSON with --json)");
+    file_kind(app.add_option("--save", save_, "Also write the comparison to this file (text, or JSON with --json)"), FileKind::file_out);
     app.add_flag("--overwrite", overwrite_, "Replace the --save file if it exists");
   }
   void run(Context&) override {

@@ -5,6 +5,7 @@
 #include "cli/command.hpp"
 #include "cli/commands_list.hpp"
 #include "cli/dem_input.hpp"
+#include "cli/schema_options.hpp"
 #include "io/output_set.hpp"
 #include "io/raster_io.hpp"
 #include "terrapolis/version.hpp"
@@ -20,7 +21,7 @@ class ConvertCommand final : public Command {
   }
   void setup(CLI::App& app) override {
     input_.add_to(app);
-    app.add_option("OUT", out_, "Output GeoTIFF")->required();
+    file_kind(app.add_option("OUT", out_, "Output GeoTIFF")->required(), FileKind::raster_out);
     app.add_flag("--cog", cog_, "Cloud Optimized GeoTIFF layout");
     app.add_flag("--overwrite", overwrite_, "Replace OUT if it exists");
   }

@@ -4,10 +4,13 @@
 
 #include <CLI/CLI.hpp>
 
+#include "cli/schema_options.hpp"
+
 namespace terrapolis::cli {
 
 void DemInput::add_to(CLI::App& app, const std::string& name) {
-  app.add_option(name, path, "Elevation model (any GDAL raster: GeoTIFF, SRTM .hgt, ESRI ASCII grid, VRT...)")->required();
+  file_kind(app.add_option(name, path, "Elevation model (any GDAL raster: GeoTIFF, SRTM .hgt, ESRI ASCII grid, VRT...)")->required(),
+            FileKind::raster_in);
   app.add_option("--band", band, "Band to read (required for multi-band files)")->check(CLI::PositiveNumber);
   app.add_option("--assume-crs", assume_crs, "CRS for a file that carries none, e.g. EPSG:32611");
 }

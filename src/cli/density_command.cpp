@@ -14,23 +14,20 @@
 #include "cli/commands_list.hpp"
 #include "cli/dem_input.hpp"
 #include "cli/plugin_options.hpp"
+#include "cli/schema_options.hpp"
 #include "core/error.hpp"
 #include "core/text.hpp"
 #include "density/density.hpp"
 #include "hydro/hydrometry.hpp"
 #include "io/output_set.hpp"
 #include "io/raster_io.hpp"
+#include "pipeline/stage_options.hpp"
 #include "terrapolis/version.hpp"
 
 namespace terrapolis::cli {
 namespace {
 
 namespace fs = std::filesystem;
-
-double number_option(const std::string& option, const std::string& text) {
-  if (const auto v = parse_number(text)) return *v;
-  throw bad_input(option + ": '" + text + "' is not a number");
-}
 
 
 /// The hydrometry the density model uses, on the DEM's grid, and whether it is worth writing.
@@ -74,19 +71,18 @@ class DensityCommand final : public Command {
 
   void setup(CLI::App& app) override {
     dem_.add_to(app);
-    app.add_option("OUTDIR", out_dir_, "Folder for coast.tif, plateau.tif, plain.tif, hydrometry.tif, buildable.tif, density.tif")->required();
+    file_kind(app.add_option("OUTDIR", out_dir_, "Folder for coast.tif, plateau.tif, plain.tif, hydrometry.tif, buildable.tif, density.tif")
+                  ->required(),
+              FileKind::folder_out);
     app.add_option("--weights", weights_, "Weights of coast,hydrometry,plateau,plain; negative repulsive, 0 neutral (default 1,1,1.5,0)");
-    app.add_option("--layer", layers_, "User raster and its weight, FILE:WEIGHT (repeatable); values in [0,1] or rescaled from their range");
-    app.add_option("--exclude", exclusions_, "Exclusion raster: non-zero cells are uninhabitable (repeatable)");
-    app.add_option("--hydrometry", hydrometry_path_, "Hydrometry raster in [0,1], resampled to the DEM grid");
-    app.add_option("--water-mask", options_.water_mask, "Raster whose non-zero cells are water");
-    app.add_flag("--nodata-is-sea", options_.nodata_is_sea, "Nodata cells are sea (SRTM and similar coasts)");
-    app.add_option("--sea-level", options_.sea_level_m, "Cells at or below this altitude are water, metres")->capture_default_str();
-    app.add_option("--r-min", options_.r_min_m, "Inner ring radius and plain disc radius (a hamlet), metres")->capture_default_str();
-    app.add_option("--r-max", options_.r_max_m, "Outer ring radius (a large city), metres")->capture_default_str();
-    app.add_option("--max-altitude", options_.max_altitude_m, "Cells above this altitude are uninhabitable, metres")->capture_default_str();
-    app.add_option("--max-slope", max_slope_, "Cells steeper than this are uninhabitable, degrees (default: no limit)");
-    app.add_option("--river-bed-cap", river_bed_cap_, "Cells whose hydrometry exceeds this (0..1) are river beds, uninhabitable");
+    file_kind(app.add_option("--layer", layers_, "User raster and its weight, FILE:WEIGHT (repeatable); values in [0,1] or rescaled from their range"),
+              FileKind::raster_in);
+    file_kind(app.add_option("--exclude", exclusions_, "Exclusion raster: non-zero cells are uninhabitable (repeatable)"), FileKind::raster_in);
+    file_kind(app.add_option("--hydrometry", hydrometry_path_, "Hydrometry raster in [0,1], resampled to the DEM grid"), FileKind::raster_in);
+    schema_.setup(app, name());
+    schema_.name_as("/density/weights", "--weights");
+    schema_.name_as("/density/layers", "--layer");
+    schema_.name_as("/density/exclusions", "--exclude");
     plugins_.setup(app, "adds its density factor, combined like a --layer of that weight, and its exclusions");
     app.add_flag("--report", report_, "Print the buildable share and the density histogram");
     app.add_flag("--cog", cog_, "Write Cloud Optimized GeoTIFFs");
@@ -94,8 +90,8 @@ class DensityCommand final : public Command {
   }
 
   void run(Context& context) override {
-    density::DensityOptions options = options_;
-    parse_options(options);
+    const pipeline::Scenario scenario = schema_.scenario(table_options());
+    density::DensityOptions options = schema_.settings([&] { return pipeline::density_options(scenario); });
     // Outputs refused before any work; hydrometry.tif is written only when used.
     std::vector<std::string> inputs = {dem_.path, hydrometry_path_, options.water_mask};
     for (const auto& layer : options.layers) inputs.push_back(layer.first);
@@ -155,23 +151,27 @@ class DensityCommand final : public Command {
     return buf;
   }
 
-  void parse_options(density::DensityOptions& options) const {
+  /// The command's own options as scenario fields: the thesis's weights unless --weights, --layer, --exclude.
+  std::vector<std::string> table_options() const {
+    std::vector<std::string> sets = {"density.preset=\"belhadj2007\""};
     if (!weights_.empty()) {
       std::stringstream ss(weights_);
       std::string part;
       std::vector<double> w;
-      while (std::getline(ss, part, ',')) w.push_back(number_option("--weights", part));
+      while (std::getline(ss, part, ',')) w.push_back(parse_number_option("--weights", part));
       if (w.size() != 4) throw bad_input("--weights: expected 4 numbers C,H,P,L but got '" + weights_ + "'");
-      for (int i = 0; i < 4; ++i) options.weights[std::size_t(i)] = w[std::size_t(i)];
+      const char* terms[4] = {"coast", "hydrometry", "plateau", "plain"};
+      for (int i = 0; i < 4; ++i) sets.push_back(std::string("density.weights.") + terms[i] + "=" + nlohmann::json(w[std::size_t(i)]).dump());
     }
+    nlohmann::json layers = nlohmann::json::array();
     for (const std::string& l : layers_) {
       const auto colon = l.rfind(':');
       if (colon == std::string::npos || colon == 0) throw bad_input("--layer: expected FILE:WEIGHT but got '" + l + "'");
-      options.layers.emplace_back(l.substr(0, colon), number_option("--layer " + l.substr(0, colon), l.substr(colon + 1)));
+      layers.push_back({{"file", l.substr(0, colon)}, {"weight", parse_number_option("--layer " + l.substr(0, colon), l.substr(colon + 1))}});
     }
-    options.exclusions = exclusions_;
-    if (!max_slope_.empty()) options.max_slope_deg = number_option("--max-slope", max_slope_);
-    if (!river_bed_cap_.empty()) options.river_bed_cap = number_option("--river-bed-cap", river_bed_cap_);
+    sets.push_back("density.layers=" + layers.dump());
+    sets.push_back("density.exclusions=" + nlohmann::json(exclusions_).dump());
+    return sets;
   }
 
   std::vector<std::pair<std::string, std::string>> provenance(const density::DensityOptions& o) const {
@@ -217,9 +217,9 @@ class DensityCommand final : public Command {
 
   DemInput dem_;
   PluginOptions plugins_;
-  std::string out_dir_, weights_, hydrometry_path_, max_slope_, river_bed_cap_;
+  std::string out_dir_, weights_, hydrometry_path_;
   std::vector<std::string> layers_, exclusions_;
-  density::DensityOptions options_;
+  SchemaOptions schema_;
   bool report_ = false, cog_ = false, overwrite_ = false;
 };
 

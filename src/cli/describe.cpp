@@ -1,11 +1,12 @@
-// `terrapolis --describe-json`: every command and option as JSON, read from CLI11's own objects.
+// `terrapolis --describe-json`: every command and option as JSON, from the schema and CLI11's own objects.
 // SPDX-License-Identifier: MIT
 #include "cli/describe.hpp"
+
+#include "cli/schema_options.hpp"
 
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
-#include <cctype>
 #include <regex>
 #include <sstream>
 
@@ -14,38 +15,34 @@ namespace {
 
 using nlohmann::ordered_json;
 
-std::string lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-  return s;
-}
-
-bool contains(const std::string& text, const std::string& word) { return lower(text).find(lower(word)) != std::string::npos; }
-
-/// What a path-valued option holds, for GUIs (QGIS parameter types): raster_in, vector_in,
-/// file_in, folder_in, raster_out, vector_out, file_out, folder_out; "" for other text (CRS
-/// codes, coordinates, lists). Read from the option's name and help text, the only place the
-/// command line states it; docs/plugins.md lists the wording rules.
-std::string kind_of(const CLI::Option& o) {
-  const std::string name = o.nonpositional() ? o.get_name() : o.get_name(true), help = o.get_description();
-  // FILE:WEIGHT pairs, plugin specs and CRS codes are text.
-  if (contains(help, "FILE:") || name == "--plugin" || help.rfind("CRS", 0) == 0) return "";
-  if (name == "DEM" || help.rfind("DEM ", 0) == 0) return "raster_in";
-  if (name == "OUTDIR" || name == "--output") return "folder_out";
-  if (name == "OUT" || help.rfind("Also write", 0) == 0) {
-    if (contains(help, ".geojson") || contains(help, "polygon") || contains(help, "road") || contains(help, "sections")) return "vector_out";
-    if (contains(help, "GeoTIFF")) return "raster_out";
-    return "file_out";
-  }
-  if (contains(help, "folder")) return "folder_in";
-  if (contains(help, ".csv")) return "file_in";  // several formats: let the user pick any file
-  if (contains(help, "raster")) return "raster_in";
-  if (contains(help, ".geojson") || contains(help, "(Points") || contains(help, "line of this file") || contains(help, "City points"))
-    return "vector_in";
-  if (contains(help, "file")) return "file_in";
-  return "";
+/// A schema-declared option, described by its schema field (cli/schema_options.hpp).
+ordered_json describe_schema_option(CLI::Option& o, const OptionSource& source) {
+  const ordered_json& f = source.field;
+  ordered_json j;
+  j["name"] = o.get_name();
+  std::vector<std::string> names;
+  for (const auto& n : o.get_lnames()) names.push_back("--" + n);
+  j["names"] = names;
+  j["positional"] = false;
+  j["help"] = f.value("description", "");
+  j["unit"] = f.value("x-unit", "");
+  j["schema"] = source.pointer;
+  j["type"] = f.value("type", "string");
+  j["cli_type"] = o.get_type_name();
+  j["default"] = f.value("default", ordered_json());
+  j["required"] = false;
+  j["repeatable"] = false;
+  if (f.contains("enum")) j["choices"] = f["enum"];
+  if (f.contains("minimum")) j["minimum"] = f["minimum"].get<double>();
+  if (f.contains("exclusiveMinimum")) j["exclusive_minimum"] = f["exclusiveMinimum"].get<double>();
+  if (f.contains("maximum")) j["maximum"] = f["maximum"].get<double>();
+  j["kind"] = source.kind.empty() ? ordered_json(nullptr) : ordered_json(source.kind);
+  return j;
 }
 
 ordered_json describe_option(CLI::Option& o) {
+  const OptionSource* source = option_source(o);
+  if (source && !source->pointer.empty()) return describe_schema_option(o, *source);
   ordered_json j;
   const bool positional = !o.nonpositional();
   j["name"] = positional ? o.get_name(true) : o.get_name();
@@ -107,13 +104,12 @@ ordered_json describe_option(CLI::Option& o) {
   if (std::regex_search(validators, m, range_re)) {
     j["minimum"] = std::stod(m[1].str());
     j["maximum"] = std::stod(m[2].str());
-  } else if (contains(validators, "NONNEGATIVE")) {
+  } else if (validators.find("NONNEGATIVE") != std::string::npos) {
     j["minimum"] = 0.0;
-  } else if (contains(validators, "POSITIVE")) {
+  } else if (validators.find("POSITIVE") != std::string::npos) {
     j["exclusive_minimum"] = 0.0;
   }
-  const std::string kind = type == "string" && !j.contains("choices") ? kind_of(o) : "";
-  j["kind"] = kind.empty() ? ordered_json(nullptr) : ordered_json(kind);
+  j["kind"] = source ? ordered_json(source->kind) : ordered_json(nullptr);
   return j;
 }
 

@@ -9,9 +9,9 @@ namespace CLI { class App; }
 
 namespace terrapolis::cli {
 
-/// Every command with its options as CLI11 declared them: name, help, type, default (the bound
-/// variable's current value), required, positional, repeatable, choices and ranges from the
-/// validators, and the kind of file a path option reads or writes (raster_in, vector_out, ...).
+/// Every command with its options: those the scenario schema declares from their schema field
+/// (description, unit, default, range, choices, kind), the commands' own from their CLI11
+/// declaration (type, default, validators) and their file kind (cli/schema_options.hpp).
 nlohmann::ordered_json describe_cli(CLI::App& app, const std::string& version);
 
 }  // namespace terrapolis::cli

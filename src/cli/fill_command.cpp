@@ -6,7 +6,9 @@
 
 #include "cli/command.hpp"
 #include "cli/commands_list.hpp"
+#include "cli/dem_input.hpp"
 #include "cli/terrain_options.hpp"
+#include "cli/schema_options.hpp"
 #include "core/error.hpp"
 #include "io/output_set.hpp"
 #include "io/raster_io.hpp"
@@ -21,23 +23,20 @@ class FillCommand final : public Command {
   std::string summary() const override { return "Fill the nodata voids of a DEM (thin-plate spline, harmonic or DMMC)"; }
 
   void setup(CLI::App& app) override {
-    app.add_option("DEM", input_, "Elevation model with voids (any GDAL raster)")->required();
-    app.add_option("OUT", output_, "Output GeoTIFF (float32, same grid and CRS)")->required();
+    input_.add_to(app);
+    file_kind(app.add_option("OUT", output_, "Output GeoTIFF (float32, same grid and CRS)")->required(), FileKind::raster_out);
     options_.add(app, true, 0.0);
     app.add_option("--max-void-km2", max_void_km2_, "Voids larger than this (km2, geodesic) stay nodata")->check(CLI::PositiveNumber);
     app.add_option("--sea-level", sea_level_m_, "Cells at or below this height (m) connected to the border are sea; voids touching the sea are not filled");
     app.add_flag("--fill-border-voids", fill_border_, "Also fill nodata connected to the grid border (by default it is outside the DEM)");
-    app.add_option("--assume-crs", assume_crs_, "CRS for a DEM that carries none, e.g. EPSG:32611");
     app.add_flag("--overwrite", overwrite_, "Replace OUT if it exists");
   }
 
   void run(Context& context) override {
     const terrain::FillParams params = options_.params();
-    OutputSet outputs("fill", {input_}, overwrite_);
+    OutputSet outputs("fill", {input_.path}, overwrite_);
     const std::string out = outputs.file(output_);
-    ReadOptions read;
-    if (!assume_crs_.empty()) read.assume_crs = assume_crs_;
-    Dem dem = read_dem(input_, read);
+    Dem dem = input_.read();
     terrain::VoidOptions voids_options;
     if (max_void_km2_ > 0) voids_options.max_area_km2 = max_void_km2_;
     voids_options.sea_level_m = sea_level_m_;
@@ -56,7 +55,8 @@ class FillCommand final : public Command {
   }
 
  private:
-  std::string input_, output_, assume_crs_;
+  DemInput input_;
+  std::string output_;
   TerrainOptions options_;
   double max_void_km2_ = 0;
   std::optional<double> sea_level_m_;

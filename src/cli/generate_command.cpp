@@ -7,6 +7,7 @@
 #include "cli/command.hpp"
 #include "cli/commands_list.hpp"
 #include "cli/terrain_options.hpp"
+#include "cli/schema_options.hpp"
 #include "core/error.hpp"
 #include "io/output_set.hpp"
 #include "io/raster_io.hpp"
@@ -21,10 +22,10 @@ class GenerateCommand final : public Command {
   std::string summary() const override { return "Generate fractal terrain (Belhadj's DMMC), optionally constrained by a sketch raster"; }
 
   void setup(CLI::App& app) override {
-    app.add_option("OUT", output_, "Output GeoTIFF (float32 heights in metres)")->required();
+    file_kind(app.add_option("OUT", output_, "Output GeoTIFF (float32 heights in metres)")->required(), FileKind::raster_out);
     grid_.add(app, true);
-    app.add_option("--constraints", sketch_, "Sketch raster: cells with a value are fixed heights (m), nodata cells are generated. "
-                                             "Warped onto the grid if it has a CRS, else it must have the grid's size");
+    file_kind(app.add_option("--constraints", sketch_, "Sketch raster: cells with a value are fixed heights (m), nodata cells are generated. "
+                                             "Warped onto the grid if it has a CRS, else it must have the grid's size"), FileKind::raster_in);
     options_.add(app, false, 1000.0);
     app.add_flag("--overwrite", overwrite_, "Replace OUT if it exists");
   }

@@ -11,15 +11,17 @@
 
 #include "cli/command.hpp"
 #include "cli/commands_list.hpp"
+#include "cli/dem_input.hpp"
 #include "cli/hydro_tiles.hpp"
+#include "cli/schema_options.hpp"
 #include "core/error.hpp"
 #include "hydro/hydro.hpp"
-#include "hydro/option_names.hpp"
 #include "hydro/river_types.hpp"
 #include "io/output_set.hpp"
 #include "io/raster_io.hpp"
 #include "io/text_io.hpp"
 #include "io/vector_io.hpp"
+#include "pipeline/stage_options.hpp"
 #include "terrapolis/version.hpp"
 
 namespace terrapolis::cli {
@@ -42,38 +44,13 @@ class HydroCommand final : public Command {
   }
 
   void setup(CLI::App& app) override {
-    app.add_option("DEM", dem_path_, "Elevation model (any GDAL raster)")->required();
-    app.add_option("OUTDIR", out_dir_, "Output folder (its parent must exist)")->required();
-    app.add_option("--fill", fill_, "Depression handling: priority-flood, epsilon, breach, none")
-        ->check(CLI::IsMember(kFillMethods))->capture_default_str();
-    app.add_option("--flow", flow_, "Routing for the accumulation: d8, dinf, mfd")
-        ->check(CLI::IsMember(kFlowMethods))->capture_default_str();
-    app.add_option("--mfd-exponent", mfd_exponent_, "MFD slope exponent p (> 0; Freeman 1.1, Holmgren 4-6)")->capture_default_str();
-    app.add_option("--d8-codes", codes_, "Code convention of flowdir.tif: esri, grass, taudem")
-        ->check(CLI::IsMember(kD8Codes))->capture_default_str();
-    app.add_option("--hydrometry", hydrometry_, "Hydrometry method: belhadj, accumulation")
-        ->check(CLI::IsMember(kHydrometryMethods))->capture_default_str();
-    app.add_option("--iterations", iterations_, "Belhadj: iterations (0: until convergence)")->capture_default_str();
-    app.add_option("--threshold", threshold_, "Belhadj: stop when the mean quantity is below this (> 0)")->capture_default_str();
-    app.add_option("--vertical", vertical_, "Belhadj: vertical scale, metres or normalised16 (the thesis's z/65535)")
-        ->check(CLI::IsMember(kVerticalScales))->capture_default_str();
-    app.add_option("--belhadj-share", share_, "Belhadj: share denominator over all 8 neighbours (as printed) or fed ones")
-        ->check(CLI::IsMember(kBelhadjShares))->capture_default_str();
-    app.add_option("--sea-level", sea_level_, "Cells at or below this elevation (m) are outlets (default: off)");
-    app.add_option("--streams-threshold", streams_km2_, "Upstream area (km2) from which a cell is on a stream")->capture_default_str();
+    dem_.add_to(app);
+    file_kind(app.add_option("OUTDIR", out_dir_, "Output folder (its parent must exist)")->required(), FileKind::folder_out);
+    schema_.setup(app, name());
     app.add_option("--area-units", units_, "Unit of accumulation.tif: m2, km2 or cells")
         ->check(CLI::IsMember({"m2", "km2", "cells"}))->capture_default_str();
-    app.add_option("--weights", weights_, "Raster of per-cell weights (resampled bilinearly onto the DEM)");
-    app.add_option("--assume-crs", assume_crs_, "CRS for a DEM file that carries none, e.g. EPSG:32611");
+    file_kind(app.add_option("--weights", weights_, "Raster of per-cell weights (resampled bilinearly onto the DEM)"), FileKind::raster_in);
     app.add_option("--outputs", outputs_, "Outputs to write, comma-separated: filled,flowdir,accumulation,hydrometry,streams")
-        ->capture_default_str();
-    app.add_flag("--classify", classify_,
-                 "Add discharge (m3/s), slope, sinuosity and river type (B, E, D, delta) to every stream reach; writes streams.qml");
-    app.add_option("--braided-discharge", types_.braided_discharge_m3s, "--classify: discharge (m3/s) from which a reach near a mouth is braided (D)")
-        ->capture_default_str();
-    app.add_option("--delta-discharge", types_.delta_discharge_m3s, "--classify: discharge (m3/s) from which a mouth reach is a delta")
-        ->capture_default_str();
-    app.add_option("--coast-distance", types_.coast_distance_km, "--classify: river distance (km) to a mouth within which a reach may be braided")
         ->capture_default_str();
     app.add_option("--tile-size", tile_size_, "Work tile by tile, tiles of at most N x N cells (writes one GeoTIFF a tile + a VRT)");
     app.add_option("--memory-limit", memory_limit_mb_, "Work tile by tile within this much memory (MB), tiles sized to fit");
@@ -82,24 +59,15 @@ class HydroCommand final : public Command {
   }
 
   void run(Context& context) override {
-    HydroOptions o;
-    // The values were checked against the same tables when the options were parsed.
-    o.fill = kFillMethods.at(fill_);
-    o.flow = kFlowMethods.at(flow_);
-    o.mfd_exponent = mfd_exponent_;
-    if (!(mfd_exponent_ > 0) || !std::isfinite(mfd_exponent_)) throw bad_input("--mfd-exponent: must be a positive number");
-    const D8Codes codes = kD8Codes.at(codes_);
-    o.hydrometry.method = kHydrometryMethods.at(hydrometry_);
-    if (iterations_ < 0) throw bad_input("--iterations: must be 0 (until convergence) or positive");
-    if (!(threshold_ > 0)) throw bad_input("--threshold: must be a positive number");
-    if (!(streams_km2_ > 0) || !std::isfinite(streams_km2_)) throw bad_input("--streams-threshold: must be a positive number of km2");
-    o.hydrometry.max_iterations = iterations_;
-    o.hydrometry.threshold = threshold_;
-    o.hydrometry.vertical = kVerticalScales.at(vertical_);
-    o.hydrometry.share = kBelhadjShares.at(share_);
-    if (!std::isnan(sea_level_)) o.sea_level = sea_level_;
+    const pipeline::Scenario scenario = schema_.scenario();
+    const nlohmann::ordered_json& h = scenario.resolved["hydro"];
+    HydroOptions o = pipeline::hydro_options(scenario);
+    if (!schema_.given("/water/sea_level_m")) o.sea_level.reset();  // this command has no sea unless told
+    const D8Codes codes = pipeline::d8_codes(scenario);
+    const std::optional<RiverTypeOptions> types = pipeline::river_type_options(scenario);
+    const bool classify = types.has_value();
+    const std::string fill = h["fill"], flow = h["flow"], hydrometry = h["hydrometry"];
     o.unit = units_ == "cells" ? AccumulationUnit::cells : AccumulationUnit::area_m2;
-    o.streams.threshold_km2 = streams_km2_;
 
     const std::string names[5] = {"filled.tif", "flowdir.tif", "accumulation.tif", "hydrometry.tif", "streams.geojson"};
     bool wanted[5] = {false, false, false, false, false};
@@ -114,16 +82,16 @@ class HydroCommand final : public Command {
     }
     o.with_hydrometry = wanted[3];
     o.with_streams = wanted[4];
-    if (classify_ && !wanted[4]) throw bad_input("--classify: needs the streams output (--outputs ... ,streams)");
-    if (classify_) check(types_);
-    OutputSet outputs("hydro", {dem_path_, weights_}, overwrite_);  // refused before any work
+    if (classify && !wanted[4]) throw bad_input("--classify: needs the streams output (--outputs ... ,streams)");
+    OutputSet outputs("hydro", {dem_.path, weights_}, overwrite_);  // refused before any work
     const fs::path dir = outputs.folder(out_dir_);
 
     std::vector<std::pair<std::string, std::string>> provenance = {
-        {"TERRAPOLIS_VERSION", version}, {"TERRAPOLIS_COMMAND", "hydro"}, {"SOURCE_DEM", fs::path(dem_path_).filename().string()},
-        {"FILL", fill_}, {"FLOW", flow_}, {"MFD_EXPONENT", number(mfd_exponent_)}, {"HYDROMETRY", hydrometry_},
-        {"ITERATIONS", std::to_string(iterations_)}, {"THRESHOLD", number(threshold_)}, {"VERTICAL", vertical_},
-        {"BELHADJ_SHARE", share_}, {"SEA_LEVEL", o.sea_level ? number(*o.sea_level) : "off"}};
+        {"TERRAPOLIS_VERSION", version}, {"TERRAPOLIS_COMMAND", "hydro"}, {"SOURCE_DEM", fs::path(dem_.path).filename().string()},
+        {"FILL", fill}, {"FLOW", flow}, {"MFD_EXPONENT", number(o.mfd_exponent)}, {"HYDROMETRY", hydrometry},
+        {"ITERATIONS", std::to_string(o.hydrometry.max_iterations)}, {"THRESHOLD", number(o.hydrometry.threshold)},
+        {"VERTICAL", h["vertical"].get<std::string>()}, {"BELHADJ_SHARE", h["belhadj_share"].get<std::string>()},
+        {"SEA_LEVEL", o.sea_level ? number(*o.sea_level) : "off"}};
     auto opts = [&](const std::string& description, std::vector<std::pair<std::string, std::string>> extra = {}) {
       WriteOptions w;
       w.cog = cog_;
@@ -133,24 +101,23 @@ class HydroCommand final : public Command {
       w.metadata.insert(w.metadata.end(), extra.begin(), extra.end());
       return w;
     };
-    ReadOptions read;
-    if (!assume_crs_.empty()) read.assume_crs = assume_crs_;
+    const ReadOptions read = dem_.options();
     const std::string flowdir_description = "D8 flow direction, " + describe(codes);
-    const std::vector<std::pair<std::string, std::string>> flowdir_metadata = {{"D8_CODES", codes_}, {"D8_CODES_DESCRIPTION", describe(codes)}};
+    const std::vector<std::pair<std::string, std::string>> flowdir_metadata = {{"D8_CODES", h["d8_codes"].get<std::string>()}, {"D8_CODES_DESCRIPTION", describe(codes)}};
     const std::string acc_unit = units_ == "cells" ? "cells" : units_;
     const std::string acc_description = "Upstream " + std::string(units_ == "cells" ? "cell count" : "area (" + acc_unit + ")") + ", " +
-                                        flow_ + " routing" + (weights_.empty() ? "" : ", weighted");
-    if (tile_size_ > 0 || memory_limit_mb_ > 0 || fs::is_directory(dem_path_)) {
+                                        flow + " routing" + (weights_.empty() ? "" : ", weighted");
+    if (tile_size_ > 0 || memory_limit_mb_ > 0 || fs::is_directory(dem_.path)) {
       // The tile engine: fill, D8 and accumulation, tile by tile (docs/scale.md).
       if (o.fill != FillMethod::priority_flood || o.flow != FlowMethod::d8 || !weights_.empty())
         throw bad_input("tiled hydro (--tile-size, --memory-limit, a folder of tiles): only --fill priority-flood, --flow d8, no --weights");
       if (outputs_ != kDefaultOutputs && (wanted[3] || wanted[4]))
         throw bad_input("--outputs: hydrometry and streams are not computed on tiles yet; ask for filled,flowdir,accumulation");
-      if (classify_) throw bad_input("--classify: streams are not computed on tiles yet");
+      if (classify) throw bad_input("--classify: streams are not computed on tiles yet");
       if (tile_size_ != 0 && tile_size_ < 8) throw bad_input("--tile-size: must be at least 8 cells");
       if (memory_limit_mb_ < 0) throw bad_input("--memory-limit: must be a positive number of MB");
       TiledHydroRequest q;
-      q.dem_path = dem_path_;
+      q.dem_path = dem_.path;
       q.out_dir = dir.string();
       q.out_name = out_dir_;
       q.read = read;
@@ -163,7 +130,7 @@ class HydroCommand final : public Command {
       q.filled = wanted[0];
       q.flowdir = wanted[1];
       q.accumulation = wanted[2];
-      q.filled_file = opts("Conditioned elevation (m), " + fill_ + " depression handling");
+      q.filled_file = opts("Conditioned elevation (m), " + fill + " depression handling");
       q.flowdir_file = opts(flowdir_description, flowdir_metadata);
       q.accumulation_file = opts(acc_description, {{"UNIT", acc_unit}});
       const std::string done = run_tiled_hydro_command(q, context);
@@ -171,11 +138,11 @@ class HydroCommand final : public Command {
       context.log.info(done);
       return;
     }
-    const Dem dem = read_dem(dem_path_, read);
+    const Dem dem = dem_.read();
     if (!weights_.empty()) o.weights = read_resampled(weights_, dem.georef(), dem.cols(), dem.rows(), Resampling::bilinear);
 
     HydroResult result = run_hydro(dem, o, context.progress);
-    if (classify_) classify_streams(result.streams, result.filled, o.sea_level, types_);
+    if (classify) classify_streams(result.streams, result.filled, o.sea_level, *types);
     if (result.hydrometry_iterations > 0) {
       char line[160];
       std::snprintf(line, sizeof line, "belhadj: %d iterations in %.2f ms, %.1f M cell-iterations/s", result.hydrometry_iterations,
@@ -195,30 +162,30 @@ class HydroCommand final : public Command {
     std::vector<std::function<void()>> writes;
     if (wanted[0])
       writes.push_back([&, p = path(0)] {
-        write_raster(p, result.filled, opts("Conditioned elevation (m), " + fill_ + " depression handling"));
+        write_raster(p, result.filled, opts("Conditioned elevation (m), " + fill + " depression handling"));
       });
     if (wanted[1])
       writes.push_back([&, p = path(1)] { write_raster(p, encode_d8(result.d8, codes), opts(flowdir_description, flowdir_metadata)); });
     if (wanted[2]) writes.push_back([&, p = path(2)] { write_raster(p, acc, opts(acc_description, {{"UNIT", acc_unit}})); });
     if (wanted[3])
-      writes.push_back([&, p = path(3)] { write_raster(p, result.hydrometry, opts("Hydrometry in [0,1] (" + hydrometry_ + ")")); });
+      writes.push_back([&, p = path(3)] { write_raster(p, result.hydrometry, opts("Hydrometry in [0,1] (" + hydrometry + ")")); });
     if (wanted[4]) writes.push_back([&, p = path(4)] { write_vector(p, result.streams); });
-    if (classify_) writes.push_back([&] { write_text_file((dir / "streams.qml").string(), river_types_qml(), false); });
+    if (classify) writes.push_back([&] { write_text_file((dir / "streams.qml").string(), river_types_qml(), false); });
     write_concurrently(writes);
     outputs.commit();
     context.log.info("hydro: wrote " + out_dir_ + (wanted[4] ? " (" + std::to_string(result.streams.features.size()) + " stream reaches)" : ""));
   }
 
  private:
-  std::string dem_path_, out_dir_, fill_ = "priority-flood", flow_ = "d8", codes_ = "esri", hydrometry_ = "belhadj";
+  DemInput dem_;
+  std::string out_dir_;
   static constexpr const char* kDefaultOutputs = "filled,flowdir,accumulation,hydrometry,streams";
   std::string outputs_ = kDefaultOutputs;
-  std::string vertical_ = "metres", share_ = "all", units_ = "m2", weights_, assume_crs_;
-  double mfd_exponent_ = 1.1, threshold_ = 1.0 / 1048576, streams_km2_ = 10.0, sea_level_ = NAN;
-  int iterations_ = 0, tile_size_ = 0;
+  std::string units_ = "m2", weights_;
+  int tile_size_ = 0;
   double memory_limit_mb_ = 0;
-  bool cog_ = false, overwrite_ = false, classify_ = false;
-  RiverTypeOptions types_;
+  bool cog_ = false, overwrite_ = false;
+  SchemaOptions schema_;
 };
 
 }  // namespace

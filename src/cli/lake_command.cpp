@@ -13,6 +13,7 @@
 #include "cli/command.hpp"
 #include "cli/commands_list.hpp"
 #include "cli/dem_input.hpp"
+#include "cli/schema_options.hpp"
 #include "core/error.hpp"
 #include "lake/lake.hpp"
 #include "io/output_set.hpp"
@@ -61,13 +62,13 @@ class LakeCommand final : public Command {
 
   void setup(CLI::App& app) override {
     dem_.add_to(app);
-    app.add_option("OUTDIR", out_dir_, "Output folder: depth.tif, shoreline.geojson, lake.json (its parent must exist)")->required();
+    file_kind(app.add_option("OUTDIR", out_dir_, "Output folder: depth.tif, shoreline.geojson, lake.json (its parent must exist)")->required(), FileKind::folder_out);
     app.add_option("--at", at_, "Seed LON,LAT (WGS 84) on the lake's floor")->required();
     app.add_option("--level", level_, "Water surface elevation (m)");
     app.add_option("--depth", depth_, "Water depth above the seed's ground (m)");
     app.add_option("--dam", dam_, "Dam line, WKT in lon/lat: 'LINESTRING (lon lat, lon lat)'; its cells rise to --crest");
     app.add_option("--crest", crest_, "Dam crest elevation (m); the level defaults to it");
-    app.add_option("--run", run_dir_, "Run folder: report the flooded road length (roads.geojson) and the cities touched (cities.geojson)");
+    file_kind(app.add_option("--run", run_dir_, "Run folder: report the flooded road length (roads.geojson) and the cities touched (cities.geojson)"), FileKind::folder_in);
     app.add_flag("--cog", cog_, "Write a Cloud Optimized GeoTIFF");
     app.add_flag("--overwrite", overwrite_, "Replace existing outputs");
   }

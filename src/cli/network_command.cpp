@@ -7,12 +7,14 @@
 
 #include "cli/command.hpp"
 #include "cli/commands_list.hpp"
+#include "cli/schema_options.hpp"
 #include "core/error.hpp"
 #include "io/crs.hpp"
 #include "io/output_set.hpp"
 #include "io/vector_io.hpp"
 #include "network/layers.hpp"
 #include "network/network.hpp"
+#include "pipeline/stage_options.hpp"
 #include "sites/layers.hpp"
 
 namespace terrapolis::cli {
@@ -24,15 +26,16 @@ class NetworkCommand final : public Command {
   std::string summary() const override { return "Join cities by a simplified union of Delaunay triangulations (Belhadj §4.3.2)"; }
 
   void setup(CLI::App& app) override {
-    app.add_option("CITIES", cities_, "City points with radius_m (metres), optional id and parent (e.g. cities.geojson from `sites`)")->required();
-    app.add_option("OUTDIR", out_, "Output folder: network.geojson")->required();
-    app.add_option("--k", options_.k, "Detour factor (> 1): an edge goes when another path is shorter than k x its length")
-        ->capture_default_str();
+    file_kind(app.add_option("CITIES", cities_, "City points with radius_m (metres), optional id and parent (e.g. cities.geojson from `sites`)")
+                  ->required(),
+              FileKind::vector_in);
+    file_kind(app.add_option("OUTDIR", out_, "Output folder: network.geojson")->required(), FileKind::folder_out);
+    schema_.setup(app, name());
     app.add_flag("--overwrite", overwrite_, "Replace existing outputs");
   }
 
   void run(Context& context) override {
-    if (!(options_.k > 1)) throw bad_input("--k: must be greater than 1");
+    const network::NetworkOptions options = pipeline::network_options(schema_.scenario());
     OutputSet outputs("network", {cities_}, overwrite_);
     const std::string network_path = (outputs.folder(out_) / "network.geojson").string();
     // Lengths are geodesic whatever the file's CRS: work in WGS 84 longitude/latitude.
@@ -41,7 +44,7 @@ class NetworkCommand final : public Command {
     const VectorLayer layer = read_vector(cities_, crs);
     const std::vector<sites::Site> sites = sites::sites_from_layer(layer, cities_);
     const auto t1 = std::chrono::steady_clock::now();
-    const network::SiteGraph graph = network::build_network(sites, crs, options_, context.progress);
+    const network::SiteGraph graph = network::build_network(sites, crs, options, context.progress);
     const auto t2 = std::chrono::steady_clock::now();
     const VectorLayer lines = network::network_layer(graph, sites, crs);
     write_vector(network_path, lines);
@@ -58,12 +61,12 @@ class NetworkCommand final : public Command {
       if (e.kept) length += e.length_m;
     }
     std::printf("network: %zu cities, %zu candidate edges, %zu kept (%zu parent-child), %.1f km of links, k %.2f\n", sites.size(),
-                graph.edges.size(), kept, family, length / 1000.0, options_.k);
+                graph.edges.size(), kept, family, length / 1000.0, options.k);
   }
 
  private:
   std::string cities_, out_;
-  network::NetworkOptions options_;
+  SchemaOptions schema_;
   bool overwrite_ = false;
 };
 

@@ -8,7 +8,9 @@
 
 #include "cli/command.hpp"
 #include "cli/commands_list.hpp"
+#include "cli/dem_input.hpp"
 #include "cli/road_options.hpp"
+#include "cli/schema_options.hpp"
 #include "core/error.hpp"
 #include "io/crs.hpp"
 #include "io/output_set.hpp"
@@ -25,17 +27,17 @@ class PathCommand final : public Command {
   std::string summary() const override { return "Lay one road between two points: anisotropic shortest path with bridges and tunnels (Galin et al. 2010)"; }
 
   void setup(CLI::App& app) override {
-    app.add_option("DEM", dem_, "Elevation model")->required();
+    dem_.add_to(app);
     app.add_option("--from", from_, "Start point LON,LAT (or X,Y with --crs dem)")->required();
     app.add_option("--to", to_, "End point LON,LAT (or X,Y with --crs dem)")->required();
-    app.add_option("OUT", out_, "Output road (.geojson or .gpkg)")->required();
+    file_kind(app.add_option("OUT", out_, "Output road (.geojson or .gpkg)")->required(), FileKind::vector_out);
     app.add_option("--crs", crs_, "CRS of --from/--to: lonlat (WGS 84) or dem (the DEM's CRS)")->check(CLI::IsMember({"lonlat", "dem"}));
     app.add_option("--search", search_, "Search: astar (heuristic: relaxed 2-D distance), astar-distance (heuristic: straight-line bound), bidir (bidirectional A*, straight-line bound), dijkstra")
         ->check(CLI::IsMember({"astar", "astar-distance", "bidir", "dijkstra"}));
-    app.add_option("--sections", sections_, "Also write the road/bridge/tunnel sections to this file");
-    app.add_option("--evaluate", evaluate_, "Instead of routing, print the cost under the cost model of the first line of this file "
-                                            "(e.g. another tool's path), walked cell by cell; OUT is not written");
-    options_.setup(app);
+    file_kind(app.add_option("--sections", sections_, "Also write the road/bridge/tunnel sections to this file"), FileKind::vector_out);
+    file_kind(app.add_option("--evaluate", evaluate_, "Instead of routing, print the cost under the cost model of the first line of this file "
+                                            "(e.g. another tool's path), walked cell by cell; OUT is not written"), FileKind::vector_in);
+    options_.setup(app, name());
   }
 
   void run(Context& context) override {
@@ -45,21 +47,21 @@ class PathCommand final : public Command {
                      : search_ == "astar-distance" ? roads::SearchMethod::astar_distance
                                                    : roads::SearchMethod::astar;
     std::vector<std::string> inputs = options_.inputs();
-    inputs.insert(inputs.end(), {dem_, evaluate_});
+    inputs.insert(inputs.end(), {dem_.path, evaluate_});
     OutputSet outputs("path", inputs, options_.overwrite);
     const std::string out = evaluate_.empty() ? outputs.file(out_) : "";
     const std::string sections = evaluate_.empty() && !sections_.empty() ? outputs.file(sections_) : "";
     const std::string earthworks = evaluate_.empty() && !options_.earthworks.empty() ? outputs.file(options_.earthworks) : "";
     const roads::CostModel model = options_.cost_model();
     const plugin::PluginSet plugins = options_.plugins.load(context.log);
-    const Dem dem = read_dem(dem_);
+    const Dem dem = dem_.read();
     const hydro::FlatWater lakes = options_.flat_water(dem);
-    roads::TerrainField terrain(dem, options_.sea_level, model.unknown_water_depth_m, model.road_radius_m, &lakes.mask);
+    roads::TerrainField terrain(dem, options_.sea_level(), model.unknown_water_depth_m, model.road_radius_m, &lakes.mask);
     options_.load_layers(terrain, plugins, dem, context.progress, context.log);
     const auto a = locate("--from", from_, terrain), b = locate("--to", to_, terrain);
     if (a == b) throw bad_input("--from/--to: both points fall in the same cell");
     for (const auto& [opt, c] : {std::pair{"--from", a}, std::pair{"--to", b}}) {
-      if (dem.is_nodata(dem.index(c.col, c.row))) throw bad_input(std::string(opt) + ": the point is on a nodata cell of " + dem_);
+      if (dem.is_nodata(dem.index(c.col, c.row))) throw bad_input(std::string(opt) + ": the point is on a nodata cell of " + dem_.path);
       if (!roads::snap_to_land(terrain, c, routing.snap_cells))
         throw bad_input(std::string(opt) + ": the point is in the sea (no land within " + std::to_string(routing.snap_cells) + " cells)");
     }
@@ -112,7 +114,7 @@ class PathCommand final : public Command {
       xy = locator.lonlat_to_crs(v[0], v[1]);
     }
     const auto cell = roads::cell_at(terrain, xy[0], xy[1]);
-    if (!cell) throw bad_input(option + ": the point " + text + " lies outside " + dem_);
+    if (!cell) throw bad_input(option + ": the point " + text + " lies outside " + dem_.path);
     return *cell;
   }
 
@@ -138,7 +140,8 @@ class PathCommand final : public Command {
   }
 
   std::string evaluate_;
-  std::string dem_, from_, to_, out_, crs_ = "lonlat", search_ = "astar", sections_;
+  DemInput dem_;
+  std::string from_, to_, out_, crs_ = "lonlat", search_ = "astar", sections_;
   RoadOptions options_;
 };
 

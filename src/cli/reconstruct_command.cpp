@@ -11,6 +11,7 @@
 #include "cli/command.hpp"
 #include "cli/commands_list.hpp"
 #include "cli/terrain_options.hpp"
+#include "cli/schema_options.hpp"
 #include "core/error.hpp"
 #include "io/crs.hpp"
 #include "io/output_set.hpp"
@@ -60,9 +61,9 @@ class ReconstructCommand final : public Command {
   std::string summary() const override { return "Rebuild a DEM from sparse heights: points (CSV lon,lat,z or GeoJSON) or a sparse raster"; }
 
   void setup(CLI::App& app) override {
-    app.add_option("SAMPLES", input_, "Heights: .csv (lon,lat,z), a vector file of points (.geojson, .gpkg) or a raster with nodata")->required();
-    app.add_option("OUT", output_, "Output GeoTIFF (float32, metres)")->required();
-    app.add_option("--like", like_, "DEM whose grid and CRS the output takes");
+    file_kind(app.add_option("SAMPLES", input_, "Heights: .csv (lon,lat,z), a vector file of points (.geojson, .gpkg) or a raster with nodata")->required(), FileKind::file_in);
+    file_kind(app.add_option("OUT", output_, "Output GeoTIFF (float32, metres)")->required(), FileKind::raster_out);
+    file_kind(app.add_option("--like", like_, "DEM whose grid and CRS the output takes"), FileKind::raster_in);
     grid_.add(app, false);
     app.add_option("--z-field", z_field_, "Vector samples: the field holding the height in metres")->capture_default_str();
     options_.add(app, true, 0.0);

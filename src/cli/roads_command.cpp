@@ -8,7 +8,9 @@
 
 #include "cli/command.hpp"
 #include "cli/commands_list.hpp"
+#include "cli/dem_input.hpp"
 #include "cli/road_options.hpp"
+#include "cli/schema_options.hpp"
 #include "core/error.hpp"
 #include "io/output_set.hpp"
 #include "io/raster_io.hpp"
@@ -24,11 +26,11 @@ class RoadsCommand final : public Command {
   std::string summary() const override { return "Route a road for every kept edge of a city network (network.geojson; cities.geojson beside it)"; }
 
   void setup(CLI::App& app) override {
-    app.add_option("DEM", dem_, "Elevation model")->required();
-    app.add_option("NETWORK", network_, "network.geojson from the network stage (LineStrings: from, to, kept)")->required();
-    app.add_option("OUTDIR", outdir_, "Folder for roads.geojson and road_sections.geojson (its parent must exist)")->required();
-    app.add_option("--cities", cities_, "Cities (Points: id, class); default: cities.geojson beside NETWORK when present");
-    options_.setup(app);
+    dem_.add_to(app);
+    file_kind(app.add_option("NETWORK", network_, "network.geojson from the network stage (LineStrings: from, to, kept)")->required(), FileKind::vector_in);
+    file_kind(app.add_option("OUTDIR", outdir_, "Folder for roads.geojson and road_sections.geojson (its parent must exist)")->required(), FileKind::folder_out);
+    file_kind(app.add_option("--cities", cities_, "Cities (Points: id, class); default: cities.geojson beside NETWORK when present"), FileKind::vector_in);
+    options_.setup(app, name());
   }
 
   void run(Context& context) override {
@@ -40,16 +42,16 @@ class RoadsCommand final : public Command {
       if (fs::exists(beside)) cities_path = beside.string();
     }
     std::vector<std::string> inputs = options_.inputs();
-    inputs.insert(inputs.end(), {dem_, network_, cities_path});
+    inputs.insert(inputs.end(), {dem_.path, network_, cities_path});
     OutputSet outputs("roads", inputs, options_.overwrite);
     const fs::path dir = outputs.folder(outdir_);
     const std::string earthworks_path = options_.earthworks.empty() ? "" : outputs.file(options_.earthworks);
 
     const roads::CostModel model = options_.cost_model();
     const plugin::PluginSet plugins = options_.plugins.load(context.log);
-    const Dem dem = read_dem(dem_);
+    const Dem dem = dem_.read();
     const hydro::FlatWater lakes = options_.flat_water(dem);
-    roads::TerrainField terrain(dem, options_.sea_level, model.unknown_water_depth_m, model.road_radius_m, &lakes.mask);
+    roads::TerrainField terrain(dem, options_.sea_level(), model.unknown_water_depth_m, model.road_radius_m, &lakes.mask);
     options_.load_layers(terrain, plugins, dem, context.progress, context.log);
     VectorLayer network = read_vector(network_, dem.georef().crs);
     network.name = network_;  // errors name the file
@@ -85,7 +87,8 @@ class RoadsCommand final : public Command {
   }
 
  private:
-  std::string dem_, network_, outdir_, cities_;
+  DemInput dem_;
+  std::string network_, outdir_, cities_;
   RoadOptions options_;
 };
 

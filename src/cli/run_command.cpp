@@ -6,6 +6,7 @@
 
 #include "cli/command.hpp"
 #include "cli/commands_list.hpp"
+#include "cli/schema_options.hpp"
 #include "pipeline/runner.hpp"
 #include "pipeline/scenario.hpp"
 
@@ -19,12 +20,12 @@ class RunCommand final : public Command {
     return "Run a scenario (JSON) from DEM to roads; without a file, the default scenario on the bundled Corsica DEM";
   }
   void setup(CLI::App& app) override {
-    app.add_option("SCENARIO", file_, "Scenario file (JSON, see schemas/scenario.schema.json); default: the embedded scenario");
+    file_kind(app.add_option("SCENARIO", file_, "Scenario file (JSON, see schemas/scenario.schema.json); default: the embedded scenario"), FileKind::file_in);
     app.add_option("--set", sets_, "Override a field: stage.field=value (repeatable), e.g. --set density.weights=[1,1,0,0]");
     // The schema's range (a JSON-safe integer): a negative or larger seed is refused, never replaced.
     app.add_option("--seed", seed_, "Seed of the run, 0 .. 2^53-1 (overrides the scenario's)")
         ->check(CLI::Range(std::uint64_t(0), std::uint64_t(9007199254740991)));
-    app.add_option("-o,--output", output_, "Run folder (overrides the scenario's)");
+    file_kind(app.add_option("-o,--output", output_, "Run folder (overrides the scenario's)"), FileKind::folder_out);
     app.add_flag("--overwrite", overwrite_, "Replace the run folder if it exists");
     const std::vector<std::string> stages = pipeline::stage_names();
     app.add_option("--from", from_, "Rerun from this stage on, reading the earlier stages' results back from the run")

@@ -10,11 +10,13 @@
 
 #include "cli/command.hpp"
 #include "cli/commands_list.hpp"
+#include "cli/schema_options.hpp"
 #include "core/error.hpp"
 #include "density/density.hpp"
 #include "hydro/hydrometry.hpp"
 #include "io/output_set.hpp"
 #include "io/raster_io.hpp"
+#include "pipeline/stage_options.hpp"
 #include "sites/layers.hpp"
 #include "sites/sites.hpp"
 
@@ -72,53 +74,27 @@ class SitesCommand final : public Command {
   std::string summary() const override { return "Place city sites with size quotas and their hierarchy on a density model (Belhadj Alg. 13-15)"; }
 
   void setup(CLI::App& app) override {
-    app.add_option("DENSITY_DIR_OR_DEM", dir_,
+    file_kind(app.add_option("DENSITY_DIR_OR_DEM", dir_,
                    "Folder holding density.tif (float, [0,1]) and buildable.tif (1 = buildable) on the DEM grid, or a DEM "
                    "(the density model is then computed with its defaults)")
-        ->required();
-    app.add_option("OUTDIR", out_, "Output folder: cities.geojson, city_extents.geojson")->required();
-    // The seed is recorded as a 64-bit signed integer field: keep it in that range.
-    app.add_option("--seed", options_.seed, "Seed of the candidate draw (0 .. 2^63-1); recorded in the outputs")
-        ->check(CLI::Range(std::uint64_t(0), std::uint64_t(std::numeric_limits<std::int64_t>::max())))
-        ->capture_default_str();
-    app.add_option("--mode", mode_, "Inclusions: paris keeps half-size suburbs (radio-concentric), manhattan removes every inclusion")
-        ->check(CLI::IsMember({"paris", "manhattan"}))
-        ->capture_default_str();
-    app.add_option("--disc-test", disc_test_, "exact: whole disc clear of uninhabitable cells; perimeter: only each circle, as the thesis")
-        ->check(CLI::IsMember({"exact", "perimeter"}))
-        ->capture_default_str();
-    app.add_option("--quotas", quotas_, "Sizes: rank_size (the region's population by a rank-size law) or belhadj2007 (the thesis's census table)")
-        ->check(CLI::IsMember({"rank_size", "belhadj2007"}))
-        ->capture_default_str();
-    app.add_option("--population", options_.population, "rank_size: people in the region (0: 60 people/km2 of buildable land, the world average)")
-        ->check(CLI::NonNegativeNumber)
-        ->capture_default_str();
-    app.add_option("--candidates", options_.candidates, "Candidate positions M (0: 20 x the number of sites)")->check(CLI::NonNegativeNumber);
-    app.add_option("--r-min", options_.r_min_m, "Smallest radius, metres (0: the class step dr)")->check(CLI::NonNegativeNumber);
-    app.add_option("--r-max", options_.r_max_m, "Radii run up to r_max - dr, metres (0: 1e6 people / 400 + dr)")->check(CLI::NonNegativeNumber);
-    app.add_option("--dr-min", options_.dr_min_m, "Smallest class step, metres; dr = max(dr_min, cell size)")->capture_default_str();
-    app.add_option("--refill", options_.refill_rounds, "Rounds giving the quota of removed sites back to the growth (0: Algorithm 14 as printed)")
-        ->check(CLI::NonNegativeNumber)
-        ->capture_default_str();
-    app.add_option("--quota-scale", options_.quota_scale,
-                   "Multiplies every quota (region area / 543940 km2 of the census fit; 1: the thesis)")
-        ->check(CLI::PositiveNumber)
-        ->capture_default_str();
+        ->required(), FileKind::folder_in);
+    file_kind(app.add_option("OUTDIR", out_, "Output folder: cities.geojson, city_extents.geojson")->required(), FileKind::folder_out);
+    schema_.setup(app, name());
     app.add_flag("--report", report_, "Print the quota table");
     app.add_flag("--overwrite", overwrite_, "Replace existing outputs");
   }
 
   void run(Context& context) override {
-    options_.mode = mode_ == "manhattan" ? sites::SitesOptions::Mode::manhattan : sites::SitesOptions::Mode::paris;
-    options_.quotas = quotas_ == "belhadj2007" ? sites::SitesOptions::Quotas::belhadj2007 : sites::SitesOptions::Quotas::rank_size;
-    options_.disc_test = disc_test_ == "perimeter" ? sites::SitesOptions::DiscTest::perimeter : sites::SitesOptions::DiscTest::exact;
+    // The command has always used the allometry's exact 5/6 (the scenario's default is 0.8333).
+    const pipeline::Scenario scenario = schema_.scenario({"sites.area_exponent=" + nlohmann::json(5.0 / 6.0).dump()});
+    const sites::SitesOptions options = schema_.settings([&] { return pipeline::sites_options(scenario); });
     OutputSet outputs("sites", {dir_}, overwrite_);
     const std::filesystem::path out_dir = outputs.folder(out_);
     const auto t0 = std::chrono::steady_clock::now();
     const bool dem = std::filesystem::is_regular_file(dir_);
     const DensityInputs in = dem ? density_from_dem(dir_, context.progress) : read_density_dir(dir_);
     const auto t1 = std::chrono::steady_clock::now();
-    const sites::SitesResult result = sites::place_sites(in.density, in.buildable, options_, context.progress);
+    const sites::SitesResult result = sites::place_sites(in.density, in.buildable, options, context.progress);
     const auto t2 = std::chrono::steady_clock::now();
     const Crs& crs = in.density.georef().crs;
     const VectorLayer cities = sites::cities_layer(result, crs);
@@ -141,16 +117,16 @@ class SitesCommand final : public Command {
       }
       std::printf("total %9s %7d %7d %7zu\n", "", quota, placed, result.sites.size());
     }
-    if (options_.quotas == sites::SitesOptions::Quotas::rank_size)
+    if (options.quotas == sites::SitesOptions::Quotas::rank_size)
       std::printf("sites: %.0f people (%s), rank-size law down to %.0f\n", result.target_population,
-                  result.population_assumed ? "assumed: default people/km2 x buildable land" : "given", options_.min_population);
+                  result.population_assumed ? "assumed: default people/km2 x buildable land" : "given", options.min_population);
     std::printf("sites: %zu cities (%d roots, %zu suburbs) from %d candidates, dr %.0f m, seed %llu\n", result.sites.size(), roots,
                 result.sites.size() - std::size_t(roots), result.candidates, result.dr_m, static_cast<unsigned long long>(result.seed));
   }
 
  private:
-  std::string dir_, out_, mode_ = "paris", disc_test_ = "exact", quotas_ = "rank_size";
-  sites::SitesOptions options_;
+  std::string dir_, out_;
+  SchemaOptions schema_;
   bool report_ = false, overwrite_ = false;
 };
 

@@ -32,11 +32,7 @@ HydroResult run_hydro(const Dem& dem, const HydroOptions& options, Progress& pro
     HydrometryOptions h = options.hydrometry;
     if (options.sea_level) h.sea_level = options.sea_level;
     if (h.method == HydrometryMethod::accumulation) {
-      Raster<double> a = d8_area;
-      if (h.sea_level)
-        for (std::size_t i = 0; i < a.size(); ++i)
-          if (is_sea(dem[i], h.sea_level)) a[i] = 0;
-      out.hydrometry = hydrometry_from_accumulation(a);
+      out.hydrometry = hydrometry_from_accumulation(d8_area, dem, h.sea_level);
     } else {
       const auto t0 = std::chrono::steady_clock::now();
       BelhadjRun run = belhadj_hydrometry(dem, metrics, belhadj_options(h), progress);

@@ -12,7 +12,10 @@
 
 namespace terrapolis::hydro {
 
-Raster<float> hydrometry_from_accumulation(const Raster<double>& area) {
+Raster<float> hydrometry_from_accumulation(Raster<double> area, const Dem& dem, const std::optional<double>& sea_level) {
+  if (sea_level)
+    for (std::size_t i = 0; i < area.size(); ++i)
+      if (is_sea(dem[i], sea_level)) area[i] = 0;
   double lo = INFINITY, hi = -INFINITY;
   for (double a : area.values())
     if (a > 0) {
@@ -45,11 +48,7 @@ Raster<float> compute_hydrometry(const Dem& dem, const HydrometryOptions& option
   const Dem filled = fill_depressions(dem, {FillMethod::priority_flood, options.sea_level}, progress);
   const auto d8 = d8_directions(filled, metrics, options.sea_level, progress);
   const FlowRouter router(filled, d8, metrics, FlowMethod::d8);
-  Raster<double> area = accumulate(filled, router, metrics, {}, progress);
-  if (options.sea_level)
-    for (std::size_t i = 0; i < area.size(); ++i)
-      if (is_sea(dem[i], options.sea_level)) area[i] = 0;
-  return hydrometry_from_accumulation(area);
+  return hydrometry_from_accumulation(accumulate(filled, router, metrics, {}, progress), dem, options.sea_level);
 }
 
 }  // namespace terrapolis::hydro

@@ -30,8 +30,9 @@ Raster<float> compute_hydrometry(const Dem& dem, const HydrometryOptions& option
 /// The Belhadj part of `options`.
 BelhadjOptions belhadj_options(const HydrometryOptions& options);
 
-/// Log rescale of an upstream area (m², > 0 on valid cells) to [0,1]:
-/// (ln a - ln min) / (ln max - ln min) over valid cells; NaN stays NaN; `sea` cells (optional) get 0.
-Raster<float> hydrometry_from_accumulation(const Raster<double>& area_m2);
+/// Log rescale of a D8 upstream area (m², > 0 on valid cells) to [0,1]:
+/// (ln a - ln min) / (ln max - ln min) over valid cells; NaN stays NaN; cells of `dem` at or below
+/// `sea_level` (when set) drain nothing and get 0. The one home of the "accumulation" method.
+Raster<float> hydrometry_from_accumulation(Raster<double> area_m2, const Dem& dem, const std::optional<double>& sea_level);
 
 }  // namespace terrapolis::hydro

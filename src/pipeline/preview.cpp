@@ -72,6 +72,57 @@ struct LegendEntry {
   bool line;
 };
 
+/// Terrain: hillshade tinted by land / sea, then the density where it exists.
+void draw_terrain(Canvas& canvas, const RunState& state, double sx, double sy) {
+  const Dem& dem = state.dem;
+  const int width = canvas.width(), height = canvas.height();
+  const Raster<std::uint8_t> shade = hillshade(dem);
+  for (int y = 0; y < height; ++y) {
+    const int r = std::min(dem.rows() - 1, int((y + 0.5) * sy));
+    for (int x = 0; x < width; ++x) {
+      const int c = std::min(dem.cols() - 1, int((x + 0.5) * sx));
+      const float z = dem(c, r);
+      if (std::isnan(z)) { canvas.blend(x, y, hex(0xdddddd), 1); continue; }
+      const float s = shade(c, r) / 255.0f;
+      const Rgb base = z <= 0 ? hex(0x9ecae1) : hex(0xe8e4d0);
+      canvas.blend(x, y, {base[0] * (0.45f + 0.55f * s), base[1] * (0.45f + 0.55f * s), base[2] * (0.45f + 0.55f * s)}, 1);
+    }
+  }
+  if (state.density) {
+    for (int y = 0; y < height; ++y) {
+      const int r = std::min(dem.rows() - 1, int((y + 0.5) * sy));
+      for (int x = 0; x < width; ++x) {
+        const int c = std::min(dem.cols() - 1, int((x + 0.5) * sx));
+        const float d = (*state.density)(c, r);
+        if (!std::isnan(d) && d > 0) canvas.blend(x, y, density_color(d), 0.55f);
+      }
+    }
+  }
+}
+
+/// The legend's swatches drawn on the canvas, and its labels for the PNG writer (which draws text).
+std::vector<TerrapolisPngText> draw_legend(Canvas& canvas, const std::vector<LegendEntry>& legend, double unit) {
+  // Legend box, bottom left, scaled down to fit the image (in units: 126 wide with its margins,
+  // 14 per entry plus 24 high); left out when its text would be under 7 px (a thumbnail).
+  std::vector<TerrapolisPngText> texts;
+  const int width = canvas.width(), height = canvas.height();
+  const double lu = std::min({unit, width / 126.0, height / (14.0 * double(legend.size()) + 24.0)});
+  if (11 * lu >= 7) {
+    const int row_h = int(14 * lu), box_w = int(110 * lu), box_h = row_h * int(legend.size()) + int(8 * lu);
+    const int bx = int(8 * lu), by = height - box_h - int(8 * lu);
+    canvas.rect(bx, by, bx + box_w, by + box_h, hex(0xffffff), 0.8f);
+    const float black[3] = {0.1f, 0.1f, 0.1f};
+    for (std::size_t i = 0; i < legend.size(); ++i) {
+      const int y = by + int(4 * lu) + int(i) * row_h;
+      const int sw = int(18 * lu), sh = legend[i].line ? std::max(2, int(3 * lu)) : int(9 * lu);
+      const int sx0 = bx + int(5 * lu), sy0 = y + (row_h - sh) / 2;
+      canvas.rect(sx0, sy0, sx0 + sw, sy0 + sh, legend[i].color);
+      texts.push_back({bx + int(28 * lu), y + row_h - int(3 * lu), int(11 * lu), {black[0], black[1], black[2]}, legend[i].label.c_str()});
+    }
+  }
+  return texts;
+}
+
 }  // namespace
 
 /// The PNG writer module: beside the executable (installed or built), else where the build put it.
@@ -104,29 +155,7 @@ void write_preview(const RunState& state, const std::string& path, int width) {
   Canvas canvas(width, height);
   const double sx = double(dem.cols()) / width, sy = double(dem.rows()) / height;
 
-  // Terrain: hillshade tinted by land / sea, then density where it exists.
-  const Raster<std::uint8_t> shade = hillshade(dem);
-  for (int y = 0; y < height; ++y) {
-    const int r = std::min(dem.rows() - 1, int((y + 0.5) * sy));
-    for (int x = 0; x < width; ++x) {
-      const int c = std::min(dem.cols() - 1, int((x + 0.5) * sx));
-      const float z = dem(c, r);
-      if (std::isnan(z)) { canvas.blend(x, y, hex(0xdddddd), 1); continue; }
-      const float s = shade(c, r) / 255.0f;
-      const Rgb base = z <= 0 ? hex(0x9ecae1) : hex(0xe8e4d0);
-      canvas.blend(x, y, {base[0] * (0.45f + 0.55f * s), base[1] * (0.45f + 0.55f * s), base[2] * (0.45f + 0.55f * s)}, 1);
-    }
-  }
-  if (state.density) {
-    for (int y = 0; y < height; ++y) {
-      const int r = std::min(dem.rows() - 1, int((y + 0.5) * sy));
-      for (int x = 0; x < width; ++x) {
-        const int c = std::min(dem.cols() - 1, int((x + 0.5) * sx));
-        const float d = (*state.density)(c, r);
-        if (!std::isnan(d) && d > 0) canvas.blend(x, y, density_color(d), 0.55f);
-      }
-    }
-  }
+  draw_terrain(canvas, state, sx, sy);
 
   // Vectors, in the DEM's CRS (layers written in another CRS are transformed).
   const GridLocator locator(dem.georef());
@@ -194,23 +223,7 @@ void write_preview(const RunState& state, const std::string& path, int width) {
   if (state.density) legend.insert(legend.begin(), {hex(0xf03b20), "density", false});
   legend.insert(legend.begin(), {hex(0x9ecae1), "sea", false});
 
-  // Legend box, bottom left, scaled down to fit the image (in units: 126 wide with its margins,
-  // 14 per entry plus 24 high); left out when its text would be under 7 px (a thumbnail).
-  std::vector<TerrapolisPngText> texts;
-  const double lu = std::min({unit, width / 126.0, height / (14.0 * double(legend.size()) + 24.0)});
-  if (11 * lu >= 7) {
-    const int row_h = int(14 * lu), box_w = int(110 * lu), box_h = row_h * int(legend.size()) + int(8 * lu);
-    const int bx = int(8 * lu), by = height - box_h - int(8 * lu);
-    canvas.rect(bx, by, bx + box_w, by + box_h, hex(0xffffff), 0.8f);
-    const float black[3] = {0.1f, 0.1f, 0.1f};
-    for (std::size_t i = 0; i < legend.size(); ++i) {
-      const int y = by + int(4 * lu) + int(i) * row_h;
-      const int sw = int(18 * lu), sh = legend[i].line ? std::max(2, int(3 * lu)) : int(9 * lu);
-      const int sx0 = bx + int(5 * lu), sy0 = y + (row_h - sh) / 2;
-      canvas.rect(sx0, sy0, sx0 + sw, sy0 + sh, legend[i].color);
-      texts.push_back({bx + int(28 * lu), y + row_h - int(3 * lu), int(11 * lu), {black[0], black[1], black[2]}, legend[i].label.c_str()});
-    }
-  }
+  const std::vector<TerrapolisPngText> texts = draw_legend(canvas, legend, unit);
   const std::string tmp = path + ".tmp.png";
   char error[512] = {};
   if (png_writer()(canvas.data(), width, height, texts.data(), int(texts.size()), "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",

@@ -54,7 +54,7 @@ std::vector<std::string> settlement_warnings(const RunState& s, const sites::Sit
 json realism_figures(RunState& s, const sites::SitesResult& r, const std::string& reference, std::vector<std::string>& warnings,
                      Progress& progress) {
   // The terrain terms for the baselines and the land mask: the run's density options, terms on.
-  density::DensityOptions options = density_options(s.scenario);
+  density::DensityOptions options = s.settings.density;
   options.terrain_terms = true;
   if (s.rivers) options.rivers = *s.rivers;
   const density::DensityResult terms = density::compute_density(s.dem, *s.hydrometry, options, progress);

@@ -13,6 +13,7 @@
 #include "io/raster_io.hpp"
 #include "io/vector_io.hpp"
 #include "pipeline/scenario.hpp"
+#include "pipeline/stage_options.hpp"
 #include "plugin/plugin.hpp"
 #include "sites/sites.hpp"
 
@@ -41,6 +42,7 @@ struct RunState {
       : scenario(s), folder(std::move(run_folder)), dem_sha256(std::move(sha256)), dem(std::move(elevation)) {}
 
   const Scenario& scenario;
+  StageSettings settings;  ///< every stage's settings, prepared before the first stage runs
   std::filesystem::path folder;  ///< the run folder being written (a temporary name until the end)
   std::string dem_sha256;
   Dem dem;

@@ -18,6 +18,7 @@
 #include "pipeline/compare.hpp"
 #include "pipeline/publish.hpp"
 #include "pipeline/run_state.hpp"
+#include "pipeline/stage_options.hpp"
 #include "pipeline/stages.hpp"
 #include "terrapolis/version.hpp"
 
@@ -137,6 +138,7 @@ json run_scenario(const Scenario& scenario, const RunOptions& options, Progress&
   namespace fs = std::filesystem;
   const fs::path output = scenario.path("output");
   const std::vector<Action> plan = plan_stages(options);
+  StageSettings settings = prepare_stages(scenario);  // every stage's settings and files, before anything is created
   const bool rerun = std::any_of(plan.begin(), plan.end(), [](Action a) { return a != Action::run; });
   json saved;
   if (rerun) saved = load_manifest(output.string());
@@ -157,6 +159,7 @@ json run_scenario(const Scenario& scenario, const RunOptions& options, Progress&
   {
     RunState state(scenario, temp, dem_sha256, std::move(dem));
     state.plugins = std::move(plugins);
+    state.settings = std::move(settings);
     json timings = json::array();
     json ran = json::array(), reused = json::array(), stale = json::array();
     const std::size_t last = options.until.empty() ? stages().size() - 1 : stage_index("--until", options.until);

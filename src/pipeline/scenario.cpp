@@ -11,6 +11,7 @@
 
 #include "core/error.hpp"
 #include "core/json_input.hpp"
+#include "core/schema_error.hpp"
 #include "core/text.hpp"
 
 namespace terrapolis::pipeline {
@@ -110,11 +111,8 @@ std::string validate_scenario(const json& scenario) {
   valijson::ValidationResults results;
   valijson::adapters::NlohmannJsonAdapter target(doc);
   if (validator.validate(schema, target, &results)) return "";
-  // The deepest error is the most specific one (valijson also reports the enclosing objects).
-  valijson::ValidationResults::Error best;
-  for (const auto& e : results)
-    if (e.context.size() > best.context.size()) best = e;
-  return json_pointer_of(best.context) + ": " + best.description;
+  const auto [pointer, problem] = schema_error(results);
+  return pointer + ": " + problem;
 }
 
 namespace {

@@ -2,8 +2,11 @@
 // SPDX-License-Identifier: MIT
 #include "pipeline/stage_options.hpp"
 
+#include <filesystem>
+#include <functional>
 #include <map>
 
+#include "core/error.hpp"
 #include "hydro/option_names.hpp"
 
 namespace terrapolis::pipeline {
@@ -80,6 +83,7 @@ density::DensityOptions density_options(const Scenario& scenario) {
   if (const double cap = d["river_bed_cap"].get<double>(); cap < 1) o.river_bed_cap = cap;
   o.r_min_m = d["r_min_m"].get<double>();
   o.r_max_m = d["r_max_m"].get<double>();
+  if (!(o.r_max_m > o.r_min_m)) throw bad_input("/density/r_max_m: must be larger than /density/r_min_m (metres)");
   o.plateau_min_m = d["plateau_min_m"].get<double>();
   o.plateau_max_m = d["plateau_max_m"].get<double>();
   o.plain_max_variation_m = d["plain_max_variation_m"].get<double>();
@@ -159,6 +163,51 @@ hydro::FlatWaterOptions flat_water_options(const Scenario& scenario) {
   o.tolerance_m = w["flat_water_tolerance_m"].get<double>();
   o.sea_level_m = w["sea_level_m"].get<double>();
   return o;
+}
+
+namespace {
+
+/// Runs `make`, naming `pointer` in its errors unless they name a field already.
+template <class Make>
+auto at(const std::string& pointer, Make&& make) -> decltype(make()) {
+  try {
+    return make();
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    throw Error(e.kind(), message.starts_with('/') ? message : pointer + ": " + message);
+  }
+}
+
+/// A file the scenario names must exist before the run starts (GDAL's /vsi paths are its to check).
+void check_file(const std::string& pointer, const std::string& path) {
+  std::error_code ec;
+  if (path.empty() || path.starts_with("/vsi") || std::filesystem::is_regular_file(path, ec)) return;
+  throw bad_input(pointer + ": " + path + ": no such file");
+}
+
+}  // namespace
+
+StageSettings prepare_stages(const Scenario& scenario) {
+  try {
+    StageSettings s;
+    s.flat_water = flat_water_options(scenario);
+    s.reservoirs = reservoir_specs(scenario);
+    s.hydro = hydro_options(scenario);
+    s.river_types = river_type_options(scenario);
+    s.d8_codes = d8_codes(scenario);
+    s.density = density_options(scenario);
+    s.sites = sites_options(scenario);
+    s.network = network_options(scenario);
+    s.roads = at("/roads/costs", [&] { return roads_settings(scenario); });
+    check_file("/water/water_mask", scenario.path("/water/water_mask"));
+    check_file("/roads/vegetation", s.roads.vegetation);
+    check_file("/sites/reference", scenario.path("/sites/reference"));
+    for (std::size_t i = 0; i < s.density.layers.size(); ++i) check_file("/density/layers/" + std::to_string(i) + "/file", s.density.layers[i].first);
+    for (std::size_t i = 0; i < s.density.exclusions.size(); ++i) check_file("/density/exclusions/" + std::to_string(i), s.density.exclusions[i]);
+    return s;
+  } catch (const Error& e) {
+    throw Error(e.kind(), scenario.source + ": " + e.what());
+  }
 }
 
 }  // namespace terrapolis::pipeline

@@ -47,4 +47,21 @@ RoadsSettings roads_settings(const Scenario& scenario);
 /// The water section's detection of lakes the DEM flattens (water.flat_water_*, water.sea_level_m).
 hydro::FlatWaterOptions flat_water_options(const Scenario& scenario);
 
+/// Every stage's typed settings, built once before the first stage runs (as PDAL prepares every
+/// stage before executing any): the commands build theirs with the same functions.
+struct StageSettings {
+  hydro::FlatWaterOptions flat_water;
+  std::vector<lake::LakeSpec> reservoirs;
+  hydro::HydroOptions hydro;
+  std::optional<hydro::RiverTypeOptions> river_types;
+  hydro::D8Codes d8_codes{};
+  density::DensityOptions density;
+  sites::SitesOptions sites;
+  network::NetworkOptions network;
+  RoadsSettings roads;
+};
+/// Builds every stage's settings, loads the cost model and checks that every file the scenario
+/// names exists. Throws bad_input as "SCENARIO: /json/pointer: problem".
+StageSettings prepare_stages(const Scenario& scenario);
+
 }  // namespace terrapolis::pipeline

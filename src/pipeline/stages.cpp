@@ -54,14 +54,14 @@ constexpr const char* kInlandWater = "inland_water.tif";
 /// (hydro::detect_flat_water), the user's water.water_mask, and the scenario's reservoirs flooded
 /// to their level (Peytavie 2010 §2.4.1).
 void write_inland_water(RunState& s, Progress& progress, const Log& log) {
-  hydro::FlatWater flat = hydro::detect_flat_water(s.dem, flat_water_options(s.scenario));
+  hydro::FlatWater flat = hydro::detect_flat_water(s.dem, s.settings.flat_water);
   Raster<std::uint8_t>& water = flat.mask;
   if (const std::string user = s.scenario.path("/water/water_mask"); !user.empty()) {
     const Raster<float> m = read_resampled(user, s.dem.georef(), s.dem.cols(), s.dem.rows(), Resampling::nearest);
     for (std::size_t i = 0; i < m.size(); ++i)
       if (!std::isnan(m[i]) && m[i] != 0) water[i] = 1;
   }
-  const std::vector<lake::LakeSpec> specs = reservoir_specs(s.scenario);
+  const std::vector<lake::LakeSpec>& specs = s.settings.reservoirs;
   json reservoirs = json::array();
   if (!specs.empty()) {
     const CellMetrics metrics = cell_metrics(s.dem.georef(), s.dem.cols(), s.dem.rows());
@@ -88,11 +88,11 @@ void write_inland_water(RunState& s, Progress& progress, const Log& log) {
 // ---- hydro (Belhadj 2007 §4.2.2; Barnes et al. 2014; docs/hydro.md) ----------------------
 
 void hydro_run(RunState& s, Progress& progress, const Log& log) {
-  const hydro::HydroOptions options = hydro_options(s.scenario);
+  const hydro::HydroOptions& options = s.settings.hydro;
   hydro::HydroResult r = hydro::run_hydro(s.dem, options, progress);
-  if (const auto types = river_type_options(s.scenario)) hydro::classify_streams(r.streams, r.filled, options.sea_level, *types);
+  if (const auto& types = s.settings.river_types) hydro::classify_streams(r.streams, r.filled, options.sea_level, *types);
   const json& h = s.scenario.resolved["hydro"];
-  const hydro::D8Codes codes = d8_codes(s.scenario);
+  const hydro::D8Codes codes = s.settings.d8_codes;
   s.write("hydro", "filled.tif", r.filled, "conditioned elevation (m), " + h["fill"].get<std::string>() + " depression handling",
           Style::elevation);
   s.write("hydro", "flowdir.tif", hydro::encode_d8(r.d8, codes), "D8 flow direction, " + hydro::describe(codes), Style::flow_direction,
@@ -138,7 +138,7 @@ void hydro_load(RunState& s) {
 // ---- density (Belhadj 2007 §4.2; docs/density.md) -----------------------------------------
 
 void density_run(RunState& s, Progress& progress, const Log& log) {
-  density::DensityOptions options = density_options(s.scenario);
+  density::DensityOptions options = s.settings.density;
   options.water_mask = saved(s, kInlandWater);  // holds water.water_mask too
   plugin::add_to_density(plugin::density_factors(s.plugins, s.dem, progress, log), options);
   if (s.rivers) options.rivers = *s.rivers;
@@ -171,7 +171,7 @@ void density_load(RunState& s) {
 // ---- sites (Belhadj 2007 §4.3.1, Algorithms 13-15; docs/sites.md) --------------------------
 
 void sites_run(RunState& s, Progress& progress, const Log& log) {
-  sites::SitesOptions options = sites_options(s.scenario);
+  sites::SitesOptions options = s.settings.sites;
   // The land of the density stage (water and nodata excluded), for the default population.
   if (s.summary.contains("density") && s.summary["density"].contains("land_area_km2"))
     options.land_area_km2 = s.summary["density"]["land_area_km2"].get<double>();
@@ -239,7 +239,7 @@ void sites_load(RunState& s) {
 
 void network_run(RunState& s, Progress& progress, const Log&) {
   const Crs& crs = s.dem.georef().crs;
-  const network::SiteGraph graph = network::build_network(s.sites, crs, network_options(s.scenario), progress);
+  const network::SiteGraph graph = network::build_network(s.sites, crs, s.settings.network, progress);
   s.network = network::network_layer(graph, s.sites, crs);
   s.write("network", "network.geojson", *s.network, "candidate links between cities (kept = in the simplified network)",
           Style::network);
@@ -256,7 +256,7 @@ void network_load(RunState& s) { s.network = read_vector(saved(s, "network.geojs
 // ---- roads (Galin et al. 2010, Peytavie 2010 ch. 4; Belhadj 2007 Alg. 16; docs/roads.md) ----
 
 void roads_run(RunState& s, Progress& progress, const Log& log) {
-  const RoadsSettings settings = roads_settings(s.scenario);
+  const RoadsSettings& settings = s.settings.roads;
   const Raster<float> water = read_resampled(saved(s, kInlandWater), s.dem.georef(), s.dem.cols(), s.dem.rows(), Resampling::nearest);
   Raster<std::uint8_t> lakes = s.dem.like<std::uint8_t>(0);
   for (std::size_t i = 0; i < water.size(); ++i) lakes[i] = water[i] == 1;

@@ -20,6 +20,7 @@
 
 #include "core/error.hpp"
 #include "core/json_input.hpp"
+#include "core/schema_error.hpp"
 #include "core/text.hpp"
 #include "core/geodesy.hpp"
 #include "plugin/terrapolis_plugin.h"
@@ -274,11 +275,8 @@ void validate_params(const LoadedPlugin& plugin, const json& params) {
   valijson::ValidationResults results;
   valijson::adapters::NlohmannJsonAdapter target(params);
   if (validator.validate(schema, target, &results)) return;
-  valijson::ValidationResults::Error best;
-  for (const auto& e : results)
-    if (e.context.size() > best.context.size()) best = e;
-  const std::string pointer = json_pointer_of(best.context);
-  throw bad_input(where(plugin) + ": params" + (pointer == "/" ? "" : pointer) + ": " + best.description);
+  const auto [pointer, problem] = schema_error(results);
+  throw bad_input(where(plugin) + ": params" + (pointer == "/" ? "" : pointer) + ": " + problem);
 }
 
 PluginSet load_plugins(const std::vector<PluginSpec>& specs, const Log& log) {

@@ -22,9 +22,15 @@ def parameter_name(option):
     return re.sub(r"[^A-Za-z0-9_]", "_", option["name"].lstrip("-"))
 
 
+# Units that say nothing a dialog label needs (the schema's x-unit of counts, switches, choices, paths).
+SILENT_UNITS = {None, "", "1", "flag", "choice", "path", "list", "name", "object", "CRS"}
+
+
 def make_parameter(option):
     """The Processing parameter for one option, or None for options the dialog does not offer."""
     name, help_text, kind = parameter_name(option), option["help"], option.get("kind")
+    if option.get("unit") not in SILENT_UNITS:
+        help_text += " [" + option["unit"] + "]"
     optional = not option["required"]
     default = option.get("default")
     if option["type"] == "boolean":

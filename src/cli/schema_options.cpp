@@ -1,0 +1,177 @@
+// Command-line options from the scenario schema: one declaration (the schema) for the scenario,
+// the command line, --describe-json and the QGIS provider.
+// SPDX-License-Identifier: MIT
+#include "cli/schema_options.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <map>
+
+#include "core/text.hpp"
+
+namespace terrapolis::cli {
+namespace {
+
+using json = nlohmann::ordered_json;
+
+std::map<const CLI::Option*, OptionSource>& sources() {
+  static std::map<const CLI::Option*, OptionSource> all;
+  return all;
+}
+
+constexpr const char* kKindNames[] = {"raster_in",  "vector_in",  "file_in",  "folder_in",
+                                      "raster_out", "vector_out", "file_out", "folder_out"};
+
+void collect(const json& schema, const std::string& pointer, const std::string& command,
+             std::vector<std::pair<std::string, json>>& out) {
+  if (!schema.contains("properties")) return;
+  for (const auto& [key, field] : schema["properties"].items()) {
+    const std::string at = pointer + "/" + key;
+    if (field.contains("x-cli") && field["x-cli"].contains(command)) out.emplace_back(at, field);
+    collect(field, at, command, out);
+  }
+}
+
+/// The command's x-cli entry: its flag and, when the command's default differs, that default.
+struct CliEntry {
+  std::string flag;
+  bool own_default = false;
+  json default_value;
+};
+CliEntry cli_entry(const json& field, const std::string& command) {
+  const json& e = field["x-cli"][command];
+  if (e.is_string()) return {e.get<std::string>(), false, field.value("default", json())};
+  return {e.at("flag").get<std::string>(), e.contains("default"), e.contains("default") ? e["default"] : field.value("default", json())};
+}
+
+/// Units worth printing in --help ("1", "flag", "choice" say nothing a reader needs).
+bool printable_unit(const std::string& unit) {
+  static const char* silent[] = {"", "1", "flag", "choice", "path", "list", "name", "object", "CRS"};
+  return std::none_of(std::begin(silent), std::end(silent), [&](const char* s) { return unit == s; });
+}
+
+std::string help_of(const json& field) {
+  const std::string unit = field.value("x-unit", "");
+  std::string help = field.value("description", "");
+  if (printable_unit(unit)) help += " [" + unit + "]";
+  return help;
+}
+
+std::string type_name_of(const json& field) {
+  if (field.contains("enum")) {
+    std::string names;
+    for (const auto& v : field["enum"]) names += (names.empty() ? "" : ",") + v.get<std::string>();
+    return "{" + names + "}";
+  }
+  const std::string type = field.value("type", "string");
+  return type == "integer" ? "INT" : type == "number" ? "FLOAT" : "TEXT";
+}
+
+std::string default_text(const json& value) {
+  if (value.is_null()) return "";
+  return value.is_string() ? value.get<std::string>() : value.dump();
+}
+
+/// The typed text as the field's JSON type; left as text when it is not one (the schema then refuses it).
+json typed_value(const json& field, const std::string& text) {
+  const std::string type = field.value("type", "string");
+  if (type == "integer") {
+    std::size_t used = 0;
+    try {
+      const long long v = std::stoll(text, &used);
+      if (used == text.size()) return v;
+    } catch (const std::exception&) {
+    }
+    return text;
+  }
+  if (type == "number") {
+    if (const auto v = parse_number(text)) return *v;
+    return text;
+  }
+  return text;
+}
+
+std::string dotted(const std::string& pointer) {
+  std::string d = pointer.substr(1);
+  std::replace(d.begin(), d.end(), '/', '.');
+  return d;
+}
+
+}  // namespace
+
+CLI::Option* file_kind(CLI::Option* option, FileKind kind) {
+  sources()[option] = {"", json(), kKindNames[int(kind)]};
+  return option;
+}
+
+const OptionSource* option_source(const CLI::Option& option) {
+  const auto it = sources().find(&option);
+  return it == sources().end() ? nullptr : &it->second;
+}
+
+std::vector<std::pair<std::string, json>> schema_fields_of(const std::string& command) {
+  std::vector<std::pair<std::string, json>> out;
+  collect(json::parse(pipeline::scenario_schema_text()), "", command, out);
+  return out;
+}
+
+void SchemaOptions::setup(CLI::App& app, const std::string& command) {
+  command_ = command;
+  for (auto& [pointer, field] : schema_fields_of(command)) {
+    const CliEntry cli = cli_entry(field, command);
+    Entry& e = entries_.emplace_back();
+    e.pointer = pointer;
+    e.flag = cli.flag;
+    e.field = field;
+    e.field["default"] = cli.default_value;
+    e.own_default = cli.own_default;
+    e.field.erase("x-cli");
+    if (field.value("type", "") == "boolean") {
+      e.on = cli.default_value.is_boolean() && cli.default_value.get<bool>();
+      e.option = app.add_flag(cli.flag, e.on, help_of(field));
+    } else {
+      e.option = app.add_option(cli.flag, e.text, help_of(field))->type_name(type_name_of(field));
+      if (!cli.default_value.is_null()) e.option->default_str(default_text(cli.default_value));
+    }
+    sources()[e.option] = {pointer, e.field, field.value("x-kind", "")};
+  }
+}
+
+bool SchemaOptions::given(const std::string& pointer) const {
+  for (const Entry& e : entries_)
+    if (e.pointer == pointer) return e.option->count() > 0;
+  return false;
+}
+
+pipeline::Scenario SchemaOptions::scenario(const std::vector<std::string>& base) const {
+  std::vector<std::string> sets = base;
+  for (const Entry& e : entries_) {
+    const bool flag = e.field.value("type", "") == "boolean";
+    if (e.option->count() > 0) sets.push_back(dotted(e.pointer) + "=" + (flag ? json(e.on) : typed_value(e.field, e.text)).dump());
+    else if (e.own_default && !e.field["default"].is_null()) sets.push_back(dotted(e.pointer) + "=" + e.field["default"].dump());
+  }
+  const std::string source = "command line";
+  try {
+    return pipeline::scenario_from_text("{}", source, sets);
+  } catch (const Error& error) {
+    std::string message = error.what();
+    if (message.starts_with(source + ": ")) message = message.substr(source.size() + 2);
+    throw Error(error.kind(), with_flags(message));
+  }
+}
+
+std::string SchemaOptions::with_flags(std::string message) const {
+  std::vector<std::pair<std::string, std::string>> longest_first = aliases_;
+  for (const Entry& e : entries_) longest_first.emplace_back(e.pointer, e.flag.substr(0, e.flag.find(',')));
+  std::sort(longest_first.begin(), longest_first.end(), [](const auto& a, const auto& b) { return a.first.size() > b.first.size(); });
+  for (const auto& [pointer, flag] : longest_first)
+    for (const std::string& name : {pointer, dotted(pointer)}) {
+      if (name.find_first_of("/.") == std::string::npos) continue;  // "seed": a word, not a name
+      for (std::size_t at = message.find(name); at != std::string::npos; at = message.find(name, at + flag.size()))
+        message.replace(at, name.size(), flag);
+    }
+  return message;
+}
+
+}  // namespace terrapolis::cli
