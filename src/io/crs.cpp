@@ -110,10 +110,10 @@ void check_output(const std::string& path, bool overwrite) {
 
 Crs crs_from_user(const std::string& definition) {
   OGRSpatialReference srs;
-  CPLErrorReset();
-  CPLPushErrorHandler(CPLQuietErrorHandler);
-  const OGRErr err = srs.SetFromUserInput(definition.c_str());
-  CPLPopErrorHandler();
+  const OGRErr err = [&] {
+    const detail::QuietGdal quiet;
+    return srs.SetFromUserInput(definition.c_str());
+  }();
   if (err != OGRERR_NONE) throw bad_input("unknown CRS '" + definition + "'");
   return detail::describe(srs);
 }

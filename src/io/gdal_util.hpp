@@ -1,6 +1,7 @@
 // Private helpers shared by the io sources (the only files that see GDAL headers).
 // SPDX-License-Identifier: MIT
 #pragma once
+#include <cpl_error.h>
 #include <ogr_spatialref.h>
 
 #include <string>
@@ -9,6 +10,18 @@
 #include "core/raster.hpp"
 
 namespace terrapolis::detail {
+
+/// Silences GDAL's stderr output for a scope and clears the last error; errors are read with
+/// CPLGetLastErrorMsg (last_gdal_error). The one GDAL error guard of the io sources.
+struct QuietGdal {
+  QuietGdal() {
+    CPLPushErrorHandler(CPLQuietErrorHandler);
+    CPLErrorReset();
+  }
+  ~QuietGdal() { CPLPopErrorHandler(); }
+  QuietGdal(const QuietGdal&) = delete;
+  QuietGdal& operator=(const QuietGdal&) = delete;
+};
 
 /// Describes an OGR spatial reference as a Crs.
 Crs describe(const OGRSpatialReference& srs);

@@ -32,11 +32,7 @@ struct DatasetCloser {
 };
 using DatasetPtr = std::unique_ptr<GDALDataset, DatasetCloser>;
 
-/// Silences GDAL's stderr output for a scope; errors are read with CPLGetLastErrorMsg.
-struct QuietGdal {
-  QuietGdal() { CPLPushErrorHandler(CPLQuietErrorHandler); CPLErrorReset(); }
-  ~QuietGdal() { CPLPopErrorHandler(); }
-};
+using detail::QuietGdal;
 
 DatasetPtr open_raster(const std::string& path) {
   init_gdal();

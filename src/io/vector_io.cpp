@@ -11,6 +11,7 @@
 #include <atomic>
 #include <filesystem>
 #include <memory>
+#include <optional>
 
 #include "core/error.hpp"
 #include "io/gdal_util.hpp"
@@ -79,12 +80,11 @@ void write_vector(const std::string& path, const VectorLayer& layer, bool overwr
   // with every write checked (a full disk fails the command instead of leaving a cut file).
   static std::atomic<int> serial{0};
   const std::string mem = "/vsimem/terrapolis-" + std::to_string(serial++) + ext;
-  CPLPushErrorHandler(CPLQuietErrorHandler);
-  CPLErrorReset();
+  std::optional<detail::QuietGdal> quiet(std::in_place);
   auto fail = [&](GDALDataset* ds, const std::string& what) {
     const std::string msg = detail::last_gdal_error(what);
     if (ds) GDALClose(GDALDataset::ToHandle(ds));
-    CPLPopErrorHandler();
+    quiet.reset();
     VSIUnlink(mem.c_str());
     throw processing_error(path + ": cannot write output (" + msg + ")");
   };
@@ -123,7 +123,7 @@ void write_vector(const std::string& path, const VectorLayer& layer, bool overwr
   GDALClose(GDALDataset::ToHandle(ds));
   const bool closed = CPLGetLastErrorType() < CE_Failure;
   const std::string msg = detail::last_gdal_error("write failed");
-  CPLPopErrorHandler();
+  quiet.reset();
   vsi_l_offset size = 0;
   GByte* bytes = closed ? VSIGetMemFileBuffer(mem.c_str(), &size, FALSE) : nullptr;
   const std::string tmp = detail::temporary_name(path);
@@ -140,10 +140,10 @@ VectorLayer read_vector(const std::string& path, const Crs& target) {
   init_gdal();
   std::error_code ec;
   if (!std::filesystem::exists(path, ec) && path.rfind("/vsi", 0) != 0) throw bad_input(path + ": no such file");
-  CPLPushErrorHandler(CPLQuietErrorHandler);
-  CPLErrorReset();
-  GDALDataset* ds = GDALDataset::Open(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY);
-  CPLPopErrorHandler();
+  GDALDataset* ds = [&] {
+    const detail::QuietGdal quiet;
+    return GDALDataset::Open(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY);
+  }();
   if (!ds || ds->GetLayerCount() == 0) {
     if (ds) GDALClose(GDALDataset::ToHandle(ds));
     throw bad_input(path + ": not a vector layer GDAL can read");
