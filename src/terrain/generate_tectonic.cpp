@@ -12,6 +12,7 @@
 #include <queue>
 
 #include "core/neighbours.hpp"
+#include "terrain/distance_field.hpp"
 #include "terrain/generators.hpp"
 #include "terrain/random.hpp"
 
@@ -37,31 +38,6 @@ double fbm(std::uint64_t seed, double x, double y, int octaves, double hurst = 0
     x *= 2, y *= 2;
   }
   return sum / norm;
-}
-
-/// Chamfer distance (in cells, 8 neighbours) to the cells where `source` is set, with the index
-/// of the nearest source cell.
-void distance_to(const std::vector<char>& source, int cols, int rows, std::vector<double>& dist, std::vector<std::size_t>& nearest) {
-  const std::size_t n = std::size_t(cols) * rows;
-  dist.assign(n, 1e30);
-  nearest.assign(n, 0);
-  using Item = std::pair<double, std::size_t>;
-  std::priority_queue<Item, std::vector<Item>, std::greater<>> queue;
-  for (std::size_t i = 0; i < n; ++i)
-    if (source[i]) dist[i] = 0, nearest[i] = i, queue.push({0.0, i});
-  while (!queue.empty()) {
-    const auto [d, i] = queue.top();
-    queue.pop();
-    if (d > dist[i]) continue;
-    const int c = int(i % std::size_t(cols)), r = int(i / std::size_t(cols));
-    for (int k = 0; k < 8; ++k) {
-      const int nc = c + dcol[std::size_t(k)], nr = r + drow[std::size_t(k)];
-      if (nc < 0 || nr < 0 || nc >= cols || nr >= rows) continue;
-      const std::size_t j = std::size_t(nr) * std::size_t(cols) + std::size_t(nc);
-      const double nd = d + (is_diagonal(k) ? std::sqrt(2.0) : 1.0);
-      if (nd < dist[j]) dist[j] = nd, nearest[j] = nearest[i], queue.push({nd, j});
-    }
-  }
 }
 
 struct Plates {
@@ -292,6 +268,7 @@ GeneratedTerrain generate_tectonic(const GenerateRequest& request) {
     for (const auto& q : p.line)
       p.width_m.push_back(std::max(1.0, std::log2(area[std::size_t(q[1]) * std::size_t(cols) + std::size_t(q[0])] / channel_cells)) * request.cell_m);
   out.skeleton.rivers = reaches_from_paths(paths);
+  out.channel_head_m2 = channel_cells * request.cell_m * request.cell_m;
   out.timings.emplace_back("tectonic", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   return out;
 }
