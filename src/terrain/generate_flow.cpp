@@ -581,7 +581,7 @@ GeneratedTerrain generate_flow(const GenerateRequest& request) {
   // DMMC between two beds at one altitude gives a floor that drains anywhere (45 % of the river
   // length on a D8 stream at 257², seed 3). The cells half-way between rivers (where the nearest
   // river cell jumps) are fixed at the basin height plus a hillslope from the nearer bed as steep
-  // as the basin's own slope there (at least 0.15 m/m), so that the ground falls towards the river
+  // as the basin's own slope there (0.15 to 2 m/m, the rise at most half the relief), so that the ground falls towards the river
   // at least as fast as down the basin and DMMC draws a valley around every river.
   {
     auto gradient = [&](int c, int r) {  // |grad a| in m/m, central differences
@@ -606,8 +606,9 @@ GeneratedTerrain generate_flow(const GenerateRequest& request) {
                                          double(a / std::size_t(cols)) - double(b / std::size_t(cols)));
           divide = jump > 3;
         }
-        const double hill = std::max(0.15, gradient(c, r));
-        if (divide) dem[i] = float(std::max<double>(f.a[i], dem[nearest[i]]) + hill * dist[i] * request.cell_m);
+        const double hill = std::clamp(gradient(c, r), 0.15, 2.0);  // at most 63°
+        const double rise = std::min(hill * dist[i] * request.cell_m, 0.5 * request.relief_m);
+        if (divide) dem[i] = float(std::max<double>(f.a[i], dem[nearest[i]]) + rise);
       }
   }
   const auto t1 = clock::now();

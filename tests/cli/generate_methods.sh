@@ -36,7 +36,8 @@ gt, cols, rows = ds.GetGeoTransform(), ds.RasterXSize, ds.RasterYSize
 srs = osr.SpatialReference(); srs.ImportFromWkt(ds.GetProjection())
 srs.SetAxisMappingStrategy(osr.OAMS_TRADITIONAL_GIS_ORDER)
 def lines(path, kind=None):
-    layer = ogr.Open(path).GetLayer()
+    source = ogr.Open(path)  # kept alive while its layer is read
+    layer = source.GetLayer()
     src = layer.GetSpatialRef(); src.SetAxisMappingStrategy(osr.OAMS_TRADITIONAL_GIS_ORDER)
     tr = osr.CoordinateTransformation(src, srs)
     for f in layer:
@@ -87,7 +88,7 @@ PY
 "$BIN" --quiet generate "$T/given.tif" --method flow --size 257x257 --cell 30 --ridges "$T/ridges.geojson"
 /usr/bin/python3 -c "
 from osgeo import gdal; import sys
-a = gdal.Open('$T/given.tif').GetRasterBand(1).ReadAsArray()
+ds = gdal.Open('$T/given.tif'); a = ds.GetRasterBand(1).ReadAsArray()
 sys.exit(0 if a[119, 130] > a[30, 30] + 500 else 1)"
 # Bad input: one line, exit 2, nothing written.
 set +e
