@@ -52,7 +52,7 @@ Cell floor_cell(double x, double y) { return {int(std::floor(x)), int(std::floor
 struct RidgeParams {
   double speed = 10;                  ///< V, cells per step (the thesis's multi-ridge model: 10)
   double turn_local = kPi / 10;       ///< δΘ_l
-  double turn_global = kPi / 2;       ///< δΘ_g
+  double turn_global = kPi / 4;       ///< δΘ_g: "une petite variation d'orientation" for many ridges (fig. 2.8 bottom)
   double sigma1 = 30, sigma2 = 90;    ///< cells: slope width (4 σ1) and crest decay (eq. 2.2-2.3)
 };
 
@@ -480,7 +480,7 @@ GeneratedTerrain generate_flow(const GenerateRequest& request) {
     }
   Skeleton skeleton;
   if (request.lines.empty()) {
-    const int pairs = std::max(2, int(std::lround(double(cols) * rows / 30000.0)));
+    const int pairs = std::max(2, int(std::lround(double(cols) * rows / 60000.0)));
     skeleton.ridges = random_ridges(f, pairs, request.relief_m, rp, rng);
   } else {
     skeleton.ridges = given_ridges(f, request.lines, request.relief_m, rp);
