@@ -94,6 +94,8 @@ sys.exit(0 if a[119, 130] > a[30, 30] + 500 else 1)"
 set +e
 "$BIN" generate "$T/bad.tif" --method nope --size 65x65 --cell 30 2>"$T/err"; rc=$?
 [ $rc -eq 2 ] && grep -q -- "--method" "$T/err" && [ ! -e "$T/bad.tif" ] || { echo "bad method: rc=$rc"; cat "$T/err"; exit 1; }
+"$BIN" generate "$T/bad.tif" --method tectonic --size 65x65 --cell 30 --ridges "$T/ridges.geojson" 2>"$T/err"; rc=$?
+[ $rc -eq 2 ] && grep -q -- "--ridges" "$T/err" && [ ! -e "$T/bad.tif" ] || { echo "ridges for tectonic: rc=$rc"; cat "$T/err"; exit 1; }
 echo '{"type":"FeatureCollection","features":[]}' > "$T/empty.geojson"
 "$BIN" generate "$T/bad.tif" --method flow --size 65x65 --cell 30 --ridges "$T/empty.geojson" 2>"$T/err"; rc=$?
 [ $rc -eq 2 ] && grep -q "empty.geojson" "$T/err" && [ ! -e "$T/bad.tif" ] && [ ! -e "$T/bad.skeleton.geojson" ] || { echo "empty ridges: rc=$rc"; cat "$T/err"; exit 1; }
