@@ -1,0 +1,38 @@
+// What every terrain generator of `terrapolis generate --method` takes and gives.
+// SPDX-License-Identifier: MIT
+#pragma once
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/progress.hpp"
+#include "core/raster.hpp"
+#include "terrain/skeleton.hpp"
+#include "terrain/subdivision.hpp"
+
+namespace terrapolis::terrain {
+
+struct GenerateRequest {
+  Raster<float> grid;            ///< the empty grid (NaN), georeferenced; square cells of cell_m
+  double cell_m = 30;
+  std::uint64_t seed = 1;
+  double relief_m = 1000;        ///< height of the highest crest above the outlets
+  DmmcParams dmmc;               ///< the DMMC that fills between the skeleton's cells
+  std::vector<std::vector<GridPoint>> lines;  ///< user lines (flow: ridges), cell coordinates
+  std::vector<GridPoint> points;               ///< user points (tectonic: mountain points)
+  Progress* progress = nullptr;
+};
+
+struct GeneratedTerrain {
+  Raster<float> dem;                  ///< metres, on the request's grid
+  Skeleton skeleton;                  ///< what the DEM was built from (empty for plain DMMC)
+  std::optional<double> sea_level_m;  ///< cells at or below it are sea
+  /// Upstream area (m²) at which the generator starts its rivers: the D8 stream threshold of the
+  /// consistency check. None: the median D8 area at the generated channel heads.
+  std::optional<double> channel_head_m2;
+  std::vector<std::pair<std::string, double>> timings;  ///< seconds by phase, for logs only (never in files)
+};
+
+}  // namespace terrapolis::terrain
