@@ -19,6 +19,7 @@
 #include "density/density.hpp"
 #include "hydro/hydrometry.hpp"
 #include "io/output_set.hpp"
+#include "io/mask_io.hpp"
 #include "io/raster_io.hpp"
 #include "terrapolis/version.hpp"
 
@@ -79,7 +80,7 @@ class DensityCommand final : public Command {
     app.add_option("--layer", layers_, "User raster and its weight, FILE:WEIGHT (repeatable); values in [0,1] or rescaled from their range");
     app.add_option("--exclude", exclusions_, "Exclusion raster: non-zero cells are uninhabitable (repeatable)");
     app.add_option("--hydrometry", hydrometry_path_, "Hydrometry raster in [0,1], resampled to the DEM grid");
-    app.add_option("--water-mask", options_.water_mask, "Raster whose non-zero cells are water");
+    app.add_option("--water-mask", water_mask_, "Raster whose non-zero cells are water");
     app.add_flag("--nodata-is-sea", options_.nodata_is_sea, "Nodata cells are sea (SRTM and similar coasts)");
     app.add_option("--sea-level", options_.sea_level_m, "Cells at or below this altitude are water, metres")->capture_default_str();
     app.add_option("--r-min", options_.r_min_m, "Inner ring radius and plain disc radius (a hamlet), metres")->capture_default_str();
@@ -95,11 +96,11 @@ class DensityCommand final : public Command {
 
   void run(Context& context) override {
     density::DensityOptions options = options_;
-    parse_options(options);
+    const std::vector<std::pair<std::string, double>> layers = parse_options(options);
     // Outputs refused before any work; hydrometry.tif is written only when used.
-    std::vector<std::string> inputs = {dem_.path, hydrometry_path_, options.water_mask};
-    for (const auto& layer : options.layers) inputs.push_back(layer.first);
-    inputs.insert(inputs.end(), options.exclusions.begin(), options.exclusions.end());
+    std::vector<std::string> inputs = {dem_.path, hydrometry_path_, water_mask_};
+    for (const auto& layer : layers) inputs.push_back(layer.first);
+    inputs.insert(inputs.end(), exclusions_.begin(), exclusions_.end());
     OutputSet outputs("density", inputs, overwrite_);
     const fs::path dir = outputs.folder(out_dir_);
     const bool write_hydro = options.weights[1] != 0 || options.river_bed_cap.has_value();
@@ -109,6 +110,7 @@ class DensityCommand final : public Command {
     const auto t0 = clock::now();
     const plugin::PluginSet plugins = plugins_.load(context.log);
     const Dem dem = dem_.read();
+    read_files(dem, layers, options);
     const Hydrometry hydrometry = obtain_hydrometry(dem, options, hydrometry_path_, context.progress);
     plugin::add_to_density(plugin::density_factors(plugins, dem, context.progress, context.log), options);
     const auto t1 = clock::now();
@@ -155,7 +157,8 @@ class DensityCommand final : public Command {
     return buf;
   }
 
-  void parse_options(density::DensityOptions& options) const {
+  /// Sets the options given as text; returns the --layer files with their weights.
+  std::vector<std::pair<std::string, double>> parse_options(density::DensityOptions& options) const {
     if (!weights_.empty()) {
       std::stringstream ss(weights_);
       std::string part;
@@ -164,20 +167,31 @@ class DensityCommand final : public Command {
       if (w.size() != 4) throw bad_input("--weights: expected 4 numbers C,H,P,L but got '" + weights_ + "'");
       for (int i = 0; i < 4; ++i) options.weights[std::size_t(i)] = w[std::size_t(i)];
     }
+    std::vector<std::pair<std::string, double>> layers;
     for (const std::string& l : layers_) {
       const auto colon = l.rfind(':');
       if (colon == std::string::npos || colon == 0) throw bad_input("--layer: expected FILE:WEIGHT but got '" + l + "'");
-      options.layers.emplace_back(l.substr(0, colon), number_option("--layer " + l.substr(0, colon), l.substr(colon + 1)));
+      layers.emplace_back(l.substr(0, colon), number_option("--layer " + l.substr(0, colon), l.substr(colon + 1)));
     }
-    options.exclusions = exclusions_;
     if (!max_slope_.empty()) options.max_slope_deg = number_option("--max-slope", max_slope_);
     if (!river_bed_cap_.empty()) options.river_bed_cap = number_option("--river-bed-cap", river_bed_cap_);
+    return layers;
+  }
+
+  /// The --layer, --exclude and --water-mask rasters on the DEM's grid (layers first among the factors).
+  void read_files(const Dem& dem, const std::vector<std::pair<std::string, double>>& layers, density::DensityOptions& options) const {
+    for (const auto& [path, weight] : layers) {
+      Raster<float> values = read_resampled(path, dem.georef(), dem.cols(), dem.rows(), Resampling::bilinear);
+      density::to_unit_range(values);
+      options.factors.push_back({fs::path(path).filename().string(), std::move(values), weight});
+    }
+    for (const std::string& path : exclusions_) options.exclusion_masks.push_back(read_mask(path, dem.georef(), dem.cols(), dem.rows()));
+    if (!water_mask_.empty()) options.water_mask = read_mask(water_mask_, dem.georef(), dem.cols(), dem.rows());
   }
 
   std::vector<std::pair<std::string, std::string>> provenance(const density::DensityOptions& o) const {
     std::ostringstream w;
     w << o.weights[0] << ',' << o.weights[1] << ',' << o.weights[2] << ',' << o.weights[3];
-    for (const auto& [path, weight] : o.layers) w << ';' << fs::path(path).filename().string() << ':' << weight;
     for (const auto& f : o.factors) w << ';' << f.name << ':' << f.weight;
     std::vector<std::pair<std::string, std::string>> m = {
         {"TERRAPOLIS_VERSION", terrapolis::version},
@@ -217,7 +231,7 @@ class DensityCommand final : public Command {
 
   DemInput dem_;
   PluginOptions plugins_;
-  std::string out_dir_, weights_, hydrometry_path_, max_slope_, river_bed_cap_;
+  std::string out_dir_, weights_, hydrometry_path_, water_mask_, max_slope_, river_bed_cap_;
   std::vector<std::string> layers_, exclusions_;
   density::DensityOptions options_;
   bool report_ = false, cog_ = false, overwrite_ = false;
