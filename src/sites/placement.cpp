@@ -295,7 +295,8 @@ SitesResult place_sites(const Raster<float>& density, const Raster<std::uint8_t>
     if (!table.populations.empty()) s.population = table.populations[std::size_t(s.radius_class)][std::size_t(c.kept)];
     ++c.kept;
   }
-  if (options.quotas == SitesOptions::Quotas::rank_size && result.land_area_km2 > 0) {
+  // Suburbs by influence (rank_size, paris: Manhattan's regular tiling has none).
+  if (options.quotas == SitesOptions::Quotas::rank_size && options.mode == SitesOptions::Mode::paris && result.land_area_km2 > 0) {
     const double people_per_km2 = result.target_population / result.land_area_km2;
     std::vector<double> influence(result.sites.size());
     for (std::size_t k = 0; k < influence.size(); ++k)

@@ -54,7 +54,7 @@ struct SitesOptions {
   /// so a town's reach grows as the square root of its size and shrinks where land is crowded;
   /// a settlement at most half as large whose centre lies in it becomes its suburb. 1: the area
   /// whose people equal the town's own (the central place's complementary region, Christaller
-  /// 1933, at its simplest); 0: no suburbs beyond partial inclusions.
+  /// 1933, at its simplest); 0: no suburbs beyond partial inclusions. Mode manhattan: none.
   double influence_factor = 1;
   // ---- belhadj2007 -----------------------------------------------------------------------------
   std::uint64_t seed = 1;   ///< seed of the candidate draw (std::mt19937_64)
