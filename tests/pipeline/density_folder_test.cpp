@@ -5,19 +5,27 @@
 #include <cmath>
 
 #include "core/error.hpp"
+#include "io/crs.hpp"
 #include "io/raster_io.hpp"
 #include "pipeline/density_folder.hpp"
-#include "sites/fixtures.hpp"
+#include "support/georefs.hpp"
 #include "support/temp_dir.hpp"
 
 using namespace terrapolis;
 
+namespace {
+Georef utm_grid() {
+  Georef g = test::projected(100.0);
+  g.crs = crs_from_user("EPSG:32632");
+  return g;
+}
+}  // namespace
+
 // A 3 x 2 grid: buildable 1, 0, 255 (nodata) and density 0.5, 0, NaN read back cell for cell.
 TEST(DensityFolder, NodataStaysNodata) {
   test::TempDir dir;
-  const auto grid = fixtures::flat_scenario(3, 2, 100.0);
-  Raster<float> density = grid.density;
-  Raster<std::uint8_t> buildable = grid.buildable;
+  Raster<float> density(3, 2, utm_grid(), 0.0f);
+  Raster<std::uint8_t> buildable(3, 2, utm_grid(), 0);
   buildable.nodata = 255;
   const std::uint8_t b[6] = {1, 0, 255, 1, 1, 0};
   const float d[6] = {0.5f, 0.0f, NAN, 1.0f, 0.25f, 0.0f};
@@ -36,10 +44,10 @@ TEST(DensityFolder, NodataStaysNodata) {
 
 TEST(DensityFolder, RefusesAMissingMaskAndOutOfRangeDensities) {
   test::TempDir dir;
-  Raster<float> density = fixtures::flat_scenario(3, 2, 100.0).density;
+  Raster<float> density(3, 2, utm_grid(), 0.5f);
   write_raster((dir.path() / "density.tif").string(), density);
   EXPECT_THROW(pipeline::read_density_folder(dir.path().string()), Error);  // no buildable.tif
-  write_raster((dir.path() / "buildable.tif").string(), fixtures::flat_scenario(3, 2, 100.0).buildable);
+  write_raster((dir.path() / "buildable.tif").string(), Raster<std::uint8_t>(3, 2, utm_grid(), 1));
   density[0] = 2.0f;
   WriteOptions replace;
   replace.overwrite = true;
