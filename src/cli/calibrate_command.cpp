@@ -19,6 +19,7 @@
 #include "io/output_set.hpp"
 #include "io/raster_io.hpp"
 #include "io/text_io.hpp"
+#include "pipeline/places.hpp"
 #include "pipeline/scenario.hpp"
 #include "pipeline/stage_options.hpp"
 #include "sites/sites.hpp"
@@ -189,13 +190,14 @@ class CalibrateCommand final : public Command {
     const Dem dem = read_dem(dem_path);
     hydro::HydroResult hydro = hydro::run_hydro(dem, pipeline::hydro_options(scenario), context.progress);
     density::DensityOptions options = pipeline::density_options(scenario);
+    pipeline::read_density_files(scenario, dem, options);
     options.terrain_terms = true;
     options.rivers = pipeline::river_cells(hydro.accumulation, scenario);
     const density::DensityResult model = density::compute_density(dem, hydro.hydrometry, options, context.progress);
     const std::vector<std::uint8_t> land = density::land_cells(model);
     Region r;
     r.name = std::filesystem::path(dem_path).stem().string();
-    const std::vector<density::Place> places = density::read_places(places_path, dem, land, r.dropped);
+    const std::vector<density::Place> places = pipeline::read_places(places_path, dem, land, r.dropped);
     if (places.empty()) throw bad_input(places_path + ": no place on the land of " + dem_path);
     std::vector<std::size_t> cells;
     for (std::size_t i = 0; i < land.size(); ++i)

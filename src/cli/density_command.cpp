@@ -20,6 +20,7 @@
 #include "density/density.hpp"
 #include "hydro/hydrometry.hpp"
 #include "io/output_set.hpp"
+#include "io/mask_io.hpp"
 #include "io/raster_io.hpp"
 #include "pipeline/stage_options.hpp"
 #include "terrapolis/version.hpp"
@@ -93,9 +94,9 @@ class DensityCommand final : public Command {
     const pipeline::Scenario scenario = schema_.scenario(table_options());
     density::DensityOptions options = schema_.settings([&] { return pipeline::density_options(scenario); });
     // Outputs refused before any work; hydrometry.tif is written only when used.
-    std::vector<std::string> inputs = {dem_.path, hydrometry_path_, options.water_mask};
-    for (const auto& layer : options.layers) inputs.push_back(layer.first);
-    inputs.insert(inputs.end(), options.exclusions.begin(), options.exclusions.end());
+    std::vector<std::string> inputs = pipeline::density_files(scenario);
+    inputs.push_back(dem_.path);
+    inputs.push_back(hydrometry_path_);
     OutputSet outputs("density", inputs, overwrite_);
     const fs::path dir = outputs.folder(out_dir_);
     const bool write_hydro = options.weights[1] != 0 || options.river_bed_cap.has_value();
@@ -105,6 +106,7 @@ class DensityCommand final : public Command {
     const auto t0 = clock::now();
     const plugin::PluginSet plugins = plugins_.load(context.log);
     const Dem dem = dem_.read();
+    pipeline::read_density_files(scenario, dem, options);
     const Hydrometry hydrometry = obtain_hydrometry(dem, options, hydrometry_path_, context.progress);
     plugin::add_to_density(plugin::density_factors(plugins, dem, context.progress, context.log), options);
     const auto t1 = clock::now();
@@ -177,7 +179,6 @@ class DensityCommand final : public Command {
   std::vector<std::pair<std::string, std::string>> provenance(const density::DensityOptions& o) const {
     std::ostringstream w;
     w << o.weights[0] << ',' << o.weights[1] << ',' << o.weights[2] << ',' << o.weights[3];
-    for (const auto& [path, weight] : o.layers) w << ';' << fs::path(path).filename().string() << ':' << weight;
     for (const auto& f : o.factors) w << ';' << f.name << ':' << f.weight;
     std::vector<std::pair<std::string, std::string>> m = {
         {"TERRAPOLIS_VERSION", terrapolis::version},

@@ -16,6 +16,7 @@
 #include "hydro/hydrometry.hpp"
 #include "io/output_set.hpp"
 #include "io/raster_io.hpp"
+#include "pipeline/density_folder.hpp"
 #include "pipeline/stage_options.hpp"
 #include "sites/layers.hpp"
 #include "sites/sites.hpp"
@@ -23,43 +24,9 @@
 namespace terrapolis::cli {
 namespace {
 
-/// density.tif (float, [0,1]) and buildable.tif (1 buildable, anything else not) on one grid.
-struct DensityInputs {
-  Raster<float> density;
-  Raster<std::uint8_t> buildable;
-};
-
-DensityInputs read_density_dir(const std::string& dir) {
-  std::error_code ec;
-  if (!std::filesystem::is_directory(dir, ec)) throw bad_input(dir + ": no such folder (expected density.tif and buildable.tif in it)");
-  const std::string density_path = (std::filesystem::path(dir) / "density.tif").string();
-  const std::string buildable_path = (std::filesystem::path(dir) / "buildable.tif").string();
-  if (!std::filesystem::exists(buildable_path, ec)) throw bad_input(buildable_path + ": no such file");
-  DensityInputs in;
-  in.density = read_dem(density_path);
-  for (std::size_t i = 0; i < in.density.size(); ++i) {
-    const float v = in.density[i];
-    if (!std::isnan(v) && !(v >= -1e-6f && v <= 1.0f + 1e-6f))
-      throw bad_input(density_path + ": density values must lie in [0,1] (found " + std::to_string(v) + ")");
-  }
-  const RasterHeader header = read_header(buildable_path);
-  if (header.cols != in.density.cols() || header.rows != in.density.rows())
-    throw bad_input(buildable_path + ": not on the grid of density.tif (" + std::to_string(header.cols) + "x" + std::to_string(header.rows) +
-                    " cells instead of " + std::to_string(in.density.cols()) + "x" + std::to_string(in.density.rows()) + ")");
-  for (int k = 0; k < 6; ++k)
-    if (std::abs(header.georef.transform[std::size_t(k)] - in.density.georef().transform[std::size_t(k)]) >
-        1e-9 * std::max(1.0, std::abs(in.density.georef().transform[std::size_t(k)])))
-      throw bad_input(buildable_path + ": not on the grid of density.tif (different geotransform)");
-  // Same grid (checked above): read the mask as is, nodata as NaN, without warping.
-  const Raster<float> mask = read_dem(buildable_path);
-  in.buildable = in.density.like<std::uint8_t>(0);
-  for (std::size_t i = 0; i < mask.size(); ++i) in.buildable[i] = mask[i] == 1.0f ? 1 : 0;  // nodata (NaN) is not buildable
-  return in;
-}
-
 /// A DEM instead of a density folder: the density model with its defaults (hydrometry by
 /// Belhadj's method, the sea at 0 m as outlet and water), as `terrapolis density` writes it.
-DensityInputs density_from_dem(const std::string& path, Progress& progress) {
+pipeline::DensityFolder density_from_dem(const std::string& path, Progress& progress) {
   const Dem dem = read_dem(path);
   const density::DensityOptions options;
   hydro::HydrometryOptions hydrometry;
@@ -92,7 +59,7 @@ class SitesCommand final : public Command {
     const std::filesystem::path out_dir = outputs.folder(out_);
     const auto t0 = std::chrono::steady_clock::now();
     const bool dem = std::filesystem::is_regular_file(dir_);
-    const DensityInputs in = dem ? density_from_dem(dir_, context.progress) : read_density_dir(dir_);
+    const pipeline::DensityFolder in = dem ? density_from_dem(dir_, context.progress) : pipeline::read_density_folder(dir_);
     const auto t1 = std::chrono::steady_clock::now();
     const sites::SitesResult result = sites::place_sites(in.density, in.buildable, options, context.progress);
     const auto t2 = std::chrono::steady_clock::now();

@@ -1,4 +1,4 @@
-// Real settlements against the density model: reading places, presence/background fits, skill (AUC).
+// Real settlements against the density model: presence/background fits, skill (AUC).
 // SPDX-License-Identifier: MIT
 #pragma once
 #include <array>
@@ -18,13 +18,6 @@ struct Place {
   double x = 0, y = 0;  ///< in the DEM's CRS (the snapped cell's centre when it was moved)
   int col = 0, row = 0;
 };
-
-/// Places read from `path` (GeoJSON, GPKG or any OGR point layer; CSV with lon/lat or x/y
-/// columns in WGS 84) with a numeric `population` (or `pop`) field, kept when they fall on a
-/// land cell of `dem` with data, or within two cells of one (a coastal town on a sea cell
-/// of a coarse grid is moved to the nearest land cell). `dropped` counts the others.
-/// Throws bad_input naming `path` when it cannot be read or has no population field.
-std::vector<Place> read_places(const std::string& path, const Dem& dem, const std::vector<std::uint8_t>& land, int& dropped);
 
 /// 1 on land cells with data (not water, not nodata): from the model's altitude term.
 std::vector<std::uint8_t> land_cells(const DensityResult& model);

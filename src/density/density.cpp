@@ -17,7 +17,6 @@
 #include "core/error.hpp"
 #include "core/geodesy.hpp"
 #include "density/disc_sums.hpp"
-#include "io/raster_io.hpp"
 
 namespace terrapolis::density {
 namespace {
@@ -83,10 +82,6 @@ void check_options(const Dem& dem, const Raster<float>& hydrometry, const Densit
     if (!std::isfinite(w)) throw bad_input("density: terrain weights must be finite numbers");
     any = any || w != 0;
   }
-  for (const auto& [path, w] : o.layers) {
-    if (!std::isfinite(w)) throw bad_input("--layer " + path + ": weight must be a finite number");
-    any = any || w != 0;
-  }
   for (const auto& f : o.factors) {
     if (!std::isfinite(f.weight)) throw bad_input(f.name + ": weight must be a finite number");
     if (f.values.cols() != dem.cols() || f.values.rows() != dem.rows()) throw bad_input(f.name + ": factor is not on the DEM's grid");
@@ -94,6 +89,8 @@ void check_options(const Dem& dem, const Raster<float>& hydrometry, const Densit
   }
   for (const auto& m : o.exclusion_masks)
     if (m.cols() != dem.cols() || m.rows() != dem.rows()) throw bad_input("exclusion mask: not on the DEM's grid");
+  if (o.water_mask.size() && (o.water_mask.cols() != dem.cols() || o.water_mask.rows() != dem.rows()))
+    throw bad_input("water mask: not on the DEM's grid");
   if (!any) throw bad_input("--weights: every weight is 0, the density would be undefined");
 }
 
@@ -111,22 +108,6 @@ float slope_deg(const Dem& dem, const CellMetrics& m, int c, int r) {
   const double dx = derivative(z(c - 1, r), z(c + 1, r), m.width_m[std::size_t(r)], m.width_m[std::size_t(r)]);
   const double dy = derivative(z(c, r - 1), z(c, r + 1), m.height_m[std::size_t(r)], m.height_m[std::size_t(r) + 1]);
   return float(std::atan(std::hypot(dx, dy)) * 180.0 / std::numbers::pi);
-}
-
-/// A user layer on the DEM grid, in [0,1]: used as is when its values already lie in [0,1],
-/// otherwise rescaled linearly from its [min, max] over the grid; NaN (no data) reads as 0.
-Raster<float> read_layer(const std::string& path, const Dem& dem) {
-  Raster<float> layer = read_resampled(path, dem.georef(), dem.cols(), dem.rows(), Resampling::bilinear);
-  float lo = std::numeric_limits<float>::infinity(), hi = -lo;
-  for (std::size_t i = 0; i < layer.size(); ++i)
-    if (!std::isnan(layer[i])) lo = std::min(lo, layer[i]), hi = std::max(hi, layer[i]);
-  const bool rescale = lo < 0 || hi > 1;
-  for (std::size_t i = 0; i < layer.size(); ++i) {
-    float& v = layer[i];
-    if (std::isnan(v)) v = 0;
-    else if (rescale) v = hi > lo ? (v - lo) / (hi - lo) : 0.0f;
-  }
-  return layer;
 }
 
 /// The 1-D squared distance transform of f sampled at increasing positions y (Felzenszwalb &
@@ -236,311 +217,316 @@ std::string describe_output(const std::string& name) {
   return name;
 }
 
-DensityResult compute_density(const Dem& dem, const Raster<float>& hydrometry, const DensityOptions& options,
-                              Progress& progress) {
-  check_options(dem, hydrometry, options);
-  const int cols = dem.cols(), rows = dem.rows();
-  const std::size_t n = dem.size();
-  const CellMetrics metrics = cell_metrics(dem.georef(), cols, rows);
-  DensityResult result;
-  DensityStats& stats = result.stats;
-  stats.cells = n;
+namespace {
 
-  // ---- masks -------------------------------------------------------------------------------
-  std::vector<std::uint8_t> kind(n);
-  std::vector<std::uint8_t> excluded(n, 0);
-  {
-    ProgressStep step(progress, "density: masks");
-    std::optional<Raster<float>> mask;
-    if (!options.water_mask.empty())
-      mask = read_resampled(options.water_mask, dem.georef(), cols, rows, Resampling::nearest);
-    for (const std::string& path : options.exclusions) {
-      const Raster<float> ex = read_resampled(path, dem.georef(), cols, rows, Resampling::nearest);
-      for (std::size_t i = 0; i < n; ++i)
-        if (!std::isnan(ex[i]) && ex[i] != 0) excluded[i] = 1;
+/// The grid as the model sees it: what each cell is, each row's span of land (only land needs
+/// characteristics: a big saving on coastal tiles that are mostly sea and on nodata borders).
+struct Grid {
+  int cols = 0, rows = 0;
+  CellMetrics metrics;
+  std::vector<std::uint8_t> kind;  ///< CellKind per cell
+  std::vector<int> span_lo, span_hi;  ///< land columns of each row: [lo, hi)
+  float land_min = 0, land_max = 0;  ///< range of the land's altitudes (min > max: no land)
+  bool any_unknown = false, any_water = false;
+};
+
+/// Water, land or unknown per cell: water at or below the sea level, on nodata when it is sea,
+/// and on the mask of inland water.
+std::vector<std::uint8_t> cell_kinds(const Dem& dem, const DensityOptions& options) {
+  std::vector<std::uint8_t> kind(dem.size());
+  const Raster<std::uint8_t>& mask = options.water_mask;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, dem.size(), 1 << 16), [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t i = range.begin(); i < range.end(); ++i) {
+      const float z = dem[i];
+      const bool valid = !std::isnan(z);
+      const bool is_water = (valid && z <= options.sea_level_m) || (!valid && options.nodata_is_sea) || (mask.size() && mask[i] != 0);
+      kind[i] = is_water ? water : valid ? land : unknown;
     }
-    for (const auto& ex : options.exclusion_masks)
-      for (std::size_t i = 0; i < n; ++i)
-        if (ex[i] != 0) excluded[i] = 1;
-    step.update(0.5);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1 << 16), [&](const tbb::blocked_range<std::size_t>& range) {
-      for (std::size_t i = range.begin(); i < range.end(); ++i) {
-        const float z = dem[i];
-        const bool valid = !std::isnan(z);
-        const bool is_water = (valid && z <= options.sea_level_m) || (!valid && options.nodata_is_sea) ||
-                              (mask && !std::isnan((*mask)[i]) && (*mask)[i] != 0);
-        kind[i] = is_water ? water : valid ? land : unknown;
-      }
-    });
-    // Uninhabitable: water, too high, excluded, river beds, too steep (§4.2.2.2: the thresholds).
-    result.hydrometry = dem.like<float>(nan_f);
-    result.buildable = dem.like<std::uint8_t>(255);
-    result.buildable.nodata = 255;
-    tbb::parallel_for(tbb::blocked_range<int>(0, rows, 8), [&](const tbb::blocked_range<int>& range) {
-      for (int r = range.begin(); r < range.end(); ++r)
-        for (int x = 0; x < cols; ++x) {
-          const std::size_t i = dem.index(x, r);
-          if (kind[i] == unknown) continue;
-          const float hv = std::isnan(hydrometry[i]) ? 0.0f : std::clamp(hydrometry[i], 0.0f, 1.0f);
-          result.hydrometry[i] = kind[i] == water ? 0.0f : hv;
-          bool ok = kind[i] == land && dem[i] <= options.max_altitude_m && !excluded[i];
-          if (ok && options.river_bed_cap && hv > *options.river_bed_cap) ok = false;
-          if (ok && options.max_slope_deg && slope_deg(dem, metrics, x, r) > *options.max_slope_deg) ok = false;
-          result.buildable[i] = ok ? 1 : 0;
-        }
-    });
-  }
+  });
+  return kind;
+}
 
-  // The plain disc must hold at least the 4-neighbours: raise r_min to the largest cell step.
-  double largest_step = 0;
-  for (int r = 0; r < rows; ++r)
-    largest_step = std::max({largest_step, metrics.width_m[std::size_t(r)], metrics.height_m[std::size_t(r)],
-                             metrics.height_m[std::size_t(r) + 1]});
-  const double r_min = std::max(options.r_min_m, largest_step * (1 + 1e-9));
-  if (!(options.r_max_m > r_min))
-    throw bad_input("--r-max: must be larger than r_min (" + std::to_string(r_min) + " m once raised to the cell size)");
-  stats.r_min_m = r_min;
-  stats.r_max_m = options.r_max_m;
-  const DiscPlan inner(metrics, rows, r_min, options.ring_bands);
-  const DiscPlan outer(metrics, rows, options.r_max_m, options.ring_bands);
-  stats.ring_bands = std::max(inner.band_count(), outer.band_count());
-  stats.ring_exact = inner.exact() && outer.exact();
-
-  // Only land cells need characteristics: each row is worked on over its span of land only
-  // (a big saving on coastal tiles that are mostly sea, and on nodata borders).
-  const auto nrows = static_cast<std::size_t>(rows);
-  std::vector<int> span_lo(nrows, 0), span_hi(nrows, 0);
+Grid describe_grid(const Dem& dem, const DensityOptions& options) {
+  Grid g;
+  g.cols = dem.cols(), g.rows = dem.rows();
+  g.metrics = cell_metrics(dem.georef(), g.cols, g.rows);
+  g.kind = cell_kinds(dem, options);
+  const auto nrows = static_cast<std::size_t>(g.rows);
+  g.span_lo.assign(nrows, 0), g.span_hi.assign(nrows, 0);
   std::vector<std::uint8_t> row_unknown(nrows, 0), row_water(nrows, 0);
   std::vector<float> row_zmin(nrows), row_zmax(nrows);
-  tbb::parallel_for(tbb::blocked_range<int>(0, rows, 8), [&](const tbb::blocked_range<int>& range) {
+  tbb::parallel_for(tbb::blocked_range<int>(0, g.rows, 8), [&](const tbb::blocked_range<int>& range) {
     for (int r = range.begin(); r < range.end(); ++r) {
-      int lo = cols, hi = 0;
+      int lo = g.cols, hi = 0;
       bool u = false, w = false;
       float zmin = std::numeric_limits<float>::infinity(), zmax = -zmin;
-      for (int x = 0; x < cols; ++x) {
+      for (int x = 0; x < g.cols; ++x) {
         const std::size_t i = dem.index(x, r);
-        const std::uint8_t k = kind[i];
+        const std::uint8_t k = g.kind[i];
         if (k == land) lo = std::min(lo, x), hi = x + 1, zmin = std::min(zmin, dem[i]), zmax = std::max(zmax, dem[i]);
         u = u || k == unknown;
         w = w || k == water;
       }
-      span_lo[std::size_t(r)] = lo;
-      span_hi[std::size_t(r)] = std::max(lo, hi);
+      g.span_lo[std::size_t(r)] = lo;
+      g.span_hi[std::size_t(r)] = std::max(lo, hi);
       row_unknown[std::size_t(r)] = u, row_water[std::size_t(r)] = w;
       row_zmin[std::size_t(r)] = zmin, row_zmax[std::size_t(r)] = zmax;
     }
   });
-  const bool any_unknown = std::find(row_unknown.begin(), row_unknown.end(), 1) != row_unknown.end();
-  const bool any_water = std::find(row_water.begin(), row_water.end(), 1) != row_water.end();
-  // Summed-area tables cover only the land's bounding box grown by the ring's reach: no cell
-  // outside it falls in the disc of a land cell.
+  g.any_unknown = std::find(row_unknown.begin(), row_unknown.end(), 1) != row_unknown.end();
+  g.any_water = std::find(row_water.begin(), row_water.end(), 1) != row_water.end();
+  g.land_min = *std::min_element(row_zmin.begin(), row_zmin.end());
+  g.land_max = *std::max_element(row_zmax.begin(), row_zmax.end());
+  return g;
+}
+
+/// The masks (§4.2.2.2, the thresholds): uninhabitable are water, cells too high, excluded,
+/// river beds and cells too steep; the hydrometry clamped to [0,1], 0 on water.
+void mark_buildable(const Dem& dem, const Grid& g, const Raster<float>& hydrometry, const DensityOptions& options, DensityResult& result,
+                    Progress& progress) {
+  ProgressStep step(progress, "density: masks");
+  std::vector<std::uint8_t> excluded(dem.size(), 0);
+  for (const auto& ex : options.exclusion_masks)
+    for (std::size_t i = 0; i < dem.size(); ++i)
+      if (ex[i] != 0) excluded[i] = 1;
+  step.update(0.5);
+  result.hydrometry = dem.like<float>(nan_f);
+  result.buildable = dem.like<std::uint8_t>(255);
+  result.buildable.nodata = 255;
+  tbb::parallel_for(tbb::blocked_range<int>(0, g.rows, 8), [&](const tbb::blocked_range<int>& range) {
+    for (int r = range.begin(); r < range.end(); ++r)
+      for (int x = 0; x < g.cols; ++x) {
+        const std::size_t i = dem.index(x, r);
+        if (g.kind[i] == unknown) continue;
+        const float hv = std::isnan(hydrometry[i]) ? 0.0f : std::clamp(hydrometry[i], 0.0f, 1.0f);
+        result.hydrometry[i] = g.kind[i] == water ? 0.0f : hv;
+        bool ok = g.kind[i] == land && dem[i] <= options.max_altitude_m && !excluded[i];
+        if (ok && options.river_bed_cap && hv > *options.river_bed_cap) ok = false;
+        if (ok && options.max_slope_deg && slope_deg(dem, g.metrics, x, r) > *options.max_slope_deg) ok = false;
+        result.buildable[i] = ok ? 1 : 0;
+      }
+  });
+}
+
+/// The summed-area tables cover only the land's bounding box grown by the discs' reach: no cell
+/// outside it falls in the disc of a land cell.
+Window disc_window(const Grid& g, const DiscPlan& inner, const DiscPlan& outer) {
   Window win;
-  {
-    int r_lo = rows, r_hi = -1, c_lo = cols, c_hi = -1;
-    for (int r = 0; r < rows; ++r)
-      if (span_lo[std::size_t(r)] < span_hi[std::size_t(r)]) {
-        r_lo = std::min(r_lo, r), r_hi = r;
-        c_lo = std::min(c_lo, span_lo[std::size_t(r)]), c_hi = std::max(c_hi, span_hi[std::size_t(r)] - 1);
-      }
-    if (r_hi >= 0) {
-      const int ry = std::max(outer.reach_rows(), inner.reach_rows()), rx = std::max(outer.reach_cols(), inner.reach_cols());
-      win.y0 = std::max(0, r_lo - ry);
-      win.x0 = std::max(0, c_lo - rx);
-      win.rows = std::min(rows, r_hi + ry + 1) - win.y0;
-      win.cols = std::min(cols, c_hi + rx + 1) - win.x0;
+  int r_lo = g.rows, r_hi = -1, c_lo = g.cols, c_hi = -1;
+  for (int r = 0; r < g.rows; ++r)
+    if (g.span_lo[std::size_t(r)] < g.span_hi[std::size_t(r)]) {
+      r_lo = std::min(r_lo, r), r_hi = r;
+      c_lo = std::min(c_lo, g.span_lo[std::size_t(r)]), c_hi = std::max(c_hi, g.span_hi[std::size_t(r)] - 1);
     }
+  if (r_hi >= 0) {
+    const int ry = std::max(outer.reach_rows(), inner.reach_rows()), rx = std::max(outer.reach_cols(), inner.reach_cols());
+    win.y0 = std::max(0, r_lo - ry);
+    win.x0 = std::max(0, c_lo - rx);
+    win.rows = std::min(g.rows, r_hi + ry + 1) - win.y0;
+    win.cols = std::min(g.cols, c_hi + rx + 1) - win.x0;
   }
+  return win;
+}
 
-  // ---- plain: standard deviation of land altitudes within r_min ---------------------------
-  result.plain = dem.like<float>(nan_f);
-  {
-    ProgressStep step(progress, "density: plain");
-    // Altitudes are taken relative to the middle of their range to keep the squares small.
-    const float lo = *std::min_element(row_zmin.begin(), row_zmin.end());
-    const float hi = *std::max_element(row_zmax.begin(), row_zmax.end());
-    const double mid = lo <= hi ? 0.5 * (double(lo) + double(hi)) : 0.0;
-    // When every cell is land, land cells in a disc are counted by arithmetic instead.
-    const bool all_land = !any_water && !any_unknown;
-    const SummedArea<std::uint32_t> count = all_land ? SummedArea<std::uint32_t>()
-                                                     : SummedArea<std::uint32_t>(win, cols, [&](std::size_t i) { return std::uint32_t(kind[i] == land); });
-    const SummedArea<double> s1(win, cols, [&](std::size_t i) { return kind[i] == land ? double(dem[i]) - mid : 0.0; });
-    const SummedArea<double> s2(win, cols, [&](std::size_t i) {
-      const double d = kind[i] == land ? double(dem[i]) - mid : 0.0;
-      return d * d;
-    });
-    const double max_var = options.plain_max_variation_m;
-    for_rows(rows, step, [&](int r0, int r1) {
-      std::vector<std::uint32_t> a(std::size_t(cols), 0);
-      std::vector<double> b(static_cast<std::size_t>(cols)), c(static_cast<std::size_t>(cols));
-      for (int r = r0; r < r1; ++r) {
-        for (int x = 0; x < cols; ++x)
-          if (kind[dem.index(x, r)] == water) result.plain(x, r) = 0;
-        const int x0 = span_lo[std::size_t(r)], x1 = span_hi[std::size_t(r)];
-        if (x0 >= x1) continue;
-        std::fill(a.begin() + x0, a.begin() + x1, 0u);
-        std::fill(b.begin() + x0, b.begin() + x1, 0.0);
-        std::fill(c.begin() + x0, c.begin() + x1, 0.0);
-        if (all_land) add_disc_count_row(inner, cols, rows, r, +1, a.data(), x0, x1);
-        else add_disc_row(count, inner, r, +1, a.data(), x0, x1);
-        add_disc_row(s1, inner, r, +1, b.data(), x0, x1);
-        add_disc_row(s2, inner, r, +1, c.data(), x0, x1);
-        for (int x = x0; x < x1; ++x) {
-          const std::size_t i = dem.index(x, r);
-          if (kind[i] != land) continue;
-          const double k = a[std::size_t(x)];
-          const double mean = b[std::size_t(x)] / k;
-          const double sd = std::sqrt(std::max(0.0, c[std::size_t(x)] / k - mean * mean));
-          result.plain[i] = float(std::clamp(1.0 - sd / max_var, 0.0, 1.0));
-        }
+/// Plain (§4.2.1, point 4): 1 - the standard deviation of the land's altitudes within r_min over
+/// plain_max_variation, clamped to [0,1]; 0 on water.
+Raster<float> plain_characteristic(const Dem& dem, const Grid& g, const DiscPlan& inner, const Window& win, double max_variation_m,
+                                   Progress& progress) {
+  Raster<float> plain = dem.like<float>(nan_f);
+  ProgressStep step(progress, "density: plain");
+  const std::vector<std::uint8_t>& kind = g.kind;
+  // Altitudes are taken relative to the middle of their range to keep the squares small.
+  const double mid = g.land_min <= g.land_max ? 0.5 * (double(g.land_min) + double(g.land_max)) : 0.0;
+  // When every cell is land, land cells in a disc are counted by arithmetic instead.
+  const bool all_land = !g.any_water && !g.any_unknown;
+  const SummedArea<std::uint32_t> count = all_land ? SummedArea<std::uint32_t>()
+                                                   : SummedArea<std::uint32_t>(win, g.cols, [&](std::size_t i) { return std::uint32_t(kind[i] == land); });
+  const SummedArea<double> s1(win, g.cols, [&](std::size_t i) { return kind[i] == land ? double(dem[i]) - mid : 0.0; });
+  const SummedArea<double> s2(win, g.cols, [&](std::size_t i) {
+    const double d = kind[i] == land ? double(dem[i]) - mid : 0.0;
+    return d * d;
+  });
+  for_rows(g.rows, step, [&](int r0, int r1) {
+    std::vector<std::uint32_t> a(std::size_t(g.cols), 0);
+    std::vector<double> b(static_cast<std::size_t>(g.cols)), c(static_cast<std::size_t>(g.cols));
+    for (int r = r0; r < r1; ++r) {
+      for (int x = 0; x < g.cols; ++x)
+        if (kind[dem.index(x, r)] == water) plain(x, r) = 0;
+      const int x0 = g.span_lo[std::size_t(r)], x1 = g.span_hi[std::size_t(r)];
+      if (x0 >= x1) continue;
+      std::fill(a.begin() + x0, a.begin() + x1, 0u);
+      std::fill(b.begin() + x0, b.begin() + x1, 0.0);
+      std::fill(c.begin() + x0, c.begin() + x1, 0.0);
+      if (all_land) add_disc_count_row(inner, g.cols, g.rows, r, +1, a.data(), x0, x1);
+      else add_disc_row(count, inner, r, +1, a.data(), x0, x1);
+      add_disc_row(s1, inner, r, +1, b.data(), x0, x1);
+      add_disc_row(s2, inner, r, +1, c.data(), x0, x1);
+      for (int x = x0; x < x1; ++x) {
+        const std::size_t i = dem.index(x, r);
+        if (kind[i] != land) continue;
+        const double k = a[std::size_t(x)];
+        const double mean = b[std::size_t(x)] / k;
+        const double sd = std::sqrt(std::max(0.0, c[std::size_t(x)] / k - mean * mean));
+        plain[i] = float(std::clamp(1.0 - sd / max_variation_m, 0.0, 1.0));
       }
-    });
-  }
+    }
+  });
+  return plain;
+}
 
-  // ---- coast and plateau: shares of the ring r_min..r_max ---------------------------------
+/// Coast and plateau (§4.2.1, points 1 and 3): the shares of water and of rough plateau ground in
+/// the ring r_min..r_max, each divided by its maximum over habitable land; 0 on water.
+void ring_shares(const Dem& dem, const Grid& g, const DiscPlan& inner, const DiscPlan& outer, const Window& win, const DensityOptions& options,
+                 DensityResult& result, Progress& progress) {
   result.coast = dem.like<float>(nan_f);
   result.plateau = dem.like<float>(nan_f);
-  {
-    ProgressStep step(progress, "density: coast and plateau");
-    // Plateau ground "opposed to plains" (§4.2.1, point 3): altitude within the plateau range,
-    // weighted by how far it is from a plain (cliffs and slopes count, flat tops do not). The
-    // weight is quantised to `levels` steps so its sums stay exact integers in 32 bits.
-    const double levels = std::min(1024.0, std::floor(double(UINT32_MAX) / std::max(1.0, outer.max_cells())));
-    if (levels < 16) throw bad_input("--r-max: the ring holds too many cells for this grid (" + std::to_string(outer.max_cells()) + ")");
-    // An inland grid has no coast: its water sums are all 0 and need no table.
-    const SummedArea<std::uint32_t> wet = any_water ? SummedArea<std::uint32_t>(win, cols, [&](std::size_t i) { return std::uint32_t(kind[i] == water); })
+  ProgressStep step(progress, "density: coast and plateau");
+  const std::vector<std::uint8_t>& kind = g.kind;
+  // Plateau ground "opposed to plains" (§4.2.1, point 3): altitude within the plateau range,
+  // weighted by how far it is from a plain (cliffs and slopes count, flat tops do not). The
+  // weight is quantised to `levels` steps so its sums stay exact integers in 32 bits.
+  const double levels = std::min(1024.0, std::floor(double(UINT32_MAX) / std::max(1.0, outer.max_cells())));
+  if (levels < 16) throw bad_input("--r-max: the ring holds too many cells for this grid (" + std::to_string(outer.max_cells()) + ")");
+  // An inland grid has no coast: its water sums are all 0 and need no table.
+  const SummedArea<std::uint32_t> wet = g.any_water ? SummedArea<std::uint32_t>(win, g.cols, [&](std::size_t i) { return std::uint32_t(kind[i] == water); })
                                                     : SummedArea<std::uint32_t>();
-    // Without unknown cells every cell is known: count ring cells by arithmetic instead.
-    const SummedArea<std::uint32_t> known = any_unknown ? SummedArea<std::uint32_t>(win, cols, [&](std::size_t i) { return std::uint32_t(kind[i] != unknown); })
+  // Without unknown cells every cell is known: count ring cells by arithmetic instead.
+  const SummedArea<std::uint32_t> known = g.any_unknown ? SummedArea<std::uint32_t>(win, g.cols, [&](std::size_t i) { return std::uint32_t(kind[i] != unknown); })
                                                         : SummedArea<std::uint32_t>();
-    const SummedArea<std::uint32_t> high(win, cols, [&](std::size_t i) {
-      const float z = dem[i];
-      const bool in_range = kind[i] == land && z >= options.plateau_min_m && z <= options.plateau_max_m;
-      return in_range ? std::uint32_t(std::lround((1.0 - double(result.plain[i])) * levels)) : 0u;
-    });
-    for_rows(rows, step, [&](int r0, int r1) {
-      std::vector<std::uint32_t> w(static_cast<std::size_t>(cols)), k(static_cast<std::size_t>(cols)), h(static_cast<std::size_t>(cols));
-      for (int r = r0; r < r1; ++r) {
-        for (int x = 0; x < cols; ++x)
-          if (kind[dem.index(x, r)] == water) result.coast(x, r) = result.plateau(x, r) = 0;
-        const int x0 = span_lo[std::size_t(r)], x1 = span_hi[std::size_t(r)];
-        if (x0 >= x1) continue;
-        std::fill(w.begin() + x0, w.begin() + x1, 0u);
-        std::fill(k.begin() + x0, k.begin() + x1, 0u);
-        std::fill(h.begin() + x0, h.begin() + x1, 0u);
-        if (any_water) {
-          add_disc_row(wet, outer, r, +1, w.data(), x0, x1);
-          add_disc_row(wet, inner, r, -1, w.data(), x0, x1);
-        }
-        if (any_unknown) {
-          add_disc_row(known, outer, r, +1, k.data(), x0, x1);
-          add_disc_row(known, inner, r, -1, k.data(), x0, x1);
-        } else {
-          add_disc_count_row(outer, cols, rows, r, +1, k.data(), x0, x1);
-          add_disc_count_row(inner, cols, rows, r, -1, k.data(), x0, x1);
-        }
-        add_disc_row(high, outer, r, +1, h.data(), x0, x1);
-        add_disc_row(high, inner, r, -1, h.data(), x0, x1);
-        for (int x = x0; x < x1; ++x) {
-          const std::size_t i = dem.index(x, r);
-          if (kind[i] != land) continue;
-          const double total = k[std::size_t(x)];
-          // Band approximations can make a ring cell count slightly off: keep shares in [0,1].
-          result.coast[i] = total > 0 ? float(std::clamp(double(w[std::size_t(x)]) / total, 0.0, 1.0)) : 0.0f;
-          result.plateau[i] = total > 0 ? float(std::clamp(double(h[std::size_t(x)]) / levels / total, 0.0, 1.0)) : 0.0f;
-        }
+  const SummedArea<std::uint32_t> high(win, g.cols, [&](std::size_t i) {
+    const float z = dem[i];
+    const bool in_range = kind[i] == land && z >= options.plateau_min_m && z <= options.plateau_max_m;
+    return in_range ? std::uint32_t(std::lround((1.0 - double(result.plain[i])) * levels)) : 0u;
+  });
+  for_rows(g.rows, step, [&](int r0, int r1) {
+    std::vector<std::uint32_t> w(static_cast<std::size_t>(g.cols)), k(static_cast<std::size_t>(g.cols)), h(static_cast<std::size_t>(g.cols));
+    for (int r = r0; r < r1; ++r) {
+      for (int x = 0; x < g.cols; ++x)
+        if (kind[dem.index(x, r)] == water) result.coast(x, r) = result.plateau(x, r) = 0;
+      const int x0 = g.span_lo[std::size_t(r)], x1 = g.span_hi[std::size_t(r)];
+      if (x0 >= x1) continue;
+      std::fill(w.begin() + x0, w.begin() + x1, 0u);
+      std::fill(k.begin() + x0, k.begin() + x1, 0u);
+      std::fill(h.begin() + x0, h.begin() + x1, 0u);
+      if (g.any_water) {
+        add_disc_row(wet, outer, r, +1, w.data(), x0, x1);
+        add_disc_row(wet, inner, r, -1, w.data(), x0, x1);
       }
-    });
-    divide_land_by_max(result.coast, kind, result.buildable);
-    divide_land_by_max(result.plateau, kind, result.buildable);
-  }
+      if (g.any_unknown) {
+        add_disc_row(known, outer, r, +1, k.data(), x0, x1);
+        add_disc_row(known, inner, r, -1, k.data(), x0, x1);
+      } else {
+        add_disc_count_row(outer, g.cols, g.rows, r, +1, k.data(), x0, x1);
+        add_disc_count_row(inner, g.cols, g.rows, r, -1, k.data(), x0, x1);
+      }
+      add_disc_row(high, outer, r, +1, h.data(), x0, x1);
+      add_disc_row(high, inner, r, -1, h.data(), x0, x1);
+      for (int x = x0; x < x1; ++x) {
+        const std::size_t i = dem.index(x, r);
+        if (kind[i] != land) continue;
+        const double total = k[std::size_t(x)];
+        // Band approximations can make a ring cell count slightly off: keep shares in [0,1].
+        result.coast[i] = total > 0 ? float(std::clamp(double(w[std::size_t(x)]) / total, 0.0, 1.0)) : 0.0f;
+        result.plateau[i] = total > 0 ? float(std::clamp(double(h[std::size_t(x)]) / levels / total, 0.0, 1.0)) : 0.0f;
+      }
+    }
+  });
+  divide_land_by_max(result.coast, kind, result.buildable);
+  divide_land_by_max(result.plateau, kind, result.buildable);
+}
 
-  // ---- terrain terms: altitude, slope, nearness to water and to rivers ----------------------
-  const bool terrain_used = std::any_of(options.terrain_weights.begin(), options.terrain_weights.end(), [](double w) { return w != 0; });
-  if (terrain_used || options.terrain_terms) {
-    ProgressStep step(progress, "density: terrain terms");
-    std::vector<std::uint8_t> wet(n), river(n, 0);
-    for (std::size_t i = 0; i < n; ++i) wet[i] = kind[i] == water;
-    const bool rivers_known = options.rivers.size() == n;
-    if (options.rivers.size() != 0 && !rivers_known) throw bad_input("rivers: not on the DEM's grid");
-    if (rivers_known)
-      for (std::size_t i = 0; i < n; ++i) river[i] = options.rivers[i] != 0 && options.rivers[i] != options.rivers.nodata;
-    const std::vector<float> to_water = any_water ? distance_to_m(wet, metrics, cols, rows) : std::vector<float>();
-    step.update(0.4);
-    const std::vector<float> to_river = rivers_known ? distance_to_m(river, metrics, cols, rows) : std::vector<float>();
-    step.update(0.8);
-    result.altitude = dem.like<float>(nan_f);
-    result.slope = dem.like<float>(nan_f);
-    result.coast_near = dem.like<float>(nan_f);
-    result.river_near = dem.like<float>(nan_f);
-    tbb::parallel_for(tbb::blocked_range<int>(0, rows, 8), [&](const tbb::blocked_range<int>& range) {
-      for (int r = range.begin(); r < range.end(); ++r)
-        for (int x = 0; x < cols; ++x) {
-          const std::size_t i = dem.index(x, r);
-          if (kind[i] != land) continue;
-          result.altitude[i] = dem[i];
-          result.slope[i] = slope_deg(dem, metrics, x, r);
-          result.coast_near[i] = any_water ? float(std::exp(-double(to_water[i]) / 10000.0)) : 0.0f;
-          result.river_near[i] = rivers_known ? float(std::exp(-double(to_river[i]) / 2000.0)) : 0.0f;
-        }
-    });
-    to_land_rank(result.altitude);
-    to_land_rank(result.slope);
-  }
+bool terrain_used(const DensityOptions& options) {
+  return std::any_of(options.terrain_weights.begin(), options.terrain_weights.end(), [](double w) { return w != 0; });
+}
 
-  // ---- hydrometry, layers, buildable, combination -----------------------------------------
+/// The terrain terms the thesis does not have (fitted by `terrapolis calibrate`): ranks of the
+/// altitude and the slope among the land cells, nearness to water and to rivers.
+void terrain_terms(const Dem& dem, const Grid& g, const DensityOptions& options, DensityResult& result, Progress& progress) {
+  ProgressStep step(progress, "density: terrain terms");
+  const std::size_t n = dem.size();
+  std::vector<std::uint8_t> wet(n), river(n, 0);
+  for (std::size_t i = 0; i < n; ++i) wet[i] = g.kind[i] == water;
+  const bool rivers_known = options.rivers.size() == n;
+  if (options.rivers.size() != 0 && !rivers_known) throw bad_input("rivers: not on the DEM's grid");
+  if (rivers_known)
+    for (std::size_t i = 0; i < n; ++i) river[i] = options.rivers[i] != 0 && options.rivers[i] != options.rivers.nodata;
+  const std::vector<float> to_water = g.any_water ? distance_to_m(wet, g.metrics, g.cols, g.rows) : std::vector<float>();
+  step.update(0.4);
+  const std::vector<float> to_river = rivers_known ? distance_to_m(river, g.metrics, g.cols, g.rows) : std::vector<float>();
+  step.update(0.8);
+  result.altitude = dem.like<float>(nan_f);
+  result.slope = dem.like<float>(nan_f);
+  result.coast_near = dem.like<float>(nan_f);
+  result.river_near = dem.like<float>(nan_f);
+  tbb::parallel_for(tbb::blocked_range<int>(0, g.rows, 8), [&](const tbb::blocked_range<int>& range) {
+    for (int r = range.begin(); r < range.end(); ++r)
+      for (int x = 0; x < g.cols; ++x) {
+        const std::size_t i = dem.index(x, r);
+        if (g.kind[i] != land) continue;
+        result.altitude[i] = dem[i];
+        result.slope[i] = slope_deg(dem, g.metrics, x, r);
+        result.coast_near[i] = g.any_water ? float(std::exp(-double(to_water[i]) / 10000.0)) : 0.0f;
+        result.river_near[i] = rivers_known ? float(std::exp(-double(to_river[i]) / 2000.0)) : 0.0f;
+      }
+  });
+  to_land_rank(result.altitude);
+  to_land_rank(result.slope);
+}
+
+/// The density (§4.2.1, Fig. 4.3): the weighted combination of the characteristics, the user's
+/// factors and the terrain terms on habitable cells, 0 elsewhere on known ground.
+void combine_terms(const Dem& dem, const Grid& g, const DensityOptions& options, DensityResult& result, Progress& progress) {
   result.density = dem.like<float>(nan_f);
-  {
-    ProgressStep step(progress, "density: combine");
-    std::vector<Raster<float>> layers;
-    for (const auto& [path, weight] : options.layers) layers.push_back(read_layer(path, dem));
-    std::vector<double> weights(options.weights.begin(), options.weights.end());
-    for (const auto& [path, weight] : options.layers) weights.push_back(weight);
-    for (const auto& f : options.factors) weights.push_back(f.weight);
-    const std::size_t first_factor = 4 + layers.size(), first_terrain = first_factor + options.factors.size();
-    // The terrain terms come last, and only when used: the thesis's model sums exactly what it always did.
-    const Raster<float>* terrain[4] = {&result.altitude, &result.slope, &result.coast_near, &result.river_near};
-    if (terrain_used) weights.insert(weights.end(), options.terrain_weights.begin(), options.terrain_weights.end());
-    for_rows(rows, step, [&](int r0, int r1) {
-      std::vector<double> values(weights.size()), cell_weights(weights);
-      for (int r = r0; r < r1; ++r)
-        for (int x = 0; x < cols; ++x) {
-          const std::size_t i = dem.index(x, r);
-          if (kind[i] == unknown) continue;
-          if (result.buildable[i] != 1) {
-            result.density[i] = 0;
-            continue;
-          }
-          values[0] = result.coast[i];
-          values[1] = result.hydrometry[i];
-          values[2] = result.plateau[i];
-          values[3] = result.plain[i];
-          for (std::size_t l = 0; l < layers.size(); ++l) values[4 + l] = layers[l][i];
-          // A factor with no value here (NaN) takes no part in this cell's combination.
-          bool any = false;
-          for (std::size_t f = 0; f < options.factors.size(); ++f) {
-            const float v = options.factors[f].values[i];
-            values[first_factor + f] = std::isnan(v) ? 0.0 : std::clamp(double(v), 0.0, 1.0);
-            cell_weights[first_factor + f] = std::isnan(v) ? 0.0 : weights[first_factor + f];
-          }
-          if (terrain_used)
-            for (std::size_t t = 0; t < 4; ++t) values[first_terrain + t] = (*terrain[t])[i];
-          for (std::size_t k = 0; k < cell_weights.size() && !any; ++k) any = cell_weights[k] != 0;
-          result.density[i] = any ? float(combine(cell_weights.data(), values.data(), cell_weights.size())) : 0.0f;
+  ProgressStep step(progress, "density: combine");
+  std::vector<double> weights(options.weights.begin(), options.weights.end());
+  for (const auto& f : options.factors) weights.push_back(f.weight);
+  const std::size_t first_factor = 4, first_terrain = first_factor + options.factors.size();
+  // The terrain terms come last, and only when used: the thesis's model sums exactly what it always did.
+  const bool with_terrain = terrain_used(options);
+  const Raster<float>* terrain[4] = {&result.altitude, &result.slope, &result.coast_near, &result.river_near};
+  if (with_terrain) weights.insert(weights.end(), options.terrain_weights.begin(), options.terrain_weights.end());
+  for_rows(g.rows, step, [&](int r0, int r1) {
+    std::vector<double> values(weights.size()), cell_weights(weights);
+    for (int r = r0; r < r1; ++r)
+      for (int x = 0; x < g.cols; ++x) {
+        const std::size_t i = dem.index(x, r);
+        if (g.kind[i] == unknown) continue;
+        if (result.buildable[i] != 1) {
+          result.density[i] = 0;
+          continue;
         }
-    });
-  }
+        values[0] = result.coast[i];
+        values[1] = result.hydrometry[i];
+        values[2] = result.plateau[i];
+        values[3] = result.plain[i];
+        // A factor with no value here (NaN) takes no part in this cell's combination.
+        for (std::size_t f = 0; f < options.factors.size(); ++f) {
+          const float v = options.factors[f].values[i];
+          values[first_factor + f] = std::isnan(v) ? 0.0 : std::clamp(double(v), 0.0, 1.0);
+          cell_weights[first_factor + f] = std::isnan(v) ? 0.0 : weights[first_factor + f];
+        }
+        if (with_terrain)
+          for (std::size_t t = 0; t < 4; ++t) values[first_terrain + t] = (*terrain[t])[i];
+        const bool any = std::any_of(cell_weights.begin(), cell_weights.end(), [](double w) { return w != 0; });
+        result.density[i] = any ? float(combine(cell_weights.data(), values.data(), cell_weights.size())) : 0.0f;
+      }
+  });
+}
 
-  // ---- report figures: per-row partial sums added in row order (deterministic) -------------
+/// Report figures: per-row partial sums added in row order (deterministic).
+void gather_stats(const Dem& dem, const Grid& g, DensityResult& result) {
+  DensityStats& stats = result.stats;
+  const auto nrows = static_cast<std::size_t>(g.rows);
   std::vector<DensityStats> per_row(nrows);
   std::vector<double> row_sum(nrows, 0.0);
-  tbb::parallel_for(tbb::blocked_range<int>(0, rows, 8), [&](const tbb::blocked_range<int>& range) {
+  tbb::parallel_for(tbb::blocked_range<int>(0, g.rows, 8), [&](const tbb::blocked_range<int>& range) {
     for (int r = range.begin(); r < range.end(); ++r) {
       DensityStats& t = per_row[std::size_t(r)];
-      for (int x = 0; x < cols; ++x) {
+      for (int x = 0; x < g.cols; ++x) {
         const std::size_t i = dem.index(x, r);
-        if (kind[i] != unknown) ++t.known_cells;
-        if (kind[i] == water) ++t.water_cells;
-        if (kind[i] == land) t.land_area_km2 += metrics.area_m2[std::size_t(r)] * 1e-6;
+        if (g.kind[i] != unknown) ++t.known_cells;
+        if (g.kind[i] == water) ++t.water_cells;
+        if (g.kind[i] == land) t.land_area_km2 += g.metrics.area_m2[std::size_t(r)] * 1e-6;
         if (result.buildable[i] == 1) {
           ++t.buildable_cells;
           row_sum[std::size_t(r)] += result.density[i];
@@ -550,17 +536,60 @@ DensityResult compute_density(const Dem& dem, const Raster<float>& hydrometry, c
     }
   });
   double sum = 0;
-  for (int r = 0; r < rows; ++r) {
-    const DensityStats& t = per_row[std::size_t(r)];
+  for (std::size_t r = 0; r < nrows; ++r) {
+    const DensityStats& t = per_row[r];
     stats.known_cells += t.known_cells;
     stats.water_cells += t.water_cells;
     stats.buildable_cells += t.buildable_cells;
     stats.land_area_km2 += t.land_area_km2;
     for (std::size_t k = 0; k < 10; ++k) stats.histogram[k] += t.histogram[k];
-    sum += row_sum[std::size_t(r)];
+    sum += row_sum[r];
   }
   stats.mean_density = stats.buildable_cells ? sum / double(stats.buildable_cells) : 0.0;
+}
+
+}  // namespace
+
+DensityResult compute_density(const Dem& dem, const Raster<float>& hydrometry, const DensityOptions& options, Progress& progress) {
+  check_options(dem, hydrometry, options);
+  const Grid grid = describe_grid(dem, options);
+  DensityResult result;
+  result.stats.cells = dem.size();
+  mark_buildable(dem, grid, hydrometry, options, result, progress);
+
+  // The plain disc must hold at least the 4-neighbours: raise r_min to the largest cell step.
+  double largest_step = 0;
+  for (std::size_t r = 0; r < std::size_t(grid.rows); ++r)
+    largest_step = std::max({largest_step, grid.metrics.width_m[r], grid.metrics.height_m[r], grid.metrics.height_m[r + 1]});
+  const double r_min = std::max(options.r_min_m, largest_step * (1 + 1e-9));
+  if (!(options.r_max_m > r_min))
+    throw bad_input("--r-max: must be larger than r_min (" + std::to_string(r_min) + " m once raised to the cell size)");
+  const DiscPlan inner(grid.metrics, grid.rows, r_min, options.ring_bands);
+  const DiscPlan outer(grid.metrics, grid.rows, options.r_max_m, options.ring_bands);
+  result.stats.r_min_m = r_min;
+  result.stats.r_max_m = options.r_max_m;
+  result.stats.ring_bands = std::max(inner.band_count(), outer.band_count());
+  result.stats.ring_exact = inner.exact() && outer.exact();
+  const Window win = disc_window(grid, inner, outer);
+
+  result.plain = plain_characteristic(dem, grid, inner, win, options.plain_max_variation_m, progress);
+  ring_shares(dem, grid, inner, outer, win, options, result, progress);
+  if (terrain_used(options) || options.terrain_terms) terrain_terms(dem, grid, options, result, progress);
+  combine_terms(dem, grid, options, result, progress);
+  gather_stats(dem, grid, result);
   return result;
+}
+
+void to_unit_range(Raster<float>& layer) {
+  float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+  for (std::size_t i = 0; i < layer.size(); ++i)
+    if (!std::isnan(layer[i])) lo = std::min(lo, layer[i]), hi = std::max(hi, layer[i]);
+  const bool rescale = lo < 0 || hi > 1;
+  for (std::size_t i = 0; i < layer.size(); ++i) {
+    float& v = layer[i];
+    if (std::isnan(v)) v = 0;
+    else if (rescale) v = hi > lo ? (v - lo) / (hi - lo) : 0.0f;
+  }
 }
 
 }  // namespace terrapolis::density

@@ -24,8 +24,9 @@ struct DensityOptions {
   double sea_level_m = 0.0;
   /// Nodata cells are sea (SRTM/NZ coasts) rather than unknown.
   bool nodata_is_sea = false;
-  /// Optional raster (any GDAL format, read with nearest resampling): non-zero cells are water.
-  std::string water_mask;
+  /// Water the altitudes do not show (lakes, a user's mask), on the DEM's grid: non-zero cells
+  /// are water; empty: none.
+  Raster<std::uint8_t> water_mask;
 
   // ---- uninhabitable cells (density 0) -------------------------------------------------------
   /// Cells above this altitude (metres) are uninhabitable (thesis: 4000 m, after Potosí, 3967 m).
@@ -63,22 +64,19 @@ struct DensityOptions {
   /// Cells of the river network on the DEM's grid (non-zero = river), for river_near; empty: no
   /// rivers known (river_near 0).
   Raster<std::uint8_t> rivers;
-  /// User rasters (any GDAL raster, resampled bilinearly to the DEM grid) and their weights.
-  std::vector<std::pair<std::string, double>> layers;
-  /// User exclusion rasters (nearest resampling): non-zero cells are uninhabitable.
-  std::vector<std::string> exclusions;
 
-  // ---- pre-computed factors (plugins) --------------------------------------------------------
-  /// A factor already on the DEM's grid, values in [0,1], with its weight: it enters the
-  /// combination exactly like a user layer, except that a NaN cell takes no part in that cell's
-  /// combination (the factor has no opinion there; a cell where every weight is then 0 gets 0).
+  // ---- user layers and plugins, on the DEM's grid (the callers read the files) ---------------
+  /// A factor with values in [0,1] and its weight, combined after the four characteristics in
+  /// the order given; a NaN cell takes no part in that cell's combination (the factor has no
+  /// opinion there; a cell where every weight is then 0 gets 0). A user layer is a factor read
+  /// bilinearly and put through to_unit_range.
   struct Factor {
     std::string name;
     Raster<float> values;
     double weight = 1;
   };
   std::vector<Factor> factors;
-  /// Exclusion masks already on the DEM's grid: non-zero cells are uninhabitable.
+  /// Exclusion masks (user rasters, plugins): non-zero cells are uninhabitable.
   std::vector<Raster<std::uint8_t>> exclusion_masks;
 };
 
@@ -122,9 +120,13 @@ double combine(const double* weights, const double* values, std::size_t n);
 
 /// Computes the density model (Belhadj 2007, §4.2.1 and Fig. 4.2-4.3).
 /// `hydrometry` is on the DEM's grid, values in [0,1] (NaN read as 0). Deterministic whatever the
-/// thread count. Throws bad_input for inconsistent options or unreadable user rasters.
+/// thread count. Throws bad_input for inconsistent options or a raster not on the DEM's grid.
 DensityResult compute_density(const Dem& dem, const Raster<float>& hydrometry, const DensityOptions& options,
                               Progress& progress);
+
+/// A user layer as the model reads it: used as is when its values already lie in [0,1],
+/// otherwise rescaled linearly from its [min, max] over the grid; NaN (no data) reads as 0.
+void to_unit_range(Raster<float>& layer);
 
 /// Names of the terrain terms, in the order of DensityOptions::terrain_weights.
 inline constexpr std::array<const char*, 4> kTerrainTerms = {"altitude", "slope", "coast_near", "river_near"};

@@ -8,6 +8,7 @@
 
 #include "core/geodesy.hpp"
 #include "density/calibration.hpp"
+#include "pipeline/places.hpp"
 #include "pipeline/stage_options.hpp"
 
 namespace terrapolis::pipeline {
@@ -55,12 +56,13 @@ json realism_figures(RunState& s, const sites::SitesResult& r, const std::string
                      Progress& progress) {
   // The terrain terms for the baselines and the land mask: the run's density options, terms on.
   density::DensityOptions options = s.settings.density;
+  read_density_files(s.scenario, s.dem, options);
   options.terrain_terms = true;
   if (s.rivers) options.rivers = *s.rivers;
   const density::DensityResult terms = density::compute_density(s.dem, *s.hydrometry, options, progress);
   const std::vector<std::uint8_t> land = density::land_cells(terms);
   int dropped = 0;
-  std::vector<density::Place> places = density::read_places(reference, s.dem, land, dropped);
+  std::vector<density::Place> places = read_places(reference, s.dem, land, dropped);
   const double min_population = s.scenario.resolved["sites"]["min_population"].get<double>();
   std::vector<double> real_sizes, generated_sizes;
   double real_total = 0, generated_total = 0;

@@ -4,10 +4,13 @@
 
 #include <filesystem>
 #include <functional>
+#include <iterator>
 #include <map>
 
 #include "core/error.hpp"
 #include "hydro/option_names.hpp"
+#include "io/mask_io.hpp"
+#include "io/raster_io.hpp"
 
 namespace terrapolis::pipeline {
 namespace {
@@ -76,7 +79,6 @@ density::DensityOptions density_options(const Scenario& scenario) {
   density::DensityOptions o;
   o.sea_level_m = w["sea_level_m"].get<double>();
   o.nodata_is_sea = w["nodata_is_sea"].get<bool>();
-  o.water_mask = scenario.path("/water/water_mask");
   o.max_altitude_m = d["max_altitude_m"].get<double>();
   // 90 degrees and a cap of 1 exclude nothing: the schema's "off" values.
   if (const double slope = d["max_slope_deg"].get<double>(); slope < 90) o.max_slope_deg = slope;
@@ -91,10 +93,31 @@ density::DensityOptions density_options(const Scenario& scenario) {
   o.weights = {weights["coast"].get<double>(), weights["hydrometry"].get<double>(), weights["plateau"].get<double>(),
                weights["plain"].get<double>()};
   for (std::size_t k = 0; k < density::kTerrainTerms.size(); ++k) o.terrain_weights[k] = weights[density::kTerrainTerms[k]].get<double>();
-  for (const auto& layer : d["layers"])
-    o.layers.emplace_back(scenario.file(layer["file"].get<std::string>()), layer["weight"].get<double>());
-  for (const auto& file : d["exclusions"]) o.exclusions.push_back(scenario.file(file.get<std::string>()));
   return o;
+}
+
+void read_density_files(const Scenario& scenario, const Dem& dem, density::DensityOptions& o) {
+  const json& d = scenario.resolved["density"];
+  std::vector<density::DensityOptions::Factor> layers;
+  for (const auto& layer : d["layers"]) {
+    const std::string file = scenario.file(layer["file"].get<std::string>());
+    Raster<float> values = read_resampled(file, dem.georef(), dem.cols(), dem.rows(), Resampling::bilinear);
+    density::to_unit_range(values);
+    layers.push_back({std::filesystem::path(file).filename().string(), std::move(values), layer["weight"].get<double>()});
+  }
+  o.factors.insert(o.factors.begin(), std::make_move_iterator(layers.begin()), std::make_move_iterator(layers.end()));
+  for (const auto& file : d["exclusions"])
+    o.exclusion_masks.push_back(read_mask(scenario.file(file.get<std::string>()), dem.georef(), dem.cols(), dem.rows()));
+  if (const std::string mask = scenario.path("/water/water_mask"); !mask.empty())
+    o.water_mask = read_mask(mask, dem.georef(), dem.cols(), dem.rows());
+}
+
+std::vector<std::string> density_files(const Scenario& scenario) {
+  const json& d = scenario.resolved["density"];
+  std::vector<std::string> files = {scenario.path("/water/water_mask")};
+  for (const auto& layer : d["layers"]) files.push_back(scenario.file(layer["file"].get<std::string>()));
+  for (const auto& file : d["exclusions"]) files.push_back(scenario.file(file.get<std::string>()));
+  return files;
 }
 
 sites::SitesOptions sites_options(const Scenario& scenario) {
@@ -121,6 +144,7 @@ sites::SitesOptions sites_options(const Scenario& scenario) {
   o.min_population = s["min_population"].get<double>();
   o.area_exponent = s["area_exponent"].get<double>();
   o.town_density_per_km2 = s["town_density_per_km2"].get<double>();
+  o.influence_factor = s["influence_factor"].get<double>();
   return o;
 }
 
@@ -202,8 +226,11 @@ StageSettings prepare_stages(const Scenario& scenario) {
     check_file("/water/water_mask", scenario.path("/water/water_mask"));
     check_file("/roads/vegetation", s.roads.vegetation);
     check_file("/sites/reference", scenario.path("/sites/reference"));
-    for (std::size_t i = 0; i < s.density.layers.size(); ++i) check_file("/density/layers/" + std::to_string(i) + "/file", s.density.layers[i].first);
-    for (std::size_t i = 0; i < s.density.exclusions.size(); ++i) check_file("/density/exclusions/" + std::to_string(i), s.density.exclusions[i]);
+    const json& density = scenario.resolved["density"];
+    for (std::size_t i = 0; i < density["layers"].size(); ++i)
+      check_file("/density/layers/" + std::to_string(i) + "/file", scenario.file(density["layers"][i]["file"].get<std::string>()));
+    for (std::size_t i = 0; i < density["exclusions"].size(); ++i)
+      check_file("/density/exclusions/" + std::to_string(i), scenario.file(density["exclusions"][i].get<std::string>()));
     return s;
   } catch (const Error& e) {
     throw Error(e.kind(), scenario.source + ": " + e.what());

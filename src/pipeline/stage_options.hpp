@@ -26,8 +26,13 @@ std::optional<hydro::RiverTypeOptions> river_type_options(const Scenario& scenar
 std::vector<lake::LakeSpec> reservoir_specs(const Scenario& scenario);
 /// Code convention of flowdir.tif.
 hydro::D8Codes d8_codes(const Scenario& scenario);
-/// The density section, with the water section and file names resolved against the scenario.
+/// The density section, with the water section (its files are read by read_density_files).
 density::DensityOptions density_options(const Scenario& scenario);
+/// The density's files read onto the DEM's grid: density.layers as factors (ahead of any
+/// plugin's), density.exclusions as masks, water.water_mask as the water mask.
+void read_density_files(const Scenario& scenario, const Dem& dem, density::DensityOptions& options);
+/// The files read_density_files reads (the water mask, the layers, the exclusions), as paths.
+std::vector<std::string> density_files(const Scenario& scenario);
 /// The sites section, with the scenario's seed.
 sites::SitesOptions sites_options(const Scenario& scenario);
 network::NetworkOptions network_options(const Scenario& scenario);

@@ -8,8 +8,10 @@
 
 #include "core/error.hpp"
 #include "core/geodesy.hpp"
+#include "io/mask_io.hpp"
 #include "io/raster_io.hpp"
 #include "network/layers.hpp"
+#include "pipeline/density_folder.hpp"
 #include "pipeline/hillshade.hpp"
 #include "pipeline/realism.hpp"
 #include "pipeline/stage_options.hpp"
@@ -57,9 +59,9 @@ void write_inland_water(RunState& s, Progress& progress, const Log& log) {
   hydro::FlatWater flat = hydro::detect_flat_water(s.dem, s.settings.flat_water);
   Raster<std::uint8_t>& water = flat.mask;
   if (const std::string user = s.scenario.path("/water/water_mask"); !user.empty()) {
-    const Raster<float> m = read_resampled(user, s.dem.georef(), s.dem.cols(), s.dem.rows(), Resampling::nearest);
+    const Raster<std::uint8_t> m = read_mask(user, s.dem.georef(), s.dem.cols(), s.dem.rows());
     for (std::size_t i = 0; i < m.size(); ++i)
-      if (!std::isnan(m[i]) && m[i] != 0) water[i] = 1;
+      if (m[i]) water[i] = 1;
   }
   const std::vector<lake::LakeSpec>& specs = s.settings.reservoirs;
   json reservoirs = json::array();
@@ -139,7 +141,8 @@ void hydro_load(RunState& s) {
 
 void density_run(RunState& s, Progress& progress, const Log& log) {
   density::DensityOptions options = s.settings.density;
-  options.water_mask = saved(s, kInlandWater);  // holds water.water_mask too
+  read_density_files(s.scenario, s.dem, options);
+  options.water_mask = read_mask(saved(s, kInlandWater), s.dem.georef(), s.dem.cols(), s.dem.rows());  // holds water.water_mask too
   plugin::add_to_density(plugin::density_factors(s.plugins, s.dem, progress, log), options);
   if (s.rivers) options.rivers = *s.rivers;
   density::DensityResult r = density::compute_density(s.dem, *s.hydrometry, options, progress);
@@ -160,12 +163,11 @@ void density_run(RunState& s, Progress& progress, const Log& log) {
 }
 
 void density_load(RunState& s) {
-  s.density = read_resampled(saved(s, "density.tif"), s.dem.georef(), s.dem.cols(), s.dem.rows(), Resampling::nearest);
-  const Raster<float> buildable =
-      read_resampled(saved(s, "buildable.tif"), s.dem.georef(), s.dem.cols(), s.dem.rows(), Resampling::nearest);
-  s.buildable = s.dem.like<std::uint8_t>(255);
-  for (std::size_t i = 0; i < buildable.size(); ++i)
-    (*s.buildable)[i] = std::isnan(buildable[i]) ? std::uint8_t(255) : std::uint8_t(buildable[i]);
+  DensityFolder saved_outputs = read_density_folder(s.folder.string());
+  if (saved_outputs.density.cols() != s.dem.cols() || saved_outputs.density.rows() != s.dem.rows())
+    throw bad_input(saved(s, "density.tif") + ": not on the DEM's grid");
+  s.density = std::move(saved_outputs.density);
+  s.buildable = std::move(saved_outputs.buildable);
 }
 
 // ---- sites (Belhadj 2007 §4.3.1, Algorithms 13-15; docs/sites.md) --------------------------

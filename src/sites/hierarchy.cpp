@@ -59,4 +59,32 @@ std::vector<Site> resolve_inclusions(const std::vector<Site>& sites, SitesOption
   return kept;
 }
 
+double influence_radius_m(double people, double factor, double people_per_km2) {
+  if (!(people_per_km2 > 0) || !(factor > 0)) return 0;
+  return std::sqrt(factor * people / people_per_km2 * 1e6 / M_PI);
+}
+
+void attach_suburbs(std::vector<Site>& sites, const std::vector<double>& influence_m, const GridDistance& distance) {
+  const CellMetrics& m = distance.metrics();
+  const double min_width = *std::min_element(m.width_m.begin(), m.width_m.end());
+  const double min_height = *std::min_element(m.height_m.begin(), m.height_m.end());
+  for (std::size_t t = 0; t < sites.size(); ++t) {
+    Site& T = sites[t];
+    if (T.parent >= 0) continue;
+    double best_pull = 0;
+    for (std::size_t s = 0; s < t; ++s) {
+      const Site& S = sites[s];
+      const double reach = influence_m[s];
+      if (S.population < 2 * T.population || !(reach > 0)) continue;
+      // Cheap rejection by cells before the geodesic distance.
+      if (std::abs(S.col - T.col) * min_width > reach || std::abs(S.row - T.row) * min_height > reach) continue;
+      const double d = distance(S.col, S.row, T.col, T.row);
+      if (!(d < reach)) continue;
+      const double pull = double(S.population) / std::max(d * d, 1.0);
+      if (pull > best_pull) best_pull = pull, T.parent = int(s);
+    }
+  }
+  for (Site& s : sites) s.depth = s.parent < 0 ? 0 : sites[std::size_t(s.parent)].depth + 1;
+}
+
 }  // namespace terrapolis::sites

@@ -156,6 +156,7 @@ SitesResult place_sites(const Raster<float>& density, const Raster<std::uint8_t>
       land_km2 = m2 * 1e-6;
     }
     if (!(std::isfinite(options.people_per_km2) && options.people_per_km2 >= 0)) throw bad_input("sites: people_per_km2 must be >= 0");
+    if (!(std::isfinite(options.influence_factor) && options.influence_factor >= 0)) throw bad_input("sites: influence_factor must be >= 0");
     result.population_assumed = !(options.population > 0);
     result.land_area_km2 = land_km2;
     result.target_population = result.population_assumed ? std::round(options.people_per_km2 * land_km2) : options.population;
@@ -293,6 +294,14 @@ SitesResult place_sites(const Raster<float>& density, const Raster<std::uint8_t>
     // rank_size: within a class, sites (by density order) take the class's sizes, largest first.
     if (!table.populations.empty()) s.population = table.populations[std::size_t(s.radius_class)][std::size_t(c.kept)];
     ++c.kept;
+  }
+  // Suburbs by influence (rank_size, paris: Manhattan's regular tiling has none).
+  if (options.quotas == SitesOptions::Quotas::rank_size && options.mode == SitesOptions::Mode::paris && result.land_area_km2 > 0) {
+    const double people_per_km2 = result.target_population / result.land_area_km2;
+    std::vector<double> influence(result.sites.size());
+    for (std::size_t k = 0; k < influence.size(); ++k)
+      influence[k] = influence_radius_m(double(result.sites[k].population), options.influence_factor, people_per_km2);
+    attach_suburbs(result.sites, influence, distance);
   }
   result.quotas = table.classes;
   return result;

@@ -49,6 +49,13 @@ struct SitesOptions {
   /// 1,500, the cell density of the EU-OECD degree of urbanisation's urban centres
   /// (Dijkstra & Poelman 2014).
   double town_density_per_km2 = 1500;
+  /// Suburbs (Belhadj §4.3.1: "la banlieue et son centre"): a settlement's influence area holds
+  /// influence_factor x its people at the region's mean density (target population / land area),
+  /// so a town's reach grows as the square root of its size and shrinks where land is crowded;
+  /// a settlement at most half as large whose centre lies in it becomes its suburb. 1: the area
+  /// whose people equal the town's own (the central place's complementary region, Christaller
+  /// 1933, at its simplest); 0: no suburbs beyond partial inclusions. Mode manhattan: none.
+  double influence_factor = 1;
   // ---- belhadj2007 -----------------------------------------------------------------------------
   std::uint64_t seed = 1;   ///< seed of the candidate draw (std::mt19937_64)
   int candidates = 0;       ///< M, candidate positions drawn; 0: automatic (20 x N_sites, at most every buildable cell)
@@ -171,5 +178,14 @@ class GridDistance {
 /// sites in the same order with ids, parents and depths renumbered.
 std::vector<Site> resolve_inclusions(const std::vector<Site>& sites, SitesOptions::Mode mode, const GridDistance& distance,
                                      int cols, int rows);
+
+/// Makes each root a suburb of the settlement that attracts it most (population over squared
+/// distance, Reilly 1931) among those at least twice as populous whose influence radius
+/// (`influence_m`, per site) reaches its centre; then renumbers depths. `sites` are ordered by
+/// size, decreasing (a parent always comes first), as place_sites leaves them.
+void attach_suburbs(std::vector<Site>& sites, const std::vector<double>& influence_m, const GridDistance& distance);
+
+/// Radius, metres, of the disc of land holding `factor` x `people` at `people_per_km2`.
+double influence_radius_m(double people, double factor, double people_per_km2);
 
 }  // namespace terrapolis::sites

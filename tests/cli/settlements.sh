@@ -21,6 +21,7 @@ assert s["population_source"].startswith("assumed: 60 people/km2"), s
 land = m["summary"]["density"]["land_area_km2"]
 assert 1400 < land < 1700 and abs(s["target_population"] - round(60 * land)) <= 1, (land, s)
 assert s["population"] == s["target_population"], s  # every settlement of the law placed
+assert 0 < s["suburbs"] < s["cities"], s  # villages in a town's influence area are its suburbs
 # Right in magnitude: the total within a factor 3 of the real places' sum (43,093).
 assert r["total"]["reference"] == 43093 and 1 / 3 < r["total"]["ratio"] < 3, r["total"]
 assert r["places"] == 15 and 0 <= r["skill"]["auc"] <= 1 and len(r["top10"]["places"]) == 10, r

@@ -321,6 +321,18 @@ TEST(Density, OutputsInRangeOnARealDemAndDeterministicAcrossThreads) {
   EXPECT_LT(one.stats.buildable_cells, one.stats.known_cells);
 }
 
+// A user layer: kept as is within [0,1]; else (v - min) / (max - min); NaN reads as 0.
+TEST(Density, UserLayersToTheUnitRange) {
+  const Georef g = projected(100.0);
+  Raster<float> inside(2, 2, g), outside(2, 2, g);
+  const float a[4] = {0.0f, 0.25f, 1.0f, NAN}, b[4] = {-10.0f, 0.0f, 30.0f, NAN};
+  for (std::size_t i = 0; i < 4; ++i) inside[i] = a[i], outside[i] = b[i];
+  to_unit_range(inside);
+  to_unit_range(outside);
+  EXPECT_EQ(inside.values(), (std::vector<float>{0.0f, 0.25f, 1.0f, 0.0f}));
+  EXPECT_EQ(outside.values(), (std::vector<float>{0.0f, 0.25f, 1.0f, 0.0f}));
+}
+
 TEST(Density, RejectsBadOptions) {
   SilentProgress p;
   const Dem dem = plain_with(false, features);

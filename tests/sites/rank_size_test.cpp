@@ -96,3 +96,55 @@ TEST(RankSize, CountsFollowThePopulationNotTheGrid) {
   EXPECT_NEAR(d.land_area_km2, 400.0, 1e-6);
   EXPECT_EQ(d.target_population, 24000.0);
 }
+
+// 1000 people at 100 per km2, factor 1: 10 km2, a disc of sqrt(10e6 / pi) = 1784.12 m.
+TEST(Suburbs, InfluenceRadiusByHand) {
+  EXPECT_NEAR(influence_radius_m(1000, 1, 100), 1784.124, 1e-3);
+  EXPECT_NEAR(influence_radius_m(4000, 1, 100), 2 * 1784.124, 1e-3);  // reach grows as the square root
+  EXPECT_EQ(influence_radius_m(1000, 0, 100), 0.0);
+}
+
+// On a 100 m grid: S (20000 people, reach 3 km) at (50,50); D (12000) 1 km south: more than half
+// of S, stays a root; M (8000, reach 1 km) 2 km east: in S's reach -> suburb of S; C (4000) 2.5 km
+// west -> S; A (3000) 800 m east of M, 2.8 km from S: M pulls 8000 / 0.8^2 = 12500, S 20000 / 2.8^2
+// = 2551 -> M, depth 2; B (1000) 1.5 km north -> S; E (1000) 4 km west: out of every reach.
+TEST(Suburbs, StrongestPullAmongLargerSettlementsInReach) {
+  auto g = fixtures::flat_scenario(101, 101, 100.0);
+  const GridDistance distance(g.density.georef(), 101, 101);
+  auto site = [](int col, int row, std::int64_t people) {
+    Site t;
+    t.col = col, t.row = row, t.population = people;
+    return t;
+  };
+  std::vector<Site> s = {site(50, 50, 20000), site(50, 60, 12000), site(70, 50, 8000), site(25, 50, 4000),
+                         site(78, 50, 3000),  site(50, 35, 1000),  site(10, 50, 1000)};
+  const std::vector<double> reach = {3000, 1100, 1000, 500, 400, 300, 300};
+  attach_suburbs(s, reach, distance);
+  const std::vector<int> parents = {-1, -1, 0, 0, 2, 0, -1}, depths = {0, 0, 1, 1, 2, 1, 0};
+  for (std::size_t k = 0; k < s.size(); ++k) {
+    EXPECT_EQ(s[k].parent, parents[k]) << "site " << k;
+    EXPECT_EQ(s[k].depth, depths[k]) << "site " << k;
+  }
+}
+
+// The default run's hierarchy on a flat region: suburbs appear, none is larger than half its
+// parent; with influence_factor 0 only Algorithm 15's partial inclusions remain, far fewer.
+TEST(Suburbs, PlacementLinksSmallerSettlements) {
+  SilentProgress progress;
+  SitesOptions o;
+  o.population = 200000;
+  const auto flat = fixtures::flat_scenario(200, 200, 100.0);
+  const auto suburbs = [&](const SitesResult& r) {
+    int n = 0;
+    for (const Site& t : r.sites)
+      if (t.parent >= 0) {
+        ++n;
+        EXPECT_LE(2 * t.population, r.sites[std::size_t(t.parent)].population);
+      }
+    return n;
+  };
+  const int with = suburbs(place_sites(flat.density, flat.buildable, o, progress));
+  o.influence_factor = 0;
+  const int without = suburbs(place_sites(flat.density, flat.buildable, o, progress));
+  EXPECT_GT(with, 2 * without + 5);
+}

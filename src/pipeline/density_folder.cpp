@@ -1,0 +1,44 @@
+// The density stage's saved outputs, read back the same way by the `sites` command and a resumed run.
+// SPDX-License-Identifier: MIT
+#include "pipeline/density_folder.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+#include "core/error.hpp"
+#include "io/raster_io.hpp"
+
+namespace terrapolis::pipeline {
+
+DensityFolder read_density_folder(const std::string& dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) throw bad_input(dir + ": no such folder (expected density.tif and buildable.tif in it)");
+  const std::string density_path = (fs::path(dir) / "density.tif").string();
+  const std::string buildable_path = (fs::path(dir) / "buildable.tif").string();
+  if (!fs::exists(buildable_path, ec)) throw bad_input(buildable_path + ": no such file");
+  DensityFolder in;
+  in.density = read_dem(density_path);
+  for (std::size_t i = 0; i < in.density.size(); ++i) {
+    const float v = in.density[i];
+    if (!std::isnan(v) && !(v >= -1e-6f && v <= 1.0f + 1e-6f))
+      throw bad_input(density_path + ": density values must lie in [0,1] (found " + std::to_string(v) + ")");
+  }
+  const RasterHeader header = read_header(buildable_path);
+  if (header.cols != in.density.cols() || header.rows != in.density.rows())
+    throw bad_input(buildable_path + ": not on the grid of density.tif (" + std::to_string(header.cols) + "x" + std::to_string(header.rows) +
+                    " cells instead of " + std::to_string(in.density.cols()) + "x" + std::to_string(in.density.rows()) + ")");
+  for (std::size_t k = 0; k < 6; ++k)
+    if (std::abs(header.georef.transform[k] - in.density.georef().transform[k]) > 1e-9 * std::max(1.0, std::abs(in.density.georef().transform[k])))
+      throw bad_input(buildable_path + ": not on the grid of density.tif (different geotransform)");
+  // Same grid (checked above): the mask as is, nodata (NaN once read) kept as 255.
+  const Raster<float> mask = read_dem(buildable_path);
+  in.buildable = in.density.like<std::uint8_t>(255);
+  in.buildable.nodata = 255;
+  for (std::size_t i = 0; i < mask.size(); ++i)
+    if (!std::isnan(mask[i])) in.buildable[i] = mask[i] == 1.0f ? 1 : 0;
+  return in;
+}
+
+}  // namespace terrapolis::pipeline
