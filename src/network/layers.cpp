@@ -2,7 +2,12 @@
 // SPDX-License-Identifier: MIT
 #include "network/layers.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <map>
+#include <optional>
+
+#include "core/error.hpp"
 
 namespace terrapolis::network {
 
@@ -29,6 +34,52 @@ VectorLayer network_layer(const SiteGraph& graph, const std::vector<sites::Site>
     layer.features.push_back(std::move(f));
   }
   return layer;
+}
+
+namespace {
+std::optional<std::int64_t> as_int(const FieldValue& v) {
+  if (const auto* i = std::get_if<std::int64_t>(&v)) return *i;
+  if (const auto* d = std::get_if<double>(&v)) return std::int64_t(std::llround(*d));
+  return std::nullopt;
+}
+}  // namespace
+
+std::vector<roads::Link> road_links(const VectorLayer& network, const VectorLayer* cities) {
+  const int f_from = network.field_index("from"), f_to = network.field_index("to"), f_kept = network.field_index("kept");
+  if (f_from < 0 || f_to < 0) throw bad_input(network.name + ": the network needs integer fields 'from' and 'to'");
+  if (network.geometry != GeometryType::line_string) throw bad_input(network.name + ": the network must hold LineStrings");
+  std::map<std::int64_t, int> city_class;
+  int classes = 0;
+  if (cities) {
+    const int f_id = cities->field_index("id"), f_class = cities->field_index("class");
+    if (f_id < 0 || f_class < 0) throw bad_input(cities->name + ": the cities need integer fields 'id' and 'class'");
+    for (const Feature& f : cities->features) {
+      const auto id = as_int(f.values[std::size_t(f_id)]), cls = as_int(f.values[std::size_t(f_class)]);
+      if (!id || !cls || *cls < 0) continue;
+      city_class[*id] = int(*cls);
+      classes = std::max(classes, int(*cls) + 1);
+    }
+  }
+  auto class_of = [&](std::int64_t id) {
+    const auto it = city_class.find(id);
+    return it == city_class.end() ? -1 : it->second;
+  };
+  std::vector<roads::Link> links;
+  for (const Feature& f : network.features) {
+    if (f_kept >= 0) {
+      const auto kept = as_int(f.values[std::size_t(f_kept)]);
+      if (kept && *kept == 0) continue;
+    }
+    if (f.parts.empty() || f.parts[0].size() < 2) continue;
+    roads::Link l;
+    l.from = as_int(f.values[std::size_t(f_from)]).value_or(-1);
+    l.to = as_int(f.values[std::size_t(f_to)]).value_or(-1);
+    l.a = f.parts[0].front();
+    l.b = f.parts[0].back();
+    l.road_class = roads::link_class(class_of(l.from), class_of(l.to), classes);
+    links.push_back(l);
+  }
+  return links;
 }
 
 }  // namespace terrapolis::network

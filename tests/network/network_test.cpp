@@ -10,6 +10,7 @@
 
 #include "core/error.hpp"
 #include "core/geodesy.hpp"
+#include "network/layers.hpp"
 #include "network/network.hpp"
 #include "sites/fixtures.hpp"
 
@@ -283,4 +284,31 @@ TEST(Network, HighLatitudeGeographicReplay) {
   NetworkOptions loose;
   loose.k = 3.0;
   check_network(s, crs, build_network(s, crs, loose, progress), 3.0);
+}
+
+TEST(Network, RoadLinksReadTheKeptEdgesAndTheirCitiesClasses) {
+  // Three cities of size classes 0, 1 and 7 (8 classes): the kept links 0-1 (motorway) and 1-2
+  // (local: the smaller end is in the last quarter); the removed candidate 0-2 is no link.
+  VectorLayer net;
+  net.name = "network.geojson";
+  net.geometry = GeometryType::line_string;
+  net.fields = {{"from", FieldType::integer}, {"to", FieldType::integer}, {"kept", FieldType::integer}};
+  net.features = {{{{{0, 0}, {1, 0}}}, {std::int64_t(0), std::int64_t(1), std::int64_t(1)}},
+                  {{{{1, 0}, {2, 1}}}, {std::int64_t(1), std::int64_t(2), std::int64_t(1)}},
+                  {{{{0, 0}, {2, 1}}}, {std::int64_t(0), std::int64_t(2), std::int64_t(0)}}};
+  VectorLayer cities;
+  cities.name = "cities.geojson";
+  cities.fields = {{"id", FieldType::integer}, {"class", FieldType::integer}};
+  for (const auto& [id, cls] : std::vector<std::array<int, 2>>{{0, 0}, {1, 1}, {2, 7}})
+    cities.features.push_back({{}, {std::int64_t(id), std::int64_t(cls)}});
+  const auto links = network::road_links(net, &cities);
+  ASSERT_EQ(links.size(), 2u);
+  EXPECT_EQ(links[0].road_class, roads::RoadClass::motorway);
+  EXPECT_EQ(links[1].road_class, roads::RoadClass::local);
+  EXPECT_EQ(links[1].from, 1);
+  EXPECT_EQ(links[1].to, 2);
+  EXPECT_EQ(links[1].b[0], 2.0);
+  EXPECT_EQ(network::road_links(net, nullptr)[0].road_class, roads::RoadClass::departmental);  // no cities: departmental
+  cities.fields[1].name = "rank";
+  EXPECT_THROW(network::road_links(net, &cities), Error);
 }
