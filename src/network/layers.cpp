@@ -48,17 +48,34 @@ std::vector<roads::Link> road_links(const VectorLayer& network, const VectorLaye
   const int f_from = network.field_index("from"), f_to = network.field_index("to"), f_kept = network.field_index("kept");
   if (f_from < 0 || f_to < 0) throw bad_input(network.name + ": the network needs integer fields 'from' and 'to'");
   if (network.geometry != GeometryType::line_string) throw bad_input(network.name + ": the network must hold LineStrings");
+  // The hierarchy level of each city from its rank by population (then size class, then id): the
+  // levels of a central-place hierarchy of ratio 3 (Christaller 1933: 1 + 3 + 9 + 27 centres), so
+  // ranks 0-3 are level 0, 4-12 level 1, 13-39 level 2 and the rest level 3, whatever the region.
   std::map<std::int64_t, int> city_class;
-  int classes = 0;
+  const int classes = 4;
   if (cities) {
-    const int f_id = cities->field_index("id"), f_class = cities->field_index("class");
+    const int f_id = cities->field_index("id"), f_class = cities->field_index("class"), f_pop = cities->field_index("population");
     if (f_id < 0 || f_class < 0) throw bad_input(cities->name + ": the cities need integer fields 'id' and 'class'");
+    struct Ranked {
+      double population;
+      std::int64_t size_class, id;
+    };
+    std::vector<Ranked> ranked;
     for (const Feature& f : cities->features) {
       const auto id = as_int(f.values[std::size_t(f_id)]), cls = as_int(f.values[std::size_t(f_class)]);
       if (!id || !cls || *cls < 0) continue;
-      city_class[*id] = int(*cls);
-      classes = std::max(classes, int(*cls) + 1);
+      double population = 0;
+      if (f_pop >= 0) {
+        if (const auto* d = std::get_if<double>(&f.values[std::size_t(f_pop)])) population = *d;
+        else if (const auto i = as_int(f.values[std::size_t(f_pop)])) population = double(*i);
+      }
+      ranked.push_back({population, *cls, *id});
     }
+    std::sort(ranked.begin(), ranked.end(), [](const Ranked& x, const Ranked& y) {
+      if (x.population != y.population) return x.population > y.population;
+      return x.size_class != y.size_class ? x.size_class < y.size_class : x.id < y.id;
+    });
+    for (std::size_t r = 0; r < ranked.size(); ++r) city_class[ranked[r].id] = r < 4 ? 0 : r < 13 ? 1 : r < 40 ? 2 : 3;
   }
   auto class_of = [&](std::int64_t id) {
     const auto it = city_class.find(id);

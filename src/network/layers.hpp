@@ -16,9 +16,9 @@ namespace terrapolis::network {
 VectorLayer network_layer(const SiteGraph& graph, const std::vector<sites::Site>& sites, const Crs& crs);
 
 /// The kept edges of a network layer (as network_layer writes it) as links for the roads, each of
-/// the class roads::link_class gives its two cities (Points: id, class, as the sites stage writes
-/// them; every link departmental without `cities`). Throws bad_input naming the layer when a field
-/// is missing.
+/// the class roads::link_class gives the hierarchy levels of its two cities (Points: id, class,
+/// population; levels from the rank by population, see the code; all departmental without cities).
+/// Throws bad_input naming the layer when a field is missing.
 std::vector<roads::Link> road_links(const VectorLayer& network, const VectorLayer* cities);
 
 }  // namespace terrapolis::network

@@ -33,12 +33,12 @@ constexpr std::string_view name_of(RoadClass c) { return style_of(c).name; }
 /// The class named `name`, or nullopt.
 std::optional<RoadClass> road_class_named(std::string_view name);
 
-/// The class of a link between two settlements of size classes `a` and `b` (0 = the largest class,
-/// `classes` classes in all): a link is as important as its smaller end (Galin et al. 2011 route a
-/// level of the hierarchy between the settlements of that level and above). The smaller end's size
-/// class, as a fraction of the classes, picks the road class by quarters: the top quarter's towns
-/// are joined by motorways, the next by national roads, then departmental and local roads.
-/// Unknown classes (negative) give a departmental road.
+/// The class of a link between two settlements of hierarchy levels `a` and `b` (0 = the top,
+/// `classes` levels in all): a link is as important as its smaller end (Galin et al. 2011 route a
+/// level of the hierarchy between the settlements of that level and above). The smaller end's
+/// level, as a fraction of the levels, picks the road class by quarters: motorways join the top
+/// quarter, then national, departmental and local roads (network::road_links gives 4 levels).
+/// Unknown levels (negative) give a departmental road.
 RoadClass link_class(int a, int b, int classes);
 
 }  // namespace terrapolis::roads
