@@ -49,8 +49,8 @@ std::vector<roads::Link> road_links(const VectorLayer& network, const VectorLaye
   if (f_from < 0 || f_to < 0) throw bad_input(network.name + ": the network needs integer fields 'from' and 'to'");
   if (network.geometry != GeometryType::line_string) throw bad_input(network.name + ": the network must hold LineStrings");
   // The hierarchy level of each city from its rank by population (then size class, then id): the
-  // levels of a central-place hierarchy of ratio 3 (Christaller 1933: 1 + 3 + 9 + 27 centres), so
-  // ranks 0-3 are level 0, 4-12 level 1, 13-39 level 2 and the rest level 3, whatever the region.
+  // levels of a central-place hierarchy of ratio 3 (Christaller 1933; docs/roads.md): the 1 + 3
+  // highest centres are level 0, the next 9 level 1, the next 27 level 2, the rest level 3.
   std::map<std::int64_t, int> city_class;
   const int classes = 4;
   if (cities) {
