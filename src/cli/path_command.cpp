@@ -81,7 +81,7 @@ class PathCommand final : public Command {
     std::vector<roads::Road> roads{*road};
     roads[0].from = 0;
     roads[0].to = 1;
-    roads[0].road_class = "departmental";
+    roads[0].road_class = road->ferry ? roads::RoadClass::maritime : roads::RoadClass::departmental;
     const VectorLayer layer = roads::roads_layer(terrain, roads);
     const VectorLayer sections_layer = roads::sections_layer(terrain, roads);
     const Dem levelled = options_.earthworks_dem(dem, terrain, roads);

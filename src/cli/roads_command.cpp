@@ -15,6 +15,7 @@
 #include "io/output_set.hpp"
 #include "io/raster_io.hpp"
 #include "io/vector_io.hpp"
+#include "network/layers.hpp"
 #include "roads/road_network.hpp"
 
 namespace terrapolis::cli {
@@ -65,7 +66,7 @@ class RoadsCommand final : public Command {
     const roads::RoadGraph graph(terrain, model, options_.graph());
     const auto t0 = std::chrono::steady_clock::now();
     roads::NetworkResult result =
-        roads::route_network(terrain, graph, network, cities ? &*cities : nullptr, options_.routing(), context.progress);
+        roads::route_network(terrain, graph, network::road_links(network, cities ? &*cities : nullptr), options_.routing(), context.progress);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     for (const std::string& f : result.failed) context.log.warn("no road under the cost model for edge " + f + " (left out)");
     for (const std::string& f : result.over_budget) context.log.warn("not routed: budget (--max-seconds) for edge " + f);

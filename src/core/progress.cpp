@@ -22,10 +22,14 @@ bool ConsoleProgress::update(double fraction) {
     ++printed_;
     if (printed_ % 4 == 0) std::fprintf(stderr, "%d", printed_ / 4 * 10);
     else std::fputc('.', stderr);
+    // Every 10 %, the time left when the step is long enough for it to matter.
+    if (printed_ % 4 == 0 && printed_ < 40 && remaining_s_ >= 10) std::fprintf(stderr, " (%.0f s left) ", remaining_s_);
   }
   std::fflush(stderr);
   return interrupt_signal() == 0;
 }
+
+void ConsoleProgress::estimate(double remaining_s, std::string_view) { remaining_s_ = remaining_s; }
 
 void ConsoleProgress::end() {
   update(1.0);
@@ -34,6 +38,8 @@ void ConsoleProgress::end() {
 
 void JsonProgress::begin(std::string_view step) {
   step_ = step;
+  detail_.clear();
+  remaining_s_ = -1;
   printed_ = -1;
   update(0.0);
 }
@@ -42,18 +48,31 @@ bool JsonProgress::update(double fraction) {
   const int percent = int(std::clamp(fraction, 0.0, 1.0) * 100.0 + 1e-9);
   if (percent != printed_) {
     printed_ = percent;
-    std::fprintf(stderr, "{\"step\":\"%s\",\"progress\":%.2f}\n", step_.c_str(), percent / 100.0);
+    std::string extra;
+    if (remaining_s_ >= 0) extra += ",\"eta_s\":" + std::to_string(int(remaining_s_ + 0.5));
+    if (!detail_.empty()) extra += ",\"detail\":\"" + detail_ + "\"";  // plain ASCII text of ours: no escaping needed
+    std::fprintf(stderr, "{\"step\":\"%s\",\"progress\":%.2f%s}\n", step_.c_str(), percent / 100.0, extra.c_str());
     std::fflush(stderr);
   }
   return interrupt_signal() == 0;
 }
 
-void JsonProgress::end() { update(1.0); }
+void JsonProgress::estimate(double remaining_s, std::string_view detail) {
+  remaining_s_ = remaining_s;
+  detail_ = detail;
+}
+
+void JsonProgress::end() {
+  remaining_s_ = 0;
+  update(1.0);
+}
 
 bool SilentProgress::update(double) { return interrupt_signal() == 0; }
 
-void ProgressStep::update(double fraction) {
+void ProgressStep::update(double fraction, std::string_view detail) {
   stop_if_interrupted();
+  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count();
+  progress_.estimate(fraction >= 0.02 ? elapsed * (1 - std::min(fraction, 1.0)) / fraction : -1, detail);
   if (!progress_.update(fraction)) throw Error(ErrorKind::cancelled, "cancelled");
 }
 

@@ -1,6 +1,7 @@
 // Progress reporting with cancellation, and a levelled log; kept apart on purpose.
 // SPDX-License-Identifier: MIT
 #pragma once
+#include <chrono>
 #include <string>
 #include <string_view>
 
@@ -17,6 +18,9 @@ class Progress {
   virtual bool update(double fraction) = 0;
   /// The current step is finished.
   virtual void end() = 0;
+  /// The step's estimated remaining time (seconds, from its pace so far) and what it is doing
+  /// ("road 12 of 300"), before an update; sinks may show them with the next fraction.
+  virtual void estimate(double /*remaining_s*/, std::string_view /*detail*/) {}
 };
 
 class SilentProgress final : public Progress {
@@ -33,8 +37,11 @@ class ConsoleProgress final : public Progress {
   bool update(double fraction) override;
   void end() override;
 
+  void estimate(double remaining_s, std::string_view detail) override;
+
  private:
   int printed_ = -1;  // last tick printed, in 2.5 % steps
+  double remaining_s_ = -1;
 };
 
 /// One JSON object per line on stderr: {"step":"fill","progress":0.42}, for GUIs such as the QGIS provider.
@@ -43,24 +50,30 @@ class JsonProgress final : public Progress {
   void begin(std::string_view step) override;
   bool update(double fraction) override;
   void end() override;
+  void estimate(double remaining_s, std::string_view detail) override;
 
  private:
-  std::string step_;
+  std::string step_, detail_;
   int printed_ = -1;  // last percent printed
+  double remaining_s_ = -1;
 };
 
 /// Runs one named step on a Progress: begin on construction, end on destruction; `update`
-/// throws Error(cancelled) when the sink asks to stop.
+/// throws Error(cancelled) when the sink asks to stop, and estimates the remaining time from the
+/// pace so far (once 2 % is done), with an optional `detail` ("road 12 of 300").
 class ProgressStep {
  public:
-  ProgressStep(Progress& progress, std::string_view step) : progress_(progress) { progress_.begin(step); }
+  ProgressStep(Progress& progress, std::string_view step) : progress_(progress), started_(std::chrono::steady_clock::now()) {
+    progress_.begin(step);
+  }
   ~ProgressStep() { progress_.end(); }
   ProgressStep(const ProgressStep&) = delete;
   ProgressStep& operator=(const ProgressStep&) = delete;
-  void update(double fraction);
+  void update(double fraction, std::string_view detail = {});
 
  private:
   Progress& progress_;
+  std::chrono::steady_clock::time_point started_;
 };
 
 enum class LogLevel { quiet, normal, verbose };

@@ -15,6 +15,7 @@
 #include "io/crs.hpp"
 #include "pipeline/hillshade.hpp"
 #include "pipeline/png/png_writer.h"
+#include "roads/road_class.hpp"
 
 namespace terrapolis::pipeline {
 namespace {
@@ -198,10 +199,10 @@ void write_preview(const RunState& state, const std::string& path, int width) {
         if (style == Style::streams) { w = unit * (0.5 + 0.3 * std::atoi(field(layer, f, "strahler").c_str())); }
         else if (style == Style::network) { if (field(layer, f, "kept") != "1") continue; color = hex(0x636363); w = unit * 0.6; dashed = true; }
         else if (style == Style::roads) {
-          const std::string cls = field(layer, f, "class");
-          color = cls == "motorway" ? hex(0xe31a1c) : cls == "national" ? hex(0xff7f00) : cls == "maritime" ? hex(0x1f78b4) : hex(0xb8860b);
-          w = unit * (cls == "motorway" ? 2.2 : cls == "national" ? 1.6 : 1.1);
-          dashed = cls == "maritime";
+          const auto& s = roads::style_of(roads::road_class_named(field(layer, f, "class")).value_or(roads::RoadClass::departmental));
+          color = hex(unsigned(std::stoul(std::string(s.colour.substr(1)), nullptr, 16)));
+          w = unit * (0.6 + 1.3 * s.width_mm);  // the QGIS widths, scaled to the image
+          dashed = s.dashed;
         } else if (style == Style::road_sections) {
           const std::string s = field(layer, f, "structure");
           if (s == "bridge") { color = hex(0x08519c); w = unit * 3; }

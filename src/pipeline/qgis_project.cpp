@@ -14,6 +14,7 @@
 #include "core/error.hpp"
 #include "io/crs.hpp"
 #include "io/text_io.hpp"
+#include "roads/road_class.hpp"
 
 namespace terrapolis::pipeline {
 namespace {
@@ -216,11 +217,13 @@ std::string qgis_style_body(const OutputFile& o, const RunState& state) {
     case Style::city_extents: return single(fill("0", "239,59,44,60", "165,15,21,255"));
     case Style::network:
       return categorized("kept", {{"1", "kept link", line("0", "#252525", 0.5)}, {"0", "removed candidate", line("1", "#bdbdbd", 0.2, "dash")}});
-    case Style::roads:
-      return categorized("class", {{"motorway", "motorway", line("0", "#e31a1c", 1.2)},
-                                   {"national", "national", line("1", "#ff7f00", 0.8)},
-                                   {"departmental", "departmental", line("2", "#ffd92f", 0.5)},
-                                   {"maritime", "maritime link", line("3", "#1f78b4", 0.5, "dash")}});
+    case Style::roads: {
+      std::vector<Category> cats;
+      for (const roads::RoadClassStyle& s : roads::kRoadClasses)
+        cats.push_back({std::string(s.name), std::string(s.label),
+                        line(std::to_string(cats.size()), std::string(s.colour), s.width_mm, s.dashed ? "dash" : "solid")});
+      return categorized("class", cats);
+    }
     case Style::road_sections:
       return categorized("structure", {{"road", "road", line("0", "#636363", 0.4)},
                                        {"bridge", "bridge", line("1", "#1f78b4", 1.4)},

@@ -268,7 +268,7 @@ void roads_run(RunState& s, Progress& progress, const Log& log) {
     terrain.set_vegetation(read_resampled(settings.vegetation, s.dem.georef(), s.dem.cols(), s.dem.rows(), Resampling::bilinear));
   plugin::add_to_terrain(plugin::road_terms(s.plugins, s.dem, progress, log), terrain);
   const roads::RoadGraph graph(terrain, settings.model, settings.routing.graph);
-  const roads::NetworkResult r = roads::route_network(terrain, graph, *s.network, &*s.cities, settings.routing, progress);
+  const roads::NetworkResult r = roads::route_network(terrain, graph, network::road_links(*s.network, &*s.cities), settings.routing, progress);
   for (const auto& f : r.failed) log.warn("no road: " + f);
   for (const auto& f : r.over_budget) log.warn("not routed: budget (roads.max_seconds): " + f);
   s.write("roads", "roads.geojson", roads::roads_layer(terrain, r.roads), "roads with class, router, length, cost, grades, structures",
@@ -278,12 +278,12 @@ void roads_run(RunState& s, Progress& progress, const Log& log) {
   std::map<std::string, double> km;
   double bridge_m = 0, tunnel_m = 0;
   for (const auto& road : r.roads) {
-    km[road.ferry ? "maritime" : road.road_class] += road.stats.length_m / 1000;
+    km[std::string(roads::name_of(road.road_class))] += road.stats.length_m / 1000;
     bridge_m += road.stats.bridge_m;
     tunnel_m += road.stats.tunnel_m;
   }
   json per_class = json::object();
-  for (const char* c : {"motorway", "national", "departmental", "maritime"}) per_class[c] = round_to(km[c], 0.01);
+  for (const roads::RoadClassStyle& c : roads::kRoadClasses) per_class[std::string(c.name)] = round_to(km[std::string(c.name)], 0.01);
   s.summary["roads"] = {{"roads", r.roads.size()}, {"failed", r.failed.size()}, {"not_routed_budget", r.over_budget.size()},
                         {"length_km", per_class},
                         {"bridge_m", round_to(bridge_m, 0.1)}, {"tunnel_m", round_to(tunnel_m, 0.1)}};

@@ -651,6 +651,18 @@ class RelaxedDistance {
   }
   bool settled(Cell v) { return scratch().closed[t_.index(v.col, v.row)] != 0; }
   std::size_t settled_cells() const { return settled_; }
+  /// Guides the search towards another source. Settled distances stay exact whatever the guide (a
+  /// consistent heuristic never settles a cell early), so re-keying the queue with the new source's
+  /// straight-line bound resumes an exact search: every road ending at the target shares it.
+  void set_source(Cell source) {
+    if (source == source_) return;
+    source_ = source;
+    for (Entry& e : heap_) {
+      const Cell c{int(e.cell % std::size_t(t_.cols())), int(e.cell / std::size_t(t_.cols()))};
+      e.f = e.g + graph_.lower_bound(c, source_);
+    }
+    std::make_heap(heap_.begin(), heap_.end());
+  }
 
  private:
   struct Entry {
@@ -745,8 +757,20 @@ class RelaxedDistance {
 
 }  // namespace
 
+struct TargetSearch::State {
+  State(const RoadGraph& graph, Cell target)
+      : target(target), arcs(graph), long_arcs(graph.terrain().size(), graph.rings().size(), std::size_t(1) << 25) {}  // at most 128 MB
+  Cell target;
+  ArcCache arcs;            ///< surface arc costs: a function of the graph alone
+  LongArcCache long_arcs;   ///< long arc costs, likewise
+  std::optional<RelaxedDistance> relaxed;  ///< the relaxed reverse search from the target, resumed by each road
+};
+
+TargetSearch::TargetSearch(const RoadGraph& graph, Cell target) : state_(std::make_unique<State>(graph, target)) {}
+TargetSearch::~TargetSearch() = default;
+
 SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMethod method, std::size_t max_nodes,
-                           Progress* progress, double max_seconds) {
+                           Progress* progress, double max_seconds, TargetSearch* shared) {
   const auto started = std::chrono::steady_clock::now();
   std::size_t pops = 0;
   // The clock is read every 1024 pops (about a millisecond of search).
@@ -789,9 +813,18 @@ SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMet
   // reduced arc costs l(u,v) - p(u) + p(v) are >= 0 in both directions and the search may stop as
   // soon as top_f + top_b >= mu, the best meeting cost (the bidirectional Dijkstra rule on the
   // reduced costs).
-  ArcCache cache(graph);
-  std::optional<RelaxedDistance> rel;
-  if (relaxed) rel.emplace(graph, to, from, cache);
+  std::optional<TargetSearch> own;
+  if (shared && !(shared->state().target == to)) throw processing_error("path: a shared target search used for another target");
+  TargetSearch::State& state = (shared ? *shared : own.emplace(graph, to)).state();
+  ArcCache& cache = state.arcs;
+  RelaxedDistance* rel = nullptr;
+  std::size_t settled_before = 0;
+  if (relaxed) {
+    if (state.relaxed) state.relaxed->set_source(from);
+    else state.relaxed.emplace(graph, to, from, cache);
+    rel = &*state.relaxed;
+    settled_before = rel->settled_cells();
+  }
   auto potential = [&](Cell v) {
     if (!use_h) return 0.0;
     if (relaxed) return std::max(graph.lower_bound(v, to), rel->bound(v));
@@ -807,7 +840,7 @@ SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMet
   const std::vector<RoadGraph::Arc>& arcs = graph.arcs();
 
   Frontier fw(t.size(), O), bw(bidir ? t.size() : 0, O);
-  LongArcCache long_cache(t.size(), graph.rings().size(), std::size_t(1) << 25);  // at most 128 MB
+  LongArcCache& long_cache = state.long_arcs;
   // Long arcs are priced as floats in both directions, cached or not, so every search sees the same costs.
   auto long_cost = [&](Cell from_cell, int a) { return double(float(graph.arc_cost(from_cell, a))); };
   auto check_memory = [&]() {
@@ -942,7 +975,7 @@ SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMet
       if (!step_once(true)) break;
     }
     result.nodes = fw.stored;
-    if (rel) result.relaxed_settled = rel->settled_cells();
+    if (rel) result.relaxed_settled = rel->settled_cells() - settled_before;
     if (goal_node == Frontier::kNone || result.over_budget) return result;
     result.found = true;
     result.cost = fw.nodes[goal_node].g;

@@ -2,6 +2,7 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -150,6 +151,23 @@ struct SearchResult {
   bool over_budget = false;            ///< stopped by max_seconds (found = false)
 };
 
+/// What successive searches ending at one target share: the arc cost caches and the relaxed reverse
+/// search of the A* heuristic (SearchMethod::astar), resumed for each new source. Sharing never
+/// changes a cost (the caches hold functions of the graph; the reverse search stays exact). One
+/// thread at a time, created and destroyed on the same thread.
+class TargetSearch {
+ public:
+  TargetSearch(const RoadGraph& graph, Cell target);
+  ~TargetSearch();
+  TargetSearch(const TargetSearch&) = delete;
+  TargetSearch& operator=(const TargetSearch&) = delete;
+  struct State;  ///< defined by the search
+  State& state() { return *state_; }
+
+ private:
+  std::unique_ptr<State> state_;
+};
+
 /// Shortest path from `from` to `to` (any final orientation). Nodes are stored per touched cell so
 /// memory grows with the explored region only. Long arcs are priced lazily: expanding a node queues
 /// one entry per ring keyed by a lower bound of what its arcs could reach, and the ring is priced only
@@ -157,8 +175,10 @@ struct SearchResult {
 /// node the ring would reach). Throws processing_error when more than `max_nodes` would be
 /// stored. Returns found = false when no finite-cost path exists.
 /// `max_seconds` > 0: give up after that long (wall clock) and return over_budget = true.
+/// `shared`: the state of earlier searches to the same `to` (see TargetSearch), or nullptr.
 SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMethod method,
-                           std::size_t max_nodes = 60'000'000, Progress* progress = nullptr, double max_seconds = 0);
+                           std::size_t max_nodes = 60'000'000, Progress* progress = nullptr, double max_seconds = 0,
+                           TargetSearch* shared = nullptr);
 
 /// Cost under `graph` of a given chain of cells joined by straight surface arcs (each step must be
 /// an arc of the graph's mask), the turns priced as the search prices them; infinity when the chain

@@ -58,7 +58,7 @@ std::optional<Cell> cell_at(const TerrainField& terrain, double x, double y) {
 }
 
 std::optional<Road> route_road(const TerrainField& t, const RoadGraph& graph, Cell from, Cell to, const RoutingOptions& options,
-                               Progress* progress) {
+                               Progress* progress, TargetSearch* shared) {
   Road road;
   const auto a = snap_to_land(t, from, options.snap_cells), b = snap_to_land(t, to, options.snap_cells);
   const auto& land = t.land_components();
@@ -76,7 +76,7 @@ std::optional<Road> route_road(const TerrainField& t, const RoadGraph& graph, Ce
   // Two land masses: only bridges can join them on the ground (an archipelago), else a ferry.
   if (!a || !b || (apart && (options.router == Router::bezier || !graph.model().bridge.enabled))) return ferry();
   if (options.router == Router::galin) {
-    const SearchResult s = shortest_path(graph, *a, *b, options.search, options.max_nodes, progress, options.max_seconds);
+    const SearchResult s = shortest_path(graph, *a, *b, options.search, options.max_nodes, progress, options.max_seconds, shared);
     if (s.over_budget) {
       road.over_budget = true;
       road.router = "galin";
@@ -118,82 +118,66 @@ std::optional<Road> route_road(const TerrainField& t, const RoadGraph& graph, Ce
   return road;
 }
 
-NetworkResult route_network(const TerrainField& t, const RoadGraph& graph, const VectorLayer& network, const VectorLayer* cities,
-                            const RoutingOptions& options, Progress& progress) {
-  const int f_from = network.field_index("from"), f_to = network.field_index("to"), f_kept = network.field_index("kept");
-  if (f_from < 0 || f_to < 0) throw bad_input(network.name + ": the network needs integer fields 'from' and 'to'");
-  if (network.geometry != GeometryType::line_string) throw bad_input(network.name + ": the network must hold LineStrings");
-  auto as_int = [](const FieldValue& v) -> std::optional<std::int64_t> {
-    if (const auto* i = std::get_if<std::int64_t>(&v)) return *i;
-    if (const auto* d = std::get_if<double>(&v)) return std::int64_t(std::llround(*d));
-    return std::nullopt;
-  };
-  std::map<std::int64_t, std::int64_t> city_class;
-  if (cities) {
-    const int f_id = cities->field_index("id"), f_class = cities->field_index("class");
-    if (f_id < 0 || f_class < 0) throw bad_input(cities->name + ": the cities need integer fields 'id' and 'class'");
-    for (const Feature& f : cities->features) {
-      const auto id = as_int(f.values[std::size_t(f_id)]), cls = as_int(f.values[std::size_t(f_class)]);
-      if (id && cls) city_class[*id] = *cls;
-    }
-  }
+NetworkResult route_network(const TerrainField& t, const RoadGraph& graph, const std::vector<Link>& links, const RoutingOptions& options,
+                            Progress& progress) {
   struct Edge {
-    std::int64_t from, to;
     Cell a, b;
   };
   std::vector<Edge> edges;
-  for (std::size_t i = 0; i < network.features.size(); ++i) {
-    const Feature& f = network.features[i];
-    if (f_kept >= 0) {
-      const auto kept = as_int(f.values[std::size_t(f_kept)]);
-      if (kept && *kept == 0) continue;
+  for (std::size_t i = 0; i < links.size(); ++i) {
+    const auto a = cell_at(t, links[i].a[0], links[i].a[1]), b = cell_at(t, links[i].b[0], links[i].b[1]);
+    if (!a || !b)
+      throw bad_input("network: link " + std::to_string(links[i].from) + "-" + std::to_string(links[i].to) + " has an end outside the DEM");
+    edges.push_back({*a, *b});
+  }
+  // Roads ending at the same cell share one target search (arc costs and the heuristic's reverse
+  // search, see TargetSearch): edges are grouped by their end, the groups routed in parallel, each
+  // group's roads in edge order on one thread, so the output does not depend on the threads.
+  std::vector<std::vector<std::size_t>> groups;
+  {
+    std::map<std::size_t, std::size_t> group_of;
+    for (std::size_t i = 0; i < edges.size(); ++i) {
+      const auto [it, fresh] = group_of.try_emplace(t.index(edges[i].b.col, edges[i].b.row), groups.size());
+      if (fresh) groups.emplace_back();
+      groups[it->second].push_back(i);
     }
-    if (f.parts.empty() || f.parts[0].size() < 2) continue;
-    const auto& line = f.parts[0];
-    const auto a = cell_at(t, line.front()[0], line.front()[1]), b = cell_at(t, line.back()[0], line.back()[1]);
-    if (!a || !b) throw bad_input(network.name + ": edge " + std::to_string(i) + " has an end outside the DEM");
-    edges.push_back({as_int(f.values[std::size_t(f_from)]).value_or(-1), as_int(f.values[std::size_t(f_to)]).value_or(-1), *a, *b});
   }
   std::vector<std::optional<Road>> out(edges.size());
   ProgressStep step(progress, "roads");
   std::mutex progress_mutex;  // the sink is not thread-safe; a cancel throws out of parallel_for
   std::size_t done = 0;
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, edges.size(), 1), [&](const tbb::blocked_range<std::size_t>& range) {
-    for (std::size_t i = range.begin(); i != range.end(); ++i) {
-      RoutingOptions o = options;
-      o.bezier.seed = mix(options.bezier.seed ^ mix(i));
-      const Edge& e = edges[i];
-      if (e.a == e.b) continue;
-      out[i] = route_road(t, graph, e.a, e.b, o);
-      if (out[i]) {
-        out[i]->from = e.from;
-        out[i]->to = e.to;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, groups.size(), 1), [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t g = range.begin(); g != range.end(); ++g) {
+      std::optional<TargetSearch> shared;
+      if (const auto end = snap_to_land(t, edges[groups[g].front()].b, options.snap_cells)) shared.emplace(graph, *end);
+      for (const std::size_t i : groups[g]) {
+        RoutingOptions o = options;
+        o.bezier.seed = mix(options.bezier.seed ^ mix(i));
+        const Edge& e = edges[i];
+        if (e.a == e.b) continue;
+        out[i] = route_road(t, graph, e.a, e.b, o, nullptr, shared ? &*shared : nullptr);
+        if (out[i]) {
+          out[i]->from = links[i].from;
+          out[i]->to = links[i].to;
+          out[i]->road_class = out[i]->ferry ? RoadClass::maritime : links[i].road_class;
+        }
+        const std::lock_guard<std::mutex> lock(progress_mutex);
+        ++done;
+        step.update(double(done) / double(edges.size()), std::to_string(done) + " of " + std::to_string(edges.size()) + " roads");
       }
-      const std::lock_guard<std::mutex> lock(progress_mutex);
-      step.update(double(++done) / double(edges.size()));
     }
   });
   step.update(1.0);
   NetworkResult result;
   for (std::size_t i = 0; i < edges.size(); ++i) {
-    const Edge& e = edges[i];
+    const std::string name = std::to_string(links[i].from) + "-" + std::to_string(links[i].to);
     if (!out[i]) {
-      if (!(e.a == e.b)) result.failed.push_back(std::to_string(e.from) + "-" + std::to_string(e.to));
-      continue;
-    }
-    if (out[i]->over_budget) {
-      result.over_budget.push_back(std::to_string(e.from) + "-" + std::to_string(e.to));
-      continue;
-    }
-    Road r = std::move(*out[i]);
-    const auto ca = city_class.find(e.from), cb = city_class.find(e.to);
-    if (ca != city_class.end() && cb != city_class.end()) {
-      const double mean = 0.5 * double(ca->second + cb->second);
-      r.road_class = mean < 1 ? "motorway" : mean < 2 ? "national" : "departmental";
+      if (!(edges[i].a == edges[i].b)) result.failed.push_back(name);
+    } else if (out[i]->over_budget) {
+      result.over_budget.push_back(name);
     } else {
-      r.road_class = "departmental";
+      result.roads.push_back(std::move(*out[i]));
     }
-    result.roads.push_back(std::move(r));
   }
   return result;
 }
@@ -223,7 +207,7 @@ VectorLayer roads_layer(const TerrainField& t, const std::vector<Road>& roads) {
     f.parts.push_back(to_crs(t, r.ferry ? r.ferry_line : r.geometry.points));
     std::optional<double> cost;
     if (r.cost) cost = round_to(*r.cost, 0.01);
-    f.values = {std::int64_t(r.from), std::int64_t(r.to), r.road_class, r.router, round_to(r.stats.length_m, 0.01), opt(cost),
+    f.values = {std::int64_t(r.from), std::int64_t(r.to), std::string(name_of(r.road_class)), r.router, round_to(r.stats.length_m, 0.01), opt(cost),
                 round_to(r.stats.max_grade_pct, 0.01), round_to(r.stats.mean_grade_pct, 0.01), round_to(r.stats.bridge_m, 0.01),
                 round_to(r.stats.tunnel_m, 0.01)};
     layer.features.push_back(std::move(f));

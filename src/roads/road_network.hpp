@@ -10,6 +10,7 @@
 #include "io/vector_io.hpp"
 #include "roads/anisotropic_search.hpp"
 #include "roads/bezier_router.hpp"
+#include "roads/road_class.hpp"
 #include "roads/road_geometry.hpp"
 
 namespace terrapolis::roads {
@@ -29,7 +30,7 @@ struct RoutingOptions {
 /// One routed road with everything the outputs need.
 struct Road {
   std::int64_t from = -1, to = -1;
-  std::string road_class;      ///< motorway, national, departmental
+  RoadClass road_class = RoadClass::departmental;  ///< maritime for a ferry link
   std::string router;          ///< galin, bezier, ferry
   std::optional<double> cost;  ///< cost under the Galin model (null when infinite: Bézier roads may break it)
   RoadGeometry geometry;
@@ -45,21 +46,26 @@ struct Road {
 /// Routes one road between two cells. Ends on water are moved to land (snap_cells); ends on two
 /// different land masses give a maritime link. Returns nullopt when no road exists (e.g. the slope
 /// threshold closes every way) and no maritime link applies.
+/// `shared`: the target search of earlier roads ending at the same (snapped) `to`, or nullptr.
 std::optional<Road> route_road(const TerrainField& terrain, const RoadGraph& graph, Cell from, Cell to, const RoutingOptions& options,
-                               Progress* progress = nullptr);
+                               Progress* progress = nullptr, TargetSearch* shared = nullptr);
 
-/// Roads of every kept edge of a network (LineStrings with from, to, kept; first and last vertices
-/// are the ends) whose cities give the class (class 0 = largest; mean class < 1 motorway, < 2
-/// national, else departmental; departmental when the cities are unknown). Roads are routed in
-/// parallel (oneTBB) into a vector indexed by edge, so the output does not depend on the threads.
-/// Edges with no road are reported in `failed` and left out.
+/// A network link to route: its two settlements (ids), their centres in the DEM's CRS, its class.
+struct Link {
+  std::int64_t from = -1, to = -1;
+  std::array<double, 2> a{}, b{};
+  RoadClass road_class = RoadClass::departmental;
+};
+
+/// Roads of the links. Roads are routed in parallel (oneTBB) into a vector indexed by link, so the
+/// output does not depend on the threads. Links with no road are reported in `failed` and left out.
 struct NetworkResult {
   std::vector<Road> roads;
   std::vector<std::string> failed;
   std::vector<std::string> over_budget;  ///< links not routed within roads.max_seconds ("from-to")
 };
-NetworkResult route_network(const TerrainField& terrain, const RoadGraph& graph, const VectorLayer& network,
-                            const VectorLayer* cities, const RoutingOptions& options, Progress& progress);
+NetworkResult route_network(const TerrainField& terrain, const RoadGraph& graph, const std::vector<Link>& links,
+                            const RoutingOptions& options, Progress& progress);
 
 /// The roads layer (one LineString per road, in the DEM's CRS) and the sections layer.
 VectorLayer roads_layer(const TerrainField& terrain, const std::vector<Road>& roads);

@@ -10,6 +10,7 @@
 
 #include "core/error.hpp"
 #include "core/geodesy.hpp"
+#include "network/layers.hpp"
 #include "network/network.hpp"
 #include "sites/fixtures.hpp"
 
@@ -283,4 +284,33 @@ TEST(Network, HighLatitudeGeographicReplay) {
   NetworkOptions loose;
   loose.k = 3.0;
   check_network(s, crs, build_network(s, crs, loose, progress), 3.0);
+}
+
+TEST(Network, RoadLinksReadTheKeptEdgesAndClassThemByTheCitiesRanks) {
+  // 41 cities, city i of population 1000 - i (rank i): ranks 0-3 are level 0, 4-12 level 1, 13-39
+  // level 2, 40 level 3. Kept links 0-1 (motorway), 1-13 (departmental: the smaller end decides)
+  // and 5-40 (local); the removed candidate 0-2 is no link.
+  VectorLayer net;
+  net.name = "network.geojson";
+  net.geometry = GeometryType::line_string;
+  net.fields = {{"from", FieldType::integer}, {"to", FieldType::integer}, {"kept", FieldType::integer}};
+  net.features = {{{{{0, 0}, {1, 0}}}, {std::int64_t(0), std::int64_t(1), std::int64_t(1)}},
+                  {{{{1, 0}, {2, 1}}}, {std::int64_t(1), std::int64_t(13), std::int64_t(1)}},
+                  {{{{0, 0}, {2, 1}}}, {std::int64_t(0), std::int64_t(2), std::int64_t(0)}},
+                  {{{{3, 0}, {4, 1}}}, {std::int64_t(5), std::int64_t(40), std::int64_t(1)}}};
+  VectorLayer cities;
+  cities.name = "cities.geojson";
+  cities.fields = {{"id", FieldType::integer}, {"class", FieldType::integer}, {"population", FieldType::integer}};
+  for (int id = 40; id >= 0; --id) cities.features.push_back({{}, {std::int64_t(id), std::int64_t(3), std::int64_t(1000 - id)}});
+  const auto links = network::road_links(net, &cities);
+  ASSERT_EQ(links.size(), 3u);
+  EXPECT_EQ(links[0].road_class, roads::RoadClass::motorway);
+  EXPECT_EQ(links[1].road_class, roads::RoadClass::departmental);
+  EXPECT_EQ(links[2].road_class, roads::RoadClass::local);
+  EXPECT_EQ(links[1].from, 1);
+  EXPECT_EQ(links[1].to, 13);
+  EXPECT_EQ(links[1].b[0], 2.0);
+  EXPECT_EQ(network::road_links(net, nullptr)[0].road_class, roads::RoadClass::departmental);  // no cities: departmental
+  cities.fields[1].name = "rank";
+  EXPECT_THROW(network::road_links(net, &cities), Error);
 }

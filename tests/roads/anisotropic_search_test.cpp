@@ -6,6 +6,7 @@
 #include <numbers>
 #include <random>
 
+#include "core/error.hpp"
 #include "roads/anisotropic_search.hpp"
 #include "roads/road_geometry.hpp"
 #include "roads_fixtures.hpp"
@@ -80,6 +81,41 @@ TEST(AnisotropicSearch, AStarBidirectionalAndDijkstraAgreeOnRandomProblems) {
     }
   }
   EXPECT_GE(found, 40);
+}
+
+TEST(AnisotropicSearch, RoadsSharingATargetSearchKeepDijkstrasCosts) {
+  // Every heuristic, several sources in turn to one target with one shared TargetSearch (the
+  // relaxed reverse search resumed and re-keyed for each source): each cost is Dijkstra's.
+  std::mt19937_64 rng(7);
+  int found = 0;
+  for (int trial = 0; trial < 30; ++trial) {
+    const Dem dem = random_dem(rng, 16);
+    const CostModel model = random_model(rng);
+    const TerrainField terrain(dem, 0.0, 10.0, 0.0);
+    const GraphOptions go{1 + int(rng() % 3), int(std::vector<int>{1, 3, 8}[rng() % 3]), rng()};
+    const RoadGraph graph(terrain, model, go);
+    const Cell target{int(rng() % 16), int(rng() % 16)};
+    for (SearchMethod method : {SearchMethod::astar, SearchMethod::astar_distance, SearchMethod::bidirectional, SearchMethod::dijkstra}) {
+      TargetSearch shared(graph, target);
+      for (int road = 0; road < 4; ++road) {
+        const Cell source{int(rng() % 16), int(rng() % 16)};
+        const SearchResult d = shortest_path(graph, source, target, SearchMethod::dijkstra);
+        const SearchResult s = shortest_path(graph, source, target, method, 60'000'000, nullptr, 0, &shared);
+        ASSERT_EQ(d.found, s.found) << trial << " road " << road;
+        if (!d.found) continue;
+        ++found;
+        EXPECT_NEAR(s.cost, d.cost, 1e-9 * (1 + d.cost)) << trial << " road " << road;
+        ASSERT_EQ(s.cells.front(), source);
+        ASSERT_EQ(s.cells.back(), target);
+      }
+    }
+  }
+  EXPECT_GE(found, 200);
+  const Dem dem = random_dem(rng, 16);
+  const TerrainField terrain(dem, 0.0, 10.0, 0.0);
+  const RoadGraph graph(terrain, default_cost_model(), GraphOptions{});
+  TargetSearch shared(graph, {3, 3});
+  EXPECT_THROW(shortest_path(graph, {0, 0}, {4, 4}, SearchMethod::astar, 60'000'000, nullptr, 0, &shared), Error);
 }
 
 TEST(AnisotropicSearch, NoSurfaceArcSteeperThanTheThresholdAndNoInfiniteArc) {

@@ -22,21 +22,13 @@ Dem islands() {
   });
 }
 
-VectorLayer network(const Dem& dem, const std::vector<std::array<int, 4>>& edges) {
-  VectorLayer l;
-  l.name = "network.geojson";
-  l.geometry = GeometryType::line_string;
-  l.crs = dem.georef().crs;
-  l.fields = {{"from", FieldType::integer}, {"to", FieldType::integer}, {"kept", FieldType::integer}};
-  int id = 0;
+std::vector<Link> network(const Dem& dem, const std::vector<std::array<int, 4>>& edges) {
+  std::vector<Link> links;
   for (const auto& e : edges) {
-    Feature f;
-    f.parts.push_back({dem.georef().cell_centre(e[0], e[1]), dem.georef().cell_centre(e[2], e[3])});
-    f.values = {std::int64_t(id), std::int64_t(id + 1), std::int64_t(1)};
-    ++id;
-    l.features.push_back(f);
+    const std::int64_t id = std::int64_t(links.size());
+    links.push_back({id, id + 1, dem.georef().cell_centre(e[0], e[1]), dem.georef().cell_centre(e[2], e[3]), RoadClass::departmental});
   }
-  return l;
+  return links;
 }
 
 std::string dump(const VectorLayer& l) {
@@ -67,7 +59,7 @@ TEST(RoadNetwork, SameOutputWithOneAndTwoThreadsAndFerriesBetweenIslands) {
   model.bridge.max_length_cells = model.tunnel.max_length_cells = 8;
   model.bridge.samples = model.tunnel.samples = 20;
   const RoadGraph graph(terrain, model, {4, 8, 9});
-  const VectorLayer net = network(dem, {{6, 20, 22, 20}, {14, 12, 14, 28}, {10, 17, 47, 20}, {42, 20, 52, 20}});
+  const std::vector<Link> net = network(dem, {{6, 20, 22, 20}, {14, 12, 14, 28}, {10, 17, 47, 20}, {42, 20, 52, 20}});
   SilentProgress silent;
   std::string outputs[2];
   for (int threads : {1, 2}) {
@@ -76,7 +68,7 @@ TEST(RoadNetwork, SameOutputWithOneAndTwoThreadsAndFerriesBetweenIslands) {
       RoutingOptions o;
       o.router = router;
       o.graph = {4, 8, 9};
-      const NetworkResult r = route_network(terrain, graph, net, nullptr, o, silent);
+      const NetworkResult r = route_network(terrain, graph, net, o, silent);
       ASSERT_EQ(r.roads.size(), 4u);
       EXPECT_TRUE(r.roads[2].ferry);  // the two islands
       EXPECT_EQ(r.roads[2].router, "ferry");
@@ -88,22 +80,36 @@ TEST(RoadNetwork, SameOutputWithOneAndTwoThreadsAndFerriesBetweenIslands) {
   EXPECT_EQ(outputs[0], outputs[1]);
 }
 
-TEST(RoadNetwork, ClassFromTheMeanRankOfTheEndCities) {
+TEST(RoadNetwork, ClassFromTheSmallerEndsSizeClassByQuarters) {
+  // 8 size classes: classes 0-1 are the top quarter, 2-3 the second, 4-5 the third, 6-7 the last.
+  EXPECT_EQ(link_class(0, 1, 8), RoadClass::motorway);
+  EXPECT_EQ(link_class(0, 2, 8), RoadClass::national);      // the smaller end decides
+  EXPECT_EQ(link_class(5, 1, 8), RoadClass::departmental);
+  EXPECT_EQ(link_class(7, 0, 8), RoadClass::local);
+  EXPECT_EQ(link_class(0, 0, 1), RoadClass::motorway);       // one class: every town is a top town
+  EXPECT_EQ(link_class(-1, 0, 8), RoadClass::departmental);  // an unknown city
+  EXPECT_EQ(link_class(9, 9, 8), RoadClass::local);          // past the last class
+  for (const RoadClassStyle& s : kRoadClasses) {
+    EXPECT_EQ(road_class_named(s.name), s.road_class);
+    EXPECT_EQ(s.colour.size(), 7u);
+  }
+  EXPECT_FALSE(road_class_named("highway"));
+}
+
+TEST(RoadNetwork, LinksKeepTheirClassAndFerriesAreMaritime) {
   const Dem dem = islands();
   const TerrainField terrain(dem, 0.0, 10.0, 0.0);
   CostModel model = default_cost_model();
   model.bridge.enabled = model.tunnel.enabled = false;
   const RoadGraph graph(terrain, model, {3, 1, 1});
-  const VectorLayer net = network(dem, {{6, 20, 22, 20}, {14, 12, 14, 28}});
-  VectorLayer cities;
-  cities.name = "cities.geojson";
-  cities.fields = {{"id", FieldType::integer}, {"class", FieldType::integer}};
-  for (int id = 0; id < 3; ++id) cities.features.push_back({{}, {std::int64_t(id), std::int64_t(id == 0 ? 0 : id == 1 ? 1 : 3)}});
+  std::vector<Link> net = network(dem, {{6, 20, 22, 20}, {10, 17, 47, 20}});
+  net[0].road_class = RoadClass::national;
+  net[1].road_class = RoadClass::motorway;
   SilentProgress silent;
-  const NetworkResult r = route_network(terrain, graph, net, &cities, RoutingOptions{}, silent);
+  const NetworkResult r = route_network(terrain, graph, net, RoutingOptions{}, silent);
   ASSERT_EQ(r.roads.size(), 2u);
-  EXPECT_EQ(r.roads[0].road_class, "motorway");      // classes 0 and 1: mean 0.5
-  EXPECT_EQ(r.roads[1].road_class, "departmental");  // classes 1 and 3: mean 2
+  EXPECT_EQ(r.roads[0].road_class, RoadClass::national);
+  EXPECT_EQ(r.roads[1].road_class, RoadClass::maritime);  // the two islands
 }
 
 TEST(BezierRouter, RefinementLeavesCellsACostLayerForbids) {
@@ -161,16 +167,16 @@ TEST(RoadNetwork, ABudgetMarksLinksNotRoutedAndKeepsTheOthers) {
   CostModel model = default_cost_model();
   model.bridge.enabled = model.tunnel.enabled = false;
   const RoadGraph graph(terrain, model, {3, 8, 1});
-  const VectorLayer net = network(dem, {{6, 20, 22, 20}, {14, 12, 14, 28}, {10, 17, 47, 20}});
+  const std::vector<Link> net = network(dem, {{6, 20, 22, 20}, {14, 12, 14, 28}, {10, 17, 47, 20}});
   SilentProgress silent;
   RoutingOptions o;
   o.graph = {3, 8, 1};
   o.max_seconds = 1e-9;  // every search runs out at its first check
-  const NetworkResult r = route_network(terrain, graph, net, nullptr, o, silent);
+  const NetworkResult r = route_network(terrain, graph, net, o, silent);
   EXPECT_EQ(r.over_budget.size(), 2u);  // the two land links
   ASSERT_EQ(r.roads.size(), 1u);        // the maritime link needs no search
   EXPECT_TRUE(r.roads[0].ferry);
   EXPECT_TRUE(r.failed.empty());
   o.max_seconds = 3600;
-  EXPECT_TRUE(route_network(terrain, graph, net, nullptr, o, silent).over_budget.empty());
+  EXPECT_TRUE(route_network(terrain, graph, net, o, silent).over_budget.empty());
 }
