@@ -7,7 +7,7 @@
 # Run from the repository root: bench/scale.sh [path/to/terrapolis] [runs]
 # Needs GNU time (/usr/bin/time), gdal-bin, python3, cmake and Open MPI (mpirun); the DEMs in
 # ../shared/dems. BENCH_RANKS="1 2 4", BENCH_MPI_TILE (tile side on ranks; default: a third of the
-# DEM's side, 9 tiles), TAUDEM_TIMEOUT (s, default 600: a TauDEM step past it is reported as such).
+# DEM's side, 9 tiles), TAUDEM_TIMEOUT (CPU s a rank and step, default 600: a TauDEM step past it is reported as such).
 # SPDX-License-Identifier: MIT
 set -euo pipefail
 bin=$(realpath "${1:-build/src/cli/terrapolis}")
@@ -37,7 +37,7 @@ cpu = statistics.median(r[1] + r[2] for r in rows)
 peak = max(r[3] for r in rows) / 1024
 print(f"  {sys.argv[1]:<40} wall {wall:7.2f} s  cpu {cpu:7.2f} s  peak {peak:7.0f} MB")
 PY
-  python3 -c "import statistics,sys; print(statistics.median(float(l.split()[0]) for l in open(sys.argv[1])))" "$work/times" >"$work/last_wall"
+  python3 -c "import statistics,sys; r=[l.split() for l in open(sys.argv[1])]; print(statistics.median(float(x[0]) for x in r), statistics.median(float(x[1]) + float(x[2]) for x in r))" "$work/times" >"$work/last"
 }
 
 # TauDEM 5.4 from the shared source archive, built once (Release, its own CMake files).
@@ -52,13 +52,15 @@ build_taudem() {
     cmake --build "$taudem" -j2 --target pitremove d8flowdir aread8 >/dev/null
 }
 
-# taudem_chain NP DEM.tif: PitRemove, D8FlowDir and AreaD8 on NP ranks, each step within the timeout.
+# taudem_chain NP DEM.tif: PitRemove, D8FlowDir and AreaD8 on NP ranks, each rank within
+# TAUDEM_TIMEOUT CPU seconds a step (CPU, not wall: fair on a loaded machine).
 taudem_chain() {
-  local np=$1 dem=$2 t=${TAUDEM_TIMEOUT:-600} d=$work/tau
+  local np=$1 dem=$2 d=$work/tau
   rm -rf "$d" && mkdir "$d"
-  timeout "$t" mpirun --oversubscribe -np "$np" "$taudem/src/pitremove" -z "$dem" -fel "$d/fel.tif" >/dev/null &&
-    timeout "$t" mpirun --oversubscribe -np "$np" "$taudem/src/d8flowdir" -fel "$d/fel.tif" -p "$d/p.tif" -sd8 "$d/sd8.tif" >/dev/null &&
-    timeout "$t" mpirun --oversubscribe -np "$np" "$taudem/src/aread8" -p "$d/p.tif" -ad8 "$d/ad8.tif" -nc >/dev/null
+  ulimit -t "${TAUDEM_TIMEOUT:-600}"
+  mpirun -q --oversubscribe -np "$np" "$taudem/src/pitremove" -z "$dem" -fel "$d/fel.tif" >/dev/null 2>&1 &&
+    mpirun -q --oversubscribe -np "$np" "$taudem/src/d8flowdir" -fel "$d/fel.tif" -p "$d/p.tif" -sd8 "$d/sd8.tif" >/dev/null 2>&1 &&
+    mpirun -q --oversubscribe -np "$np" "$taudem/src/aread8" -p "$d/p.tif" -ad8 "$d/ad8.tif" -nc >/dev/null 2>&1
 }
 export -f taudem_chain
 export taudem work
@@ -100,12 +102,12 @@ for dem in "${dems[@]}"; do
   echo "$name on MPI ranks: Terrapolis tiles of $tile, --threads 1 a rank; TauDEM PitRemove + D8FlowDir + AreaD8 (timeout ${TAUDEM_TIMEOUT:-600} s a step)"
   for np in ${BENCH_RANKS:-1 2 4}; do
     run "terrapolis-mpi np $np" mpirun --oversubscribe -np "$np" "$mpi_bin" -q hydro "$dem" "$work/out" "${sea[@]}" --tile-size "$tile" --threads 1
-    ours=$(cat "$work/last_wall")
+    ours=$(cat "$work/last")
     if (( have_taudem )); then
-      if run "taudem np $np" bash -c 'taudem_chain "$0" "$1"' "$np" "$work/$name.tif" 2>/dev/null; then
-        python3 -c "import sys; print(f'    TauDEM / Terrapolis wall: {float(sys.argv[2]) / float(sys.argv[1]):.1f}x')" "$ours" "$(cat "$work/last_wall")"
+      if run "taudem np $np" bash -c 'taudem_chain "$0" "$1"' "$np" "$work/$name.tif"; then
+        python3 -c "import sys; a, b = sys.argv[1].split(), sys.argv[2].split(); print(f'    TauDEM / Terrapolis: wall {float(b[0]) / float(a[0]):.1f}x, CPU {float(b[1]) / float(a[1]):.1f}x')" "$ours" "$(cat "$work/last")"
       else
-        echo "  taudem np $np: did not finish within ${TAUDEM_TIMEOUT:-600} s a step"
+        echo "  taudem np $np: a step did not finish within ${TAUDEM_TIMEOUT:-600} CPU s a rank"
       fi
     fi
   done
