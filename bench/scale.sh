@@ -1,9 +1,13 @@
 #!/usr/bin/env bash
 # Tile engine benchmark: `terrapolis hydro` whole-grid vs tile by tile (--tile-size, --memory-limit)
 # on the shared SRTM tiles: wall and CPU time (medians), peak resident memory, and a check that
-# the tiled outputs hold the whole-grid cells.
+# the tiled outputs hold the whole-grid cells. Then, when terrapolis-mpi was built, the tiles on
+# 1, 2 and 4 MPI ranks against TauDEM 5.4 (PitRemove + D8FlowDir + AreaD8) on the same ranks:
+# TauDEM is built here from ../shared/peers/taudem-*.tar.gz, once, into $TAUDEM_BUILD.
 # Run from the repository root: bench/scale.sh [path/to/terrapolis] [runs]
-# Needs GNU time (/usr/bin/time), gdal-bin, python3; the DEMs in ../shared/dems.
+# Needs GNU time (/usr/bin/time), gdal-bin, python3, cmake and Open MPI (mpirun); the DEMs in
+# ../shared/dems. BENCH_RANKS="1 2 4", BENCH_MPI_TILE (tile side on ranks; default: a third of the
+# DEM's side, 9 tiles), TAUDEM_TIMEOUT (CPU s a rank and step, default 600: a TauDEM step past it is reported as such).
 # SPDX-License-Identifier: MIT
 set -euo pipefail
 bin=$(realpath "${1:-build/src/cli/terrapolis}")
@@ -12,6 +16,8 @@ dems=(${BENCH_DEMS:-../shared/dems/N47E009.hgt ../shared/dems/S46W066.hgt})
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 outputs=filled,flowdir,accumulation
+mpi_bin=$(dirname "$bin")/terrapolis-mpi
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 
 # run LABEL CMD...: median wall and CPU seconds and the largest peak resident MB over $runs runs.
 run() {
@@ -20,7 +26,7 @@ run() {
   : >"$work/times"
   for _ in $(seq "$runs"); do
     rm -rf "$work/out"
-    /usr/bin/time -f "%e %U %S %M" -o "$log" "$@" >/dev/null 2>"$work/stderr" || { cat "$work/stderr"; exit 1; }
+    /usr/bin/time -f "%e %U %S %M" -o "$log" "$@" >/dev/null 2>"$work/stderr" || { cat "$work/stderr"; return 1; }
     cat "$log" >>"$work/times"
   done
   python3 - "$label" "$work/times" <<'PY'
@@ -31,7 +37,33 @@ cpu = statistics.median(r[1] + r[2] for r in rows)
 peak = max(r[3] for r in rows) / 1024
 print(f"  {sys.argv[1]:<40} wall {wall:7.2f} s  cpu {cpu:7.2f} s  peak {peak:7.0f} MB")
 PY
+  python3 -c "import statistics,sys; r=[l.split() for l in open(sys.argv[1])]; print(statistics.median(float(x[0]) for x in r), statistics.median(float(x[1]) + float(x[2]) for x in r))" "$work/times" >"$work/last"
 }
+
+# TauDEM 5.4 from the shared source archive, built once (Release, its own CMake files).
+taudem=${TAUDEM_BUILD:-$HOME/.cache/terrapolis-bench/taudem}
+build_taudem() {
+  [[ -x $taudem/src/aread8 ]] && return 0
+  local archive
+  archive=$(ls ../shared/peers/taudem-*-src.tar.gz 2>/dev/null | head -1)
+  [[ -n $archive ]] || { echo "no TauDEM source in ../shared/peers: TauDEM skipped"; return 1; }
+  mkdir -p "$taudem.src" && tar xzf "$archive" -C "$taudem.src"
+  cmake -S "$taudem.src" -B "$taudem" -DCMAKE_BUILD_TYPE=Release >/dev/null &&
+    cmake --build "$taudem" -j2 --target pitremove d8flowdir aread8 >/dev/null
+}
+
+# taudem_chain NP DEM.tif: PitRemove, D8FlowDir and AreaD8 on NP ranks, each rank within
+# TAUDEM_TIMEOUT CPU seconds a step (CPU, not wall: fair on a loaded machine).
+taudem_chain() {
+  local np=$1 dem=$2 d=$work/tau
+  rm -rf "$d" && mkdir "$d"
+  ulimit -t "${TAUDEM_TIMEOUT:-600}"
+  mpirun -q --oversubscribe -np "$np" "$taudem/src/pitremove" -z "$dem" -fel "$d/fel.tif" >/dev/null 2>&1 &&
+    mpirun -q --oversubscribe -np "$np" "$taudem/src/d8flowdir" -fel "$d/fel.tif" -p "$d/p.tif" -sd8 "$d/sd8.tif" >/dev/null 2>&1 &&
+    mpirun -q --oversubscribe -np "$np" "$taudem/src/aread8" -p "$d/p.tif" -ad8 "$d/ad8.tif" -nc >/dev/null 2>&1
+}
+export -f taudem_chain
+export taudem work
 
 same_cells() {  # raw copies compared byte for byte
   rm -f "$work"/[ab].*
@@ -53,5 +85,30 @@ for dem in "${dems[@]}"; do
     run "tiled $option" "$bin" -q hydro "$dem" "$work/out" "${sea[@]}" $option
     "$bin" -v hydro "$dem" "$work/tiled" "${sea[@]}" $option --overwrite 2>&1 | grep "^tiles:" | sed 's/^/    /'
     for o in filled flowdir accumulation; do same_cells "$work/whole/$o.tif" "$work/tiled/$o.vrt"; done
+  done
+done
+
+# Terrapolis tiles on MPI ranks vs TauDEM on the same ranks (one thread a rank for both).
+[[ -x $mpi_bin ]] || { echo "no terrapolis-mpi (MPI not found at build time): ranks skipped"; exit 0; }
+have_taudem=1
+build_taudem || have_taudem=0
+for dem in "${dems[@]}"; do
+  name=$(basename "$dem" .hgt)
+  side=$(gdalinfo "$dem" | sed -n 's/^Size is \([0-9]*\),.*/\1/p')
+  tile=${BENCH_MPI_TILE:-$(( (side + 2) / 3 ))}
+  sea=()
+  [[ $name == S46W066 ]] && sea=(--sea-level 0)
+  gdal_translate -q -ot Float32 "$dem" "$work/$name.tif"
+  echo "$name on MPI ranks: Terrapolis tiles of $tile, --threads 1 a rank; TauDEM PitRemove + D8FlowDir + AreaD8 (timeout ${TAUDEM_TIMEOUT:-600} s a step)"
+  for np in ${BENCH_RANKS:-1 2 4}; do
+    run "terrapolis-mpi np $np" mpirun --oversubscribe -np "$np" "$mpi_bin" -q hydro "$dem" "$work/out" "${sea[@]}" --tile-size "$tile" --threads 1
+    ours=$(cat "$work/last")
+    if (( have_taudem )); then
+      if run "taudem np $np" bash -c 'taudem_chain "$0" "$1"' "$np" "$work/$name.tif"; then
+        python3 -c "import sys; a, b = sys.argv[1].split(), sys.argv[2].split(); print(f'    TauDEM / Terrapolis: wall {float(b[0]) / float(a[0]):.1f}x, CPU {float(b[1]) / float(a[1]):.1f}x')" "$ours" "$(cat "$work/last")"
+      else
+        echo "  taudem np $np: a step did not finish within ${TAUDEM_TIMEOUT:-600} CPU s a rank"
+      fi
+    fi
   done
 done

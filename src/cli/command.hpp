@@ -31,6 +31,9 @@ class Command {
   virtual void run(Context& context) = 0;
 };
 
+/// Parses the command line and runs its command; returns the exit code (errors printed on stderr).
+int run_command_line(int argc, char** argv);
+
 /// Every command, in the order `terrapolis --help` lists them (the one registration point).
 std::vector<std::unique_ptr<Command>> all_commands();
 

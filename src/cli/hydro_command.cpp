@@ -111,9 +111,13 @@ class HydroCommand final : public Command {
       // The tile engine: fill, D8 and accumulation, tile by tile (docs/scale.md).
       if (o.fill != FillMethod::priority_flood || o.flow != FlowMethod::d8 || !weights_.empty())
         throw bad_input("tiled hydro (--tile-size, --memory-limit, a folder of tiles): only --fill priority-flood, --flow d8, no --weights");
-      if (outputs_ != kDefaultOutputs && (wanted[3] || wanted[4]))
-        throw bad_input("--outputs: hydrometry and streams are not computed on tiles yet; ask for filled,flowdir,accumulation");
-      if (classify) throw bad_input("--classify: streams are not computed on tiles yet");
+      // The default outputs on tiles: all but the hydrometry, and the streams when the accumulation is an area.
+      const bool explicit_outputs = outputs_ != kDefaultOutputs;
+      if (explicit_outputs && wanted[3])
+        throw bad_input("--outputs: the hydrometry is not computed on tiles yet; ask for filled,flowdir,accumulation,streams");
+      if (explicit_outputs && wanted[4] && o.unit == AccumulationUnit::cells)
+        throw bad_input("--outputs: streams on tiles need --area-units m2 or km2");
+      if (classify) throw bad_input("--classify: river types are not computed on tiles yet");
       if (tile_size_ != 0 && tile_size_ < 8) throw bad_input("--tile-size: must be at least 8 cells");
       if (memory_limit_mb_ < 0) throw bad_input("--memory-limit: must be a positive number of MB");
       TiledHydroRequest q;
@@ -130,6 +134,8 @@ class HydroCommand final : public Command {
       q.filled = wanted[0];
       q.flowdir = wanted[1];
       q.accumulation = wanted[2];
+      q.streams = wanted[4] && o.unit != AccumulationUnit::cells;
+      q.streams_threshold_km2 = o.streams.threshold_km2;
       q.filled_file = opts("Conditioned elevation (m), " + fill + " depression handling");
       q.flowdir_file = opts(flowdir_description, flowdir_metadata);
       q.accumulation_file = opts(acc_description, {{"UNIT", acc_unit}});

@@ -4,15 +4,14 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <algorithm>
 #include <fstream>
-#include <mutex>
 
 #include "core/error.hpp"
-#include "hydro/tiled/tiled_hydro.hpp"
+#include "io/vector_io.hpp"
 
 namespace terrapolis::cli {
 namespace {
@@ -28,74 +27,111 @@ double peak_resident_mb() {
   return 0;
 }
 
-}  // namespace
+TileDistribution* distribution = nullptr;
 
-std::string run_tiled_hydro_command(const TiledHydroRequest& q, Context& context) {
+std::string tiles_of_this_process(const TiledHydroRequest& q, Context& context, hydro::tiled::TileDriver& driver) {
   const DemWindowReader reader(q.dem_path, q.read);
   const RasterHeader& h = reader.header();
-  const fs::path out(q.out_dir);  // a fresh staging folder (OutputSet): no earlier tiles in it
+  const fs::path out(q.out_dir);  // a fresh staging folder (OutputSet, rank 0's): no earlier tiles in it
   struct Layer {
     std::string name;
     bool wanted;
     const WriteOptions* options;
-    std::vector<std::string> tiles;
   };
-  Layer layers[3] = {{"filled", q.filled, &q.filled_file, {}},
-                     {"flowdir", q.flowdir, &q.flowdir_file, {}},
-                     {"accumulation", q.accumulation, &q.accumulation_file, {}}};
+  const Layer layers[3] = {{"filled", q.filled, &q.filled_file},
+                           {"flowdir", q.flowdir, &q.flowdir_file},
+                           {"accumulation", q.accumulation, &q.accumulation_file}};
   hydro::tiled::TiledOptions o;
-  o.tile_size = q.tile_size;
   o.memory_limit_mb = q.memory_limit_mb;
   o.sea_level = q.sea_level;
   o.unit = q.unit;
-  const int threads = context.threads > 0 ? context.threads : int(std::max(1L, sysconf(_SC_NPROCESSORS_ONLN)));
+  o.streams_threshold_m2 = q.streams_threshold_km2 * 1e6;
+  const int threads = context.threads > 0 ? context.threads : hydro::tiled::allowed_threads();
   o.concurrent_tiles = threads;
-  std::mutex tiles_mutex;
-  for (Layer& l : layers)
-    if (l.wanted) fs::create_directory(out / l.name);
-  const fs::path scratch = out / (".scratch-" + std::to_string(getpid()));
+  const bool leader = driver.rank() == 0;
+  if (leader)  // before the engine's first exchange, hence before any process writes a tile
+    for (const Layer& l : layers)
+      if (l.wanted) fs::create_directory(out / l.name);
+  const fs::path scratch = out / (".scratch-" + std::to_string(driver.rank()) + "-" + std::to_string(getpid()));
   fs::create_directory(scratch);
+  struct RemoveScratch {
+    fs::path path;
+    ~RemoveScratch() {
+      std::error_code ec;
+      fs::remove_all(path, ec);
+    }
+  } remove_scratch{scratch};
   o.scratch_dir = scratch.string();
   o.tile_size = q.tile_size > 0 ? q.tile_size : hydro::tiled::tile_size_for(h.cols, h.rows, q.memory_limit_mb, threads);
-  const int across = hydro::tiled::TileGrid(h.cols, h.rows, o.tile_size).across();
-  auto tile_path = [&](Layer& l, int t) {
+  const hydro::tiled::TileGrid grid(h.cols, h.rows, o.tile_size);
+  auto tile_path = [&](const Layer& l, int t) {
     char name[64];
-    std::snprintf(name, sizeof name, "tile_%04d_%04d.tif", t / across, t % across);
-    const std::string p = (out / l.name / name).string();
-    std::lock_guard lock(tiles_mutex);
-    l.tiles.push_back(p);
-    return p;
+    std::snprintf(name, sizeof name, "tile_%04d_%04d.tif", t / grid.across(), t % grid.across());
+    return (out / l.name / name).string();
   };
   hydro::tiled::TileSinks sinks;
   if (q.filled) sinks.filled = [&](int t, const Dem& z) { write_raster(tile_path(layers[0], t), z, q.filled_file); };
   if (q.flowdir)
-    sinks.d8 = [&](int t, const Raster<std::uint8_t>& d8) { write_raster(tile_path(layers[1], t), hydro::encode_d8(d8, q.codes), q.flowdir_file); };
+    sinks.d8 = [&](int t, const Raster<std::uint8_t>& d8) {
+      write_raster(tile_path(layers[1], t), hydro::encode_d8(d8, q.codes), q.flowdir_file);
+    };
   if (q.accumulation)
     sinks.accumulation = [&](int t, const Raster<double>& acc) {
       Raster<float> v = acc.like<float>(NAN);
       for (std::size_t i = 0; i < v.size(); ++i) v[i] = float(acc[i] * q.accumulation_scale);
       write_raster(tile_path(layers[2], t), v, q.accumulation_file);
     };
+  std::size_t reaches = 0;
+  if (q.streams)
+    sinks.streams = [&](hydro::StreamCells& cells) {
+      const VectorLayer layer = hydro::streams_of_cells(cells, h.georef, cell_metrics(h.georef, h.cols, h.rows), context.progress);
+      cells = {};
+      reaches = layer.features.size();
+      write_vector((out / "streams.geojson").string(), layer);
+    };
   const hydro::tiled::TiledReport report = hydro::tiled::run_tiled_hydro(
       h.cols, h.rows, h.georef, [&](int c0, int r0, int c, int r) { return reader.read(c0, r0, c, r); }, o, sinks,
-      context.progress);
-  fs::remove_all(scratch);
-  for (Layer& l : layers)
+      context.progress, driver);
+  if (!leader) return {};
+  for (const Layer& l : layers)
     if (l.wanted) {
-      std::sort(l.tiles.begin(), l.tiles.end());
-      const std::string vrt = (out / (l.name + ".vrt")).string();
-      write_vrt(vrt, l.tiles, false);
+      std::vector<std::string> tiles;
+      for (int t = 0; t < grid.count(); ++t) tiles.push_back(tile_path(l, t));
+      write_vrt((out / (l.name + ".vrt")).string(), tiles, false);
     }
-  char line[400];
+  char line[440];
   std::snprintf(line, sizeof line,
                 "tiles: %d of %d cells a side, %d at once; %llu spill labels, %llu edges; %llu cells of flats across tiles; "
-                "%llu links; state %.1f MB a tile + %.1f MB global; peak resident %.0f MB",
+                "%llu links; %llu stream cells; state %.1f MB a tile + %.1f MB global; peak resident %.0f MB; %d process%s",
                 report.tiles, report.tile_size, report.concurrent_tiles, (unsigned long long)report.labels,
                 (unsigned long long)report.spill_edges, (unsigned long long)report.flat_cells_shared,
-                (unsigned long long)report.links, report.tile_state_bytes / 1e6, report.global_state_bytes / 1e6,
-                peak_resident_mb());
+                (unsigned long long)report.links, (unsigned long long)report.stream_cells, report.tile_state_bytes / 1e6, report.global_state_bytes / 1e6,
+                peak_resident_mb(), driver.ranks(), driver.ranks() == 1 ? "" : "es");
   context.log.detail(line);
-  return "hydro: wrote " + q.out_name + " (" + std::to_string(report.tiles) + " tiles)";
+  return "hydro: wrote " + q.out_name + " (" + std::to_string(report.tiles) + " tiles" +
+         (q.streams ? ", " + std::to_string(reaches) + " stream reaches)" : ")");
+}
+
+}  // namespace
+
+void set_tile_distribution(TileDistribution* d) { distribution = d; }
+
+std::string run_tiled_hydro_command(const TiledHydroRequest& q, Context& context) {
+  if (!distribution) {
+    hydro::tiled::LocalTiles local;
+    return run_tiled_hydro_tiles(q, context, local);
+  }
+  distribution->start(q, context);
+  return run_tiled_hydro_tiles(q, context, distribution->driver());
+}
+
+std::string run_tiled_hydro_tiles(const TiledHydroRequest& q, Context& context, hydro::tiled::TileDriver& driver) {
+  try {
+    return tiles_of_this_process(q, context, driver);
+  } catch (...) {
+    driver.check(std::current_exception());  // every process learns of it and throws it
+    throw;
+  }
 }
 
 }  // namespace terrapolis::cli

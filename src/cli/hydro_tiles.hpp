@@ -8,6 +8,7 @@
 
 #include "cli/command.hpp"
 #include "hydro/accumulation.hpp"
+#include "hydro/tiled/tiled_hydro.hpp"
 #include "hydro/flow_directions.hpp"
 #include "io/raster_io.hpp"
 
@@ -24,12 +25,29 @@ struct TiledHydroRequest {
   double accumulation_scale = 1;  ///< file value = accumulation x scale (km2: 1e-6)
   hydro::D8Codes codes = hydro::D8Codes::esri;
   bool filled = true, flowdir = true, accumulation = true;
+  bool streams = false;               ///< streams.geojson, reaches stitched across tiles (unit area_m2)
+  double streams_threshold_km2 = 10;
   WriteOptions filled_file, flowdir_file, accumulation_file;  ///< description, metadata, COG, overwrite
 };
 
 /// Writes OUTDIR/filled.vrt, flowdir.vrt, accumulation.vrt over one GeoTIFF a tile in
 /// OUTDIR/filled/, flowdir/, accumulation/ (tile_RRRR_CCCC.tif); the same cells as the whole-grid
-/// command. Returns the log line.
+/// command. Returns the log line. Under terrapolis-mpi, the request goes to every rank first.
 std::string run_tiled_hydro_command(const TiledHydroRequest& request, Context& context);
+
+/// Where tiled requests run besides this process: installed by terrapolis-mpi (mpi_main.cpp).
+class TileDistribution {
+ public:
+  virtual ~TileDistribution() = default;
+  /// On the process that parsed the command line: hands `request` to the other processes, which
+  /// then call run_tiled_hydro_tiles with it.
+  virtual void start(const TiledHydroRequest& request, const Context& context) = 0;
+  virtual hydro::tiled::TileDriver& driver() = 0;
+};
+void set_tile_distribution(TileDistribution* distribution);
+
+/// One process's part of a tiled request: its tiles (the driver deals them); rank 0 also writes the
+/// VRTs and returns the log line. Collective over the driver's processes, errors included.
+std::string run_tiled_hydro_tiles(const TiledHydroRequest& request, Context& context, hydro::tiled::TileDriver& driver);
 
 }  // namespace terrapolis::cli

@@ -1,4 +1,4 @@
-// Entry point of the `terrapolis` command line: global options, subcommands, exit codes.
+// The `terrapolis` command line: global options, subcommands, exit codes (main: terrapolis.cpp, mpi_main.cpp).
 // SPDX-License-Identifier: MIT
 #include <CLI/CLI.hpp>
 #include <tbb/global_control.h>
@@ -41,7 +41,7 @@ std::vector<std::string> join_negative_values(int argc, char** argv) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int terrapolis::cli::run_command_line(int argc, char** argv) {
   using namespace terrapolis;
   CLI::App app{"Terrapolis: from a georeferenced elevation model to a regional urbanisation plan.", "terrapolis"};
   app.set_version_flag("--version", std::string("terrapolis ") + terrapolis::version);

@@ -2,6 +2,7 @@
 // SPDX-License-Identifier: MIT
 #include "hydro/streams.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -14,29 +15,40 @@ VectorLayer extract_streams(const Raster<std::uint8_t>& d8, const Raster<double>
                             const StreamOptions& options, Progress& progress) {
   if (!(options.threshold_km2 > 0) || !std::isfinite(options.threshold_km2))
     throw bad_input("--streams-threshold: must be a positive number of km2");
-  ProgressStep step(progress, "streams");
-  const int cols = d8.cols();
   const double threshold = options.threshold_km2 * 1e6;
-  const std::size_t n_cells = d8.size();
-  auto on_stream = [&](std::size_t i) { return d8[i] != kNoData && area[i] >= threshold; };
+  StreamCells cells{d8.cols(), d8.rows(), {}, {}, {}};
+  for (std::size_t i = 0; i < d8.size(); ++i)
+    if (d8[i] != kNoData && area[i] >= threshold) {
+      cells.index.push_back(std::int64_t(i));
+      cells.code.push_back(d8[i]);
+      cells.area_m2.push_back(area[i]);
+    }
+  return streams_of_cells(cells, d8.georef(), metrics, progress);
+}
+
+VectorLayer streams_of_cells(const StreamCells& cells, const Georef& georef, const CellMetrics& metrics, Progress& progress) {
+  ProgressStep step(progress, "streams");
+  const int cols = cells.cols;
+  const std::size_t n_cells = cells.index.size();  // cells of the network, numbered in row-major order
   // Receiver on the stream network, or -1 (outlet).
   auto receiver = [&](std::size_t i) -> std::ptrdiff_t {
-    const int k = d8[i];
+    const int k = cells.code[i];
     if (k >= 8) return -1;
-    const int c = int(i % std::size_t(cols)) + dcol[k], r = int(i / std::size_t(cols)) + drow[k];
-    if (!d8.inside(c, r)) return -1;
-    const std::size_t n = d8.index(c, r);
-    return on_stream(n) ? std::ptrdiff_t(n) : -1;
+    const int c = int(cells.index[i] % cols) + dcol[k], r = int(cells.index[i] / cols) + drow[k];
+    if (c < 0 || r < 0 || c >= cols || r >= cells.rows) return -1;
+    const std::int64_t g = std::int64_t(r) * cols + c;
+    const auto it = std::lower_bound(cells.index.begin(), cells.index.end(), g);
+    return it != cells.index.end() && *it == g ? it - cells.index.begin() : -1;
   };
+  auto col_row = [&](std::size_t i) { return std::pair{int(cells.index[i] % cols), int(cells.index[i] / cols)}; };
   std::vector<std::uint8_t> inflow(n_cells, 0), order(n_cells, 0), top(n_cells, 0), top_count(n_cells, 0);
   for (std::size_t i = 0; i < n_cells; ++i)
-    if (on_stream(i))
-      if (auto n = receiver(i); n >= 0) ++inflow[std::size_t(n)];
+    if (auto n = receiver(i); n >= 0) ++inflow[std::size_t(n)];
   step.update(0.3);
   // Strahler in topological order from the sources.
   std::vector<std::uint8_t> pending(inflow);
   for (std::size_t s = 0; s < n_cells; ++s) {
-    if (!on_stream(s) || inflow[s] != 0) continue;
+    if (inflow[s] != 0) continue;
     std::size_t i = s;
     for (;;) {
       order[i] = inflow[i] == 0 ? 1 : std::uint8_t(top[i] + (top_count[i] >= 2 ? 1 : 0));
@@ -57,7 +69,7 @@ VectorLayer extract_streams(const Raster<std::uint8_t>& d8, const Raster<double>
   VectorLayer layer;
   layer.name = "streams";
   layer.geometry = GeometryType::line_string;
-  layer.crs = d8.georef().crs;
+  layer.crs = georef.crs;
   layer.fields = {{"id", FieldType::integer},
                   {"strahler", FieldType::integer},
                   {"upstream_km2", FieldType::real},
@@ -68,7 +80,7 @@ VectorLayer extract_streams(const Raster<std::uint8_t>& d8, const Raster<double>
   std::int64_t next = 1;
   std::vector<std::size_t> starts;
   for (std::size_t i = 0; i < n_cells; ++i)
-    if (on_stream(i) && inflow[i] != 1) {
+    if (inflow[i] != 1) {
       starts.push_back(i);
       reach_id[i] = -1;  // provisional: single-cell reaches get no id
     }
@@ -94,12 +106,12 @@ VectorLayer extract_streams(const Raster<std::uint8_t>& d8, const Raster<double>
     f.parts.emplace_back();
     double length = 0;
     for (std::size_t j = 0; j < path.size(); ++j) {
-      const int c = int(path[j] % std::size_t(cols)), r = int(path[j] / std::size_t(cols));
-      f.parts[0].push_back(d8.georef().cell_centre(c, r));
-      if (j > 0) length += metrics.step_m(int(path[j - 1] / std::size_t(cols)), d8[path[j - 1]]);
+      const auto [c, r] = col_row(path[j]);
+      f.parts[0].push_back(georef.cell_centre(c, r));
+      if (j > 0) length += metrics.step_m(col_row(path[j - 1]).second, cells.code[path[j - 1]]);
     }
     const std::int64_t down = ends_at_confluence ? std::max<std::int64_t>(reach_id[last], 0) : 0;
-    f.values = {reach_id[s], std::int64_t(order[s]), area[end_own] / 1e6, length, down};
+    f.values = {reach_id[s], std::int64_t(order[s]), cells.area_m2[end_own] / 1e6, length, down};
     layer.features.push_back(std::move(f));
   }
   return layer;

@@ -2,6 +2,7 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 #include <cstdint>
+#include <vector>
 
 #include "core/geodesy.hpp"
 #include "core/progress.hpp"
@@ -23,5 +24,17 @@ struct StreamOptions {
 /// Reaches of a single cell (a source that is also an outlet) are left out. Deterministic.
 VectorLayer extract_streams(const Raster<std::uint8_t>& d8, const Raster<double>& area_m2, const CellMetrics& metrics,
                             const StreamOptions& options, Progress& progress);
+
+/// The cells of a stream network (upstream area at least the threshold) of a `cols` x `rows` grid,
+/// in row-major order: what the tile engine gathers from its tiles (a few % of the cells).
+struct StreamCells {
+  int cols = 0, rows = 0;
+  std::vector<std::int64_t> index;  ///< row * cols + col, increasing
+  std::vector<std::uint8_t> code;   ///< D8 code (flow_directions.hpp)
+  std::vector<double> area_m2;      ///< D8 upstream area
+};
+
+/// extract_streams on the stream cells alone, on the grid of `georef` (the same layer).
+VectorLayer streams_of_cells(const StreamCells& cells, const Georef& georef, const CellMetrics& metrics, Progress& progress);
 
 }  // namespace terrapolis::hydro

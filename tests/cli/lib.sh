@@ -40,3 +40,13 @@ stand_in_density() {
   gdal_calc.py --quiet -A "$1" --outfile "$2/buildable.tif" --type Byte --calc "(A>0)*(A<1000)" --NoDataValue 255
   gdal_calc.py --quiet -A "$1" --outfile "$2/density.tif" --type Float32 --calc "(A>0)*(A<1000)*exp(-maximum(A,0)/400.0)"
 }
+
+# same_cells A B: two rasters (any GDAL format, e.g. a VRT of tiles) hold the same cells, byte for
+# byte (both copied to raw ENVI files and compared), on the same grid.
+same_cells() {
+  rm -f "$WORK"/[ab].*
+  GDAL_PAM_ENABLED=NO gdal_translate -q -of ENVI "$1" "$WORK/a.bin" && GDAL_PAM_ENABLED=NO gdal_translate -q -of ENVI "$2" "$WORK/b.bin"
+  cmp -s "$WORK/a.bin" "$WORK/b.bin" || { echo "$1 and $2: cells differ"; return 1; }
+  [[ $(gdalinfo "$1" | grep -E "^(Size is|Origin|Pixel Size)") == $(gdalinfo "$2" | grep -E "^(Size is|Origin|Pixel Size)") ]] ||
+    { echo "$1 and $2: grids differ"; return 1; }
+}

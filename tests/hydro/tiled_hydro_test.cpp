@@ -83,7 +83,8 @@ Whole tiled(const Dem& dem, int tile_size, int concurrent, std::optional<double>
     return out;
   };
   SilentProgress quiet;
-  const TiledReport rep = run_tiled_hydro(dem.cols(), dem.rows(), dem.georef(), read, o, sinks, quiet);
+  LocalTiles local;
+  const TiledReport rep = run_tiled_hydro(dem.cols(), dem.rows(), dem.georef(), read, o, sinks, quiet, local);
   if (report) *report = rep;
   EXPECT_TRUE(std::filesystem::is_empty(scratch)) << "scratch files left behind";
   std::filesystem::remove(scratch);

@@ -2,12 +2,15 @@
 // SPDX-License-Identifier: MIT
 #include "hydro/tiled/tiled_hydro.hpp"
 
+#include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstring>
+#include <type_traits>
 #include <deque>
 #include <filesystem>
 #include <fstream>
@@ -145,6 +148,17 @@ struct SharedCell {
   std::uint8_t code;
   bool member;
 };
+struct SharedEntry {
+  std::int64_t cell;  // mosaic index
+  SharedCell value;
+};
+
+/// A cell of the stream network, as a tile hands it on.
+struct StreamCell {
+  std::int64_t index;
+  double area_m2;
+  std::uint8_t code;
+};
 
 /// A flow path leaving a tile (Barnes 2017): the last cell in the tile, what it has gathered
 /// inside the tile, and the cell of the next tile it flows into.
@@ -164,6 +178,38 @@ void read_codes(const std::string& path, Raster<std::uint8_t>& d8) {
   in.read(reinterpret_cast<char*>(d8.data()), std::streamsize(d8.size()));
   if (!in) throw bad_input(path + ": cannot read scratch data back");
 }
+
+/// Vectors of plain values appended to a tile's bytes for TileDriver::share (count, then values).
+template <class T>
+void put(std::vector<char>& bytes, const std::vector<T>& v) {
+  static_assert(std::is_trivially_copyable_v<T>);
+  const std::uint64_t n = v.size();
+  const char* count = reinterpret_cast<const char*>(&n);
+  bytes.insert(bytes.end(), count, count + sizeof n);
+  bytes.insert(bytes.end(), reinterpret_cast<const char*>(v.data()), reinterpret_cast<const char*>(v.data() + v.size()));
+}
+
+/// The vectors of a tile's bytes, in the order they were put.
+class Unpack {
+ public:
+  explicit Unpack(const std::vector<char>& bytes) : bytes_(bytes) {}
+  template <class T>
+  std::vector<T> take() {
+    std::uint64_t n = 0;
+    if (at_ + sizeof n > bytes_.size()) throw processing_error("tiles: truncated message from another process");
+    std::memcpy(&n, bytes_.data() + at_, sizeof n);
+    at_ += sizeof n;
+    if (n > (bytes_.size() - at_) / sizeof(T)) throw processing_error("tiles: truncated message from another process");
+    std::vector<T> v(n);
+    std::memcpy(v.data(), bytes_.data() + at_, n * sizeof(T));
+    at_ += n * sizeof(T);
+    return v;
+  }
+
+ private:
+  const std::vector<char>& bytes_;
+  std::size_t at_ = 0;
+};
 
 }  // namespace
 
@@ -189,6 +235,10 @@ namespace {
 constexpr double kGlobalBytesPerTileSide = 600;
 }  // namespace
 
+int allowed_threads() {
+  return int(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+}
+
 int tile_size_for(int cols, int rows, double memory_limit_mb, int concurrent) {
   const double limit = memory_limit_mb * 1e6;
   for (int side = 1 << 15; side >= 64; side = side * 7 / 8) {
@@ -202,10 +252,10 @@ int tile_size_for(int cols, int rows, double memory_limit_mb, int concurrent) {
 }
 
 TiledReport run_tiled_hydro(int cols, int rows, const Georef& georef, const ReadWindow& read, const TiledOptions& options,
-                            const TileSinks& sinks, Progress& progress) {
+                            const TileSinks& sinks, Progress& progress, TileDriver& driver) {
   namespace fs = std::filesystem;
   TiledReport report;
-  report.concurrent_tiles = options.concurrent_tiles > 0 ? options.concurrent_tiles : tbb::this_task_arena::max_concurrency();
+  report.concurrent_tiles = options.concurrent_tiles > 0 ? options.concurrent_tiles : allowed_threads();
   report.tile_size = options.tile_size > 0 ? std::max(options.tile_size, 8)
                                            : tile_size_for(cols, rows, options.memory_limit_mb, report.concurrent_tiles);
   const TileGrid grid(cols, rows, report.tile_size);
@@ -214,18 +264,41 @@ TiledReport run_tiled_hydro(int cols, int rows, const Georef& georef, const Read
   const CellMetrics metrics = cell_metrics(georef, cols, rows);
   const std::optional<double> sea = options.sea_level;
   tbb::task_arena arena(report.concurrent_tiles);
-  auto for_tiles = [&](const char* what, auto&& body) {
-    ProgressStep step(progress, what);
-    std::atomic<int> done{0};
-    std::mutex m;
-    arena.execute([&] {
-      tbb::parallel_for(0, tiles, 1, [&](int t) {
-        body(t, grid.rect(t));
-        const int d = ++done;
-        std::unique_lock lock(m, std::try_to_lock);
-        if (lock) step.update(double(d) / tiles);
+  std::vector<int> own;  // the tiles this process reads and writes
+  for (int t = 0; t < tiles; ++t)
+    if (driver.owns(t)) own.push_back(t);
+  // A pass over this process's tiles; its error, if any, for the driver to agree on.
+  auto for_tiles = [&](const char* what, auto&& body) -> std::exception_ptr {
+    try {
+      ProgressStep step(progress, what);
+      std::atomic<int> done{0};
+      std::mutex m;
+      arena.execute([&] {
+        tbb::parallel_for(0, int(own.size()), 1, [&](int k) {
+          body(own[std::size_t(k)], grid.rect(own[std::size_t(k)]));
+          const int d = ++done;
+          std::unique_lock lock(m, std::try_to_lock);
+          if (lock) step.update(double(d) / double(own.size()));
+        });
       });
-    });
+    } catch (...) {
+      return std::current_exception();
+    }
+    return nullptr;
+  };
+  // After a pass: what it learnt about each tile, from the process that owns it, everywhere.
+  auto exchange = [&](std::exception_ptr failure, auto&& pack, auto&& unpack) {
+    if (driver.ranks() == 1) return driver.check(failure);
+    std::vector<std::vector<char>> bytes(static_cast<std::size_t>(tiles));
+    if (!failure)
+      for (int t : own) pack(t, bytes[std::size_t(t)]);
+    driver.share(bytes, failure);
+    for (int t = 0; t < tiles; ++t)
+      if (!driver.owns(t)) {
+        Unpack in(bytes[std::size_t(t)]);
+        unpack(t, in);
+        bytes[std::size_t(t)] = {};
+      }
   };
   auto read_tile = [&](const TileRect& r) { return read(r.col0 - 1, r.row0 - 1, r.cols + 2, r.rows + 2); };
   const fs::path scratch = options.scratch_dir.empty() ? fs::temp_directory_path() : fs::path(options.scratch_dir);
@@ -242,7 +315,7 @@ TiledReport run_tiled_hydro(int cols, int rows, const Georef& georef, const Read
   std::vector<Frame> frames(static_cast<std::size_t>(tiles));
   std::vector<std::vector<SpillEdge>> tile_edges(static_cast<std::size_t>(tiles));
   std::vector<std::uint32_t> tile_labels(static_cast<std::size_t>(tiles));
-  for_tiles("fill tiles", [&](int t, const TileRect& r) {
+  std::exception_ptr failure = for_tiles("fill tiles", [&](int t, const TileRect& r) {
     TileFill f = fill_tile(read_tile(r), sea);
     Frame frame(r);
     for (int row = 0; row < r.rows; ++row)
@@ -256,6 +329,21 @@ TiledReport run_tiled_hydro(int cols, int rows, const Georef& georef, const Read
     tile_edges[std::size_t(t)] = std::move(f.edges);
     tile_labels[std::size_t(t)] = f.labels;
   });
+  exchange(
+      failure,
+      [&](int t, std::vector<char>& out) {
+        put(out, frames[std::size_t(t)].z);
+        put(out, frames[std::size_t(t)].label);
+        put(out, tile_edges[std::size_t(t)]);
+        put(out, std::vector<std::uint32_t>{tile_labels[std::size_t(t)]});
+      },
+      [&](int t, Unpack& in) {
+        Frame& frame = frames[std::size_t(t)] = Frame(grid.rect(t), false);
+        frame.z = in.take<float>();
+        frame.label = in.take<std::uint32_t>();
+        tile_edges[std::size_t(t)] = in.take<SpillEdge>();
+        tile_labels[std::size_t(t)] = in.take<std::uint32_t>().at(0);
+      });
   // Global labels: 0 for the true outlets, then each tile's edge seeds in tile order.
   std::vector<std::uint32_t> base(static_cast<std::size_t>(tiles));
   std::uint64_t nodes = 1;
@@ -312,8 +400,8 @@ TiledReport run_tiled_hydro(int cols, int rows, const Georef& georef, const Read
   // 2. Filled tiles (the flood again, each cell raised to its label's level), first-pass D8 on
   // the tile and a one-cell halo, flats inside the tile drained; cells of flats reaching the halo
   // handed on.
-  std::vector<std::vector<std::pair<std::int64_t, SharedCell>>> shared(static_cast<std::size_t>(tiles));
-  for_tiles("flow directions of tiles", [&](int t, const TileRect& r) {
+  std::vector<std::vector<SharedEntry>> shared(static_cast<std::size_t>(tiles));
+  failure = for_tiles("flow directions of tiles", [&](int t, const TileRect& r) {
     TileFill f = fill_tile(read_tile(r), sea);
     for (std::size_t i = 0; i < f.z.size(); ++i) f.z[i] = final_z(f.z[i], global(t, f.label[i]));
     f.label = {};
@@ -393,6 +481,9 @@ TiledReport run_tiled_hydro(int cols, int rows, const Georef& georef, const Read
       }
     write_codes(codes_path(t), d8);
   });
+  exchange(
+      failure, [&](int t, std::vector<char>& out) { put(out, shared[std::size_t(t)]); },
+      [&](int t, Unpack& in) { shared[std::size_t(t)] = in.take<SharedEntry>(); });
 
   // Flats that cross tile edges, each gathered whole (its cells and their neighbours) on a
   // window of its bounding box and drained there: the same rings, hence the same directions.
@@ -498,7 +589,7 @@ TiledReport run_tiled_hydro(int cols, int rows, const Georef& georef, const Read
   std::vector<std::vector<Link>> links(static_cast<std::size_t>(tiles));
   // For each edge cell of a tile (Frame order, first ring only used), the link its flow leaves by.
   std::vector<std::vector<std::int32_t>> edge_exit(static_cast<std::size_t>(tiles));
-  for_tiles("accumulation of tiles", [&](int t, const TileRect& r) {
+  failure = for_tiles("accumulation of tiles", [&](int t, const TileRect& r) {
     Raster<std::uint8_t> d8(r.cols, r.rows, shifted(georef, r.col0, r.row0), kNoData);
     d8.nodata = kNoData;
     read_codes(codes_path(t), d8);
@@ -545,6 +636,16 @@ TiledReport run_tiled_hydro(int cols, int rows, const Georef& georef, const Read
       }
     edge_exit[std::size_t(t)] = std::move(exits);
   });
+  exchange(
+      failure,
+      [&](int t, std::vector<char>& out) {
+        put(out, links[std::size_t(t)]);
+        put(out, edge_exit[std::size_t(t)]);
+      },
+      [&](int t, Unpack& in) {
+        links[std::size_t(t)] = in.take<Link>();
+        edge_exit[std::size_t(t)] = in.take<std::int32_t>();
+      });
   // The link graph: each link flows into the tile of its target and leaves it by that cell's
   // exit; solved in topological order, the sums exact.
   std::vector<std::uint32_t> link_base(static_cast<std::size_t>(tiles) + 1, 0);
@@ -595,9 +696,13 @@ TiledReport run_tiled_hydro(int cols, int rows, const Georef& georef, const Read
   all = {};
   total = {};
 
-  // 4. The accumulation again, with what flows in from the other tiles.
-  if (sinks.accumulation)
-    for_tiles("accumulation", [&](int t, const TileRect& r) {
+  // 4. The accumulation again, with what flows in from the other tiles; the stream cells kept.
+  if (sinks.streams && options.unit != AccumulationUnit::area_m2)
+    throw bad_input("tiles: streams need the accumulation as an area (--area-units m2 or km2)");
+  std::vector<std::vector<StreamCell>> stream_cells(static_cast<std::size_t>(tiles));
+  failure = nullptr;
+  if (sinks.accumulation || sinks.streams)
+    failure = for_tiles("accumulation", [&](int t, const TileRect& r) {
       Raster<std::uint8_t> d8(r.cols, r.rows, shifted(georef, r.col0, r.row0), kNoData);
       read_codes(codes_path(t), d8);
       std::vector<std::int64_t> acc = own_units(d8, r);
@@ -606,8 +711,37 @@ TiledReport run_tiled_hydro(int cols, int rows, const Georef& georef, const Read
       accumulate_d8_units(d8, acc);
       Raster<double> out = d8.like<double>(0.0);
       for (std::size_t i = 0; i < out.size(); ++i) out[i] = d8[i] == kNoData ? NAN : units.value(acc[i]);
-      sinks.accumulation(t, out);
+      if (sinks.streams)
+        for (int row = 0; row < r.rows; ++row)
+          for (int c = 0; c < r.cols; ++c)
+            if (const double a = out(c, row); d8(c, row) != kNoData && a >= options.streams_threshold_m2)
+              stream_cells[std::size_t(t)].push_back({std::int64_t(r.row0 + row) * cols + r.col0 + c, a, d8(c, row)});
+      if (sinks.accumulation) sinks.accumulation(t, out);
     });
+  if (!sinks.streams) {
+    driver.check(failure);  // every process's tiles written
+    return report;
+  }
+  exchange(
+      failure, [&](int t, std::vector<char>& out) { put(out, stream_cells[std::size_t(t)]); },
+      [&](int t, Unpack& in) { stream_cells[std::size_t(t)] = in.take<StreamCell>(); });
+  if (driver.rank() != 0) return report;
+  std::vector<StreamCell> network;
+  for (auto& part : stream_cells) {
+    network.insert(network.end(), part.begin(), part.end());
+    part = {};
+  }
+  std::sort(network.begin(), network.end(), [](const StreamCell& a, const StreamCell& b) { return a.index < b.index; });
+  StreamCells streams{cols, rows, {}, {}, {}};
+  for (const StreamCell& cell : network) {
+    streams.index.push_back(cell.index);
+    streams.code.push_back(cell.code);
+    streams.area_m2.push_back(cell.area_m2);
+  }
+  report.stream_cells = network.size();
+  report.global_state_bytes = std::max(report.global_state_bytes, frame_bytes + double(network.size()) * 40);
+  network = {};
+  sinks.streams(streams);
   return report;
 }
 

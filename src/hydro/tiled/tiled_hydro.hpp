@@ -3,6 +3,7 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 #include <cstdint>
+#include <exception>
 #include <functional>
 #include <optional>
 #include <string>
@@ -11,6 +12,7 @@
 #include "core/progress.hpp"
 #include "core/raster.hpp"
 #include "hydro/accumulation.hpp"
+#include "hydro/streams.hpp"
 
 namespace terrapolis::hydro::tiled {
 
@@ -37,16 +39,51 @@ class TileGrid {
   std::vector<int> col_bounds_, row_bounds_;
 };
 
+/// Who processes which tiles, and how what a pass learnt about its tiles (their frames, spill
+/// edges, shared flat cells, links: perimeters and global graphs, never whole tiles) reaches every
+/// process before the next pass. LocalTiles: all tiles in this process; terrapolis-mpi: tiles
+/// dealt round-robin to MPI ranks (src/cli/mpi_main.cpp). Every process solves the global graphs
+/// itself, from the same gathered bytes: the same answer everywhere, no further messages.
+class TileDriver {
+ public:
+  virtual ~TileDriver() = default;
+  virtual int rank() const = 0;
+  virtual int ranks() const = 0;
+  bool owns(int tile) const { return tile % ranks() == rank(); }
+  /// Collective. `per_tile[t]` holds the bytes of each tile t this process owns; on return, those
+  /// of every tile. `failure`: this process's pass failed; if any process's did, every process
+  /// throws the lowest failing rank's error (a terrapolis::Error), and share() is not called again.
+  virtual void share(std::vector<std::vector<char>>& per_tile, std::exception_ptr failure) = 0;
+  /// Collective: share() with nothing to share; throws the first failure of any process.
+  void check(std::exception_ptr failure) {
+    std::vector<std::vector<char>> none;
+    share(none, failure);
+  }
+};
+
+/// Every tile in this process.
+class LocalTiles final : public TileDriver {
+ public:
+  int rank() const override { return 0; }
+  int ranks() const override { return 1; }
+  void share(std::vector<std::vector<char>>&, std::exception_ptr failure) override {
+    if (failure) std::rethrow_exception(failure);
+  }
+};
+
 /// Reads cells [col0, col0+cols) x [row0, row0+rows) of the mosaic's DEM (metres, NaN nodata;
-/// NaN outside the mosaic). Called from several threads at once.
+/// NaN outside the mosaic). Called from several threads at once, for the tiles this process owns.
 using ReadWindow = std::function<Dem(int col0, int row0, int cols, int rows)>;
 
-/// What the engine hands out, one tile at a time (from several threads at once), each raster on
+/// What the engine hands out, one tile this process owns at a time (from several threads at once), each raster on
 /// its tile's grid and georeferencing; an empty function skips that output's work where it can.
 struct TileSinks {
   std::function<void(int tile, const Dem& filled)> filled;
   std::function<void(int tile, const Raster<std::uint8_t>& d8)> d8;  ///< flow_directions.hpp codes
   std::function<void(int tile, const Raster<double>& accumulation)> accumulation;
+  /// The stream cells of the whole mosaic (TiledOptions::streams_threshold_m2), gathered from
+  /// every tile, on rank 0 only: streams_of_cells makes the whole grid's reaches of them.
+  std::function<void(StreamCells& cells)> streams;
 };
 
 struct TiledOptions {
@@ -54,10 +91,12 @@ struct TiledOptions {
   int tile_size = 0;
   /// Memory for the engine's state (tiles being processed, the global graphs), MB.
   double memory_limit_mb = 1024;
-  /// Tiles processed at once (each holds its state): 0 = as many as threads allowed.
+  /// Tiles processed at once by this process (each holds its state): 0 = as many as threads allowed.
   int concurrent_tiles = 0;
   std::optional<double> sea_level;
   AccumulationUnit unit = AccumulationUnit::area_m2;
+  /// Upstream area from which a cell is on a stream (m², unit area_m2), for TileSinks::streams.
+  double streams_threshold_m2 = 10e6;
   /// Folder for the D8 codes kept between passes (1 byte a cell, removed at the end).
   std::string scratch_dir;
 };
@@ -68,6 +107,7 @@ struct TiledReport {
   std::uint64_t labels = 0, spill_edges = 0;   ///< Barnes 2016 spillover graph
   std::uint64_t flat_cells_shared = 0;          ///< cells of flats that cross tile edges, solved globally
   std::uint64_t links = 0;                      ///< Barnes 2017: flow paths leaving a tile
+  std::uint64_t stream_cells = 0;               ///< cells of the stream network gathered (rank 0)
   double tile_state_bytes = 0;                  ///< per tile processed at once
   double global_state_bytes = 0;                ///< at the largest: frames plus the spill graph, shared flats or links
 };
@@ -80,12 +120,16 @@ inline constexpr double kTileBytesPerCell = 48;
 /// within `memory_limit_mb`; throws bad_input when not even 64-cell tiles fit.
 int tile_size_for(int cols, int rows, double memory_limit_mb, int concurrent);
 
+/// The threads this process may use (--threads, or what terrapolis-mpi leaves to each rank).
+int allowed_threads();
+
 /// Runs priority-flood filling (Barnes 2016), D8 with flat resolution (Barnes et al. 2014b, flats
 /// that cross tile edges gathered and solved whole) and D8 accumulation (Barnes 2017, fixed-point
 /// sums) on a `cols` x `rows` mosaic georeferenced by `georef`. The tiles handed to `sinks`,
 /// put together, equal fill_depressions (priority_flood), d8_directions and accumulate (D8) on the
-/// whole grid bit for bit, for any tile size. Deterministic for any thread count.
+/// whole grid bit for bit, for any tile size. Deterministic for any thread and process count.
+/// Collective over `driver`'s processes: each reads and hands out only the tiles it owns.
 TiledReport run_tiled_hydro(int cols, int rows, const Georef& georef, const ReadWindow& read, const TiledOptions& options,
-                            const TileSinks& sinks, Progress& progress);
+                            const TileSinks& sinks, Progress& progress, TileDriver& driver);
 
 }  // namespace terrapolis::hydro::tiled
