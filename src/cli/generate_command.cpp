@@ -1,51 +1,107 @@
-// `terrapolis generate OUT.tif --size WxH --cell M`: fractal terrain by DMMC, optionally constrained by a sketch,
-// or a region grown from its river skeleton (--method coast | planar, generate_methods.hpp).
+// `terrapolis generate OUT.tif --size WxH --cell M [--method M]`: synthetic terrain. dmmc: fractal terrain
+// constrained by a sketch; the other methods build a skeleton (rivers, ridges) first, each in its own
+// source file (terrain/generate_*.cpp), and write it beside the DEM with the checks of its rivers.
 // SPDX-License-Identifier: MIT
 #include <CLI/CLI.hpp>
 
+#include <chrono>
 #include <cmath>
 
 #include "cli/command.hpp"
 #include "cli/commands_list.hpp"
 #include "cli/generate_methods.hpp"
+#include "cli/generate_report.hpp"
 #include "cli/terrain_options.hpp"
 #include "core/error.hpp"
 #include "io/output_set.hpp"
 #include "io/raster_io.hpp"
+#include "io/text_io.hpp"
 #include "io/vector_io.hpp"
+#include "terrain/generators.hpp"
 #include "terrain/subdivision.hpp"
 
 namespace terrapolis::cli {
 namespace {
 
+terrain::GeneratedTerrain generate_dmmc(const terrain::GenerateRequest& request) {
+  terrain::GeneratedTerrain out;
+  out.dem = request.grid;
+  const auto t0 = std::chrono::steady_clock::now();
+  terrain::dmmc(out.dem, request.dmmc, request.progress);
+  out.timings.emplace_back("dmmc", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  return out;
+}
+
+/// The generators, by --method name.
+struct Method {
+  const char* name;
+  terrain::GeneratedTerrain (*generate)(const terrain::GenerateRequest&);
+};
+constexpr Method kMethods[] = {
+    {"dmmc", generate_dmmc},
+    {"flow", terrain::generate_flow},
+    {"tectonic", terrain::generate_tectonic},
+    {"coast", terrain::generate_coast},
+    {"planar", terrain::generate_planar},
+};
+
+std::string method_names() {
+  std::string names;
+  for (const auto& m : kMethods) names += (names.empty() ? "" : " | ") + std::string(m.name);
+  return names;
+}
+
+/// `path` without its extension, for the files written beside it.
+std::string stem_of(const std::string& path) {
+  const auto dot = path.find_last_of('.'), slash = path.find_last_of('/');
+  return dot != std::string::npos && (slash == std::string::npos || dot > slash) ? path.substr(0, dot) : path;
+}
+
+/// A vector file's coordinates in the cell coordinates of `grid` (centre of cell (c,r) at (c,r)).
+terrain::GridPoint to_cell(const Georef& g, const std::array<double, 2>& p) {
+  const auto& t = g.transform;
+  return {(p[0] - t[0]) / t[1] - 0.5, (p[1] - t[3]) / t[5] - 0.5};
+}
+
 class GenerateCommand final : public Command {
  public:
   std::string name() const override { return "generate"; }
   std::string summary() const override {
-    return "Generate terrain: fractal (Belhadj's DMMC, optionally constrained by a sketch) or from a river skeleton (coast, planar)";
+    return "Generate a synthetic region: fractal terrain (DMMC, optionally from a sketch) or a terrain built from rivers and ridges";
   }
 
   void setup(CLI::App& app) override {
+    app_ = &app;
     app.add_option("OUT", output_, "Output GeoTIFF (float32 heights in metres)")->required();
     grid_.add(app, true);
-    app.add_option("--constraints", sketch_, "Sketch raster: cells with a value are fixed heights (m), nodata cells are generated. "
+    app.add_option("--method", method_, "Generator: " + method_names() + " (see docs/terrain.md)")->capture_default_str();
+    app.add_option("--relief", relief_m_, "flow, tectonic: height (m) of the highest crest above the outlets")
+        ->capture_default_str()->check(CLI::PositiveNumber);
+    app.add_option("--ridges", lines_path_, "flow: ridge lines (any OGR vector file of lines; default: random ridges from --seed)");
+    app.add_option("--mountains", points_path_, "tectonic: mountain points, one plate each (any OGR vector file of points; default: random)");
+    app.add_option("--constraints", sketch_, "dmmc: sketch raster: cells with a value are fixed heights (m), nodata cells are generated. "
                                              "Warped onto the grid if it has a CRS, else it must have the grid's size");
     options_.add(app, false, 1000.0);
-    app.add_option("--method", method_, "dmmc | coast (Génévaux et al.: rivers grown from a coastline) | planar (binary-tree basin on a planar map)")
-        ->capture_default_str();
-    app.add_option("--skeleton", skeleton_, "coast, planar: GeoJSON of the rivers and ridges the terrain was built from (default: OUT's name + _skeleton.geojson)");
-    coast_.add(app);
-    planar_.add(app);
+    skeleton_options_.add(app);
     app.add_flag("--overwrite", overwrite_, "Replace OUT if it exists");
   }
 
   void run(Context& context) override {
-    if (method_ == "coast" || method_ == "planar") return run_skeleton(context);
-    if (method_ != "dmmc") throw bad_input("--method: unknown method '" + method_ + "' (expected dmmc, coast or planar)");
+    const Method* method = nullptr;
+    for (const auto& m : kMethods)
+      if (method_ == m.name) method = &m;
+    if (!method) throw bad_input("--method: unknown generator '" + method_ + "' (expected " + method_names() + ")");
+    const bool skeleton_method = method_ != "dmmc";
+    if (skeleton_method && !sketch_.empty()) throw bad_input("--constraints: only --method dmmc takes a sketch");
+    if (skeleton_method && grid_.crs.empty()) default_local_grid();
+    // Between a skeleton's cells the noise must stay below the relief it carves, or it makes pits.
+    if (skeleton_method && app_->get_option("--roughness")->count() == 0) options_.roughness_m = 0.05 * relief_m_;
     terrain::FillParams params = options_.params();
     Raster<float> grid = grid_.make();
-    OutputSet outputs("generate", {sketch_}, overwrite_);
+    OutputSet outputs("generate", {sketch_, lines_path_, points_path_, skeleton_options_.coast_path}, overwrite_);
     const std::string out = outputs.file(output_);
+    const std::string skeleton_out = skeleton_method ? outputs.file(stem_of(output_) + ".skeleton.geojson") : "";
+    const std::string report_out = skeleton_method ? outputs.file(stem_of(output_) + ".report.json") : "";
     if (!sketch_.empty()) {
       const RasterHeader header = read_header(sketch_, ReadOptions{std::nullopt, std::string("EPSG:4326")});
       Raster<float> sketch;
@@ -64,49 +120,35 @@ class GenerateCommand final : public Command {
       context.log.info("generate: " + std::to_string(fixed) + " cells fixed by the sketch");
     }
     params.dmmc.low_pass = false;  // generation wants the fractal detail, not the smoothest surface
-    terrain::dmmc(grid, params.dmmc, &context.progress);
+    terrain::GenerateRequest request;
+    request.cell_m = grid_.cell_m;
+    request.seed = options_.seed;
+    request.relief_m = relief_m_;
+    request.dmmc = params.dmmc;
+    request.progress = &context.progress;
+    if (!lines_path_.empty()) request.lines = read_lines(lines_path_, grid.georef());
+    if (!points_path_.empty()) request.points = read_points(points_path_, grid.georef());
+    if (!skeleton_options_.coast_path.empty()) request.polygons = read_rings(skeleton_options_.coast_path, grid.georef());
+    skeleton_options_.apply(request);
+    request.grid = std::move(grid);
+    const terrain::GeneratedTerrain terrain = method->generate(request);
+    for (const auto& [phase, seconds] : terrain.timings)
+      context.log.detail("generate: " + phase + " in " + std::to_string(seconds) + " s");
+
     WriteOptions write;
     write.description = "generated elevation (m)";
     write.metadata = options_.metadata(false);
-    write_raster(out, grid, write);
+    write.metadata.emplace_back("TERRAPOLIS_GENERATOR", method_);
+    if (skeleton_method) write.metadata.emplace_back("TERRAPOLIS_RELIEF_M", std::to_string(relief_m_));
+    write_raster(out, terrain.dem, write);
+    if (skeleton_method) {
+      write_vector(skeleton_out, terrain::skeleton_layer(terrain.skeleton, terrain.dem.georef(), grid_.cell_m));
+      write_text_file(report_out, skeleton_report(terrain, grid_.cell_m, method_, context.log, context.progress), false);
+    }
     outputs.commit();
   }
 
  private:
-  /// The skeleton generators: a georeferenced DEM (default: a local azimuthal equidistant grid
-  /// centred on the origin, so that QGIS and `terrapolis run` place it) and its skeleton.
-  void run_skeleton(Context& context) {
-    if (!sketch_.empty()) throw bad_input("--constraints: only --method dmmc takes a sketch");
-    GridOptions grid_options = grid_;
-    if (grid_options.crs.empty()) grid_options.crs = "+proj=aeqd +lat_0=0 +lon_0=0 +x_0=0 +y_0=0 +datum=WGS84 +units=m +no_defs";
-    Raster<float> grid = grid_options.make();
-    if (grid_.crs.empty() && grid_.origin.empty()) {  // centre the local grid on the projection's origin
-      auto t = grid.georef().transform;
-      t[0] = -0.5 * grid.cols() * t[1];
-      t[3] = -0.5 * grid.rows() * t[5];
-      Georef georef = grid.georef();
-      georef.transform = t;
-      grid = Raster<float>(grid.cols(), grid.rows(), georef, std::numeric_limits<float>::quiet_NaN());
-    }
-    std::vector<std::string> inputs;
-    if (!coast_.coast.empty()) inputs.push_back(coast_.coast);
-    OutputSet outputs("generate", inputs, overwrite_);
-    const std::string out = outputs.file(output_);
-    std::string skeleton_path = skeleton_;
-    if (skeleton_path.empty()) {
-      const auto dot = output_.find_last_of('.');
-      skeleton_path = (dot == std::string::npos || output_.find('/', dot) != std::string::npos ? output_ : output_.substr(0, dot)) + "_skeleton.geojson";
-    }
-    const std::string skeleton = outputs.file(skeleton_path);
-    const GeneratedRegion region = method_ == "coast" ? coast_.run(grid, options_.seed, context) : planar_.run(grid, options_.seed, context);
-    WriteOptions write;
-    write.description = "generated elevation (m)";
-    write.metadata = region.metadata;
-    write.metadata.emplace_back("TERRAPOLIS_METHOD", method_);
-    write_concurrently({[&] { write_raster(out, grid, write); }, [&] { write_vector(skeleton, region.skeleton, true); }});
-    outputs.commit();
-  }
-
   bool read_header_has_no_crs() const {
     try {
       (void)read_header(sketch_);
@@ -129,11 +171,66 @@ class GenerateCommand final : public Command {
     }
   }
 
-  std::string output_, sketch_, method_ = "dmmc", skeleton_;
+  /// Without --crs: ETRS89-LAEA Europe (EPSG:3035), the grid centred on the projection's centre
+  /// (52N 10E), so a generated region has real metres and opens in QGIS; --crs/--origin override it.
+  void default_local_grid() {
+    grid_.crs = "EPSG:3035";
+    if (!grid_.origin.empty()) return;
+    const auto x = grid_.size.find_first_of("xX");
+    if (x == std::string::npos) return;  // make() reports the bad size
+    double cols = 0, rows = 0;
+    try {
+      cols = std::stod(grid_.size.substr(0, x));
+      rows = std::stod(grid_.size.substr(x + 1));
+    } catch (const std::exception&) {
+      return;
+    }
+    grid_.origin = std::to_string(4321000.0 - cols * grid_.cell_m / 2) + "," + std::to_string(3210000.0 + rows * grid_.cell_m / 2);
+  }
+  static std::vector<std::vector<terrain::GridPoint>> read_lines(const std::string& path, const Georef& georef) {
+    const VectorLayer layer = read_vector(path, georef.crs);
+    std::vector<std::vector<terrain::GridPoint>> lines;
+    for (const auto& f : layer.features) {
+      if (layer.geometry != GeometryType::line_string || f.parts.empty() || f.parts[0].size() < 2)
+        throw bad_input(path + ": expected lines of at least 2 points");
+      std::vector<terrain::GridPoint> line;
+      for (const auto& p : f.parts[0]) line.push_back(to_cell(georef, p));
+      lines.push_back(std::move(line));
+    }
+    if (lines.empty()) throw bad_input(path + ": holds no line");
+    return lines;
+  }
+  static std::vector<std::vector<terrain::GridPoint>> read_rings(const std::string& path, const Georef& georef) {
+    const VectorLayer layer = read_vector(path, georef.crs);
+    if (layer.geometry != GeometryType::polygon) throw bad_input(path + ": expected polygons (the land)");
+    std::vector<std::vector<terrain::GridPoint>> rings;
+    for (const auto& f : layer.features)
+      for (const auto& part : f.parts) {
+        std::vector<terrain::GridPoint> ring;
+        for (const auto& p : part) ring.push_back(to_cell(georef, p));
+        if (ring.size() > 1 && ring.front() == ring.back()) ring.pop_back();
+        if (ring.size() >= 3) rings.push_back(std::move(ring));
+      }
+    if (rings.empty()) throw bad_input(path + ": holds no polygon");
+    return rings;
+  }
+  static std::vector<terrain::GridPoint> read_points(const std::string& path, const Georef& georef) {
+    const VectorLayer layer = read_vector(path, georef.crs);
+    std::vector<terrain::GridPoint> points;
+    for (const auto& f : layer.features) {
+      if (layer.geometry != GeometryType::point || f.parts.empty() || f.parts[0].empty()) throw bad_input(path + ": expected points");
+      points.push_back(to_cell(georef, f.parts[0][0]));
+    }
+    if (points.size() < 2) throw bad_input(path + ": needs at least 2 points (one plate each)");
+    return points;
+  }
+
+  std::string output_, sketch_, lines_path_, points_path_, method_ = "dmmc";
+  double relief_m_ = 1500;
+  CLI::App* app_ = nullptr;
   GridOptions grid_;
-  CoastOptions coast_;
-  PlanarOptions planar_;
   TerrainOptions options_;
+  CoastPlanarOptions skeleton_options_;
   bool overwrite_ = false;
 };
 

@@ -1,12 +1,13 @@
 // Plane geometry of the skeleton generators: points in plan metres, segment distances, a bin index
-// for neighbourhood queries and a portable uniform draw.
+// for neighbourhood queries, uniform draws.
 // SPDX-License-Identifier: MIT
 #pragma once
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <random>
 #include <vector>
+
+#include "terrain/random.hpp"
 
 namespace terrapolis::terrain {
 
@@ -72,17 +73,8 @@ class SpatialBins {
   std::vector<std::vector<int>> bins_;
 };
 
-/// Uniform doubles from std::mt19937_64 by a fixed formula (the std distributions differ between
-/// standard libraries; our outputs must not).
-class UniformDraw {
- public:
-  explicit UniformDraw(std::uint64_t seed) : generator_(seed) {}
-  double operator()() { return double(generator_() >> 11) * (1.0 / 9007199254740992.0); }  ///< [0,1)
-  double between(double lo, double hi) { return lo + (hi - lo) * (*this)(); }
-  int integer(int lo, int hi) { return lo + int((*this)() * (hi - lo + 1)); }  ///< [lo,hi]
-
- private:
-  std::mt19937_64 generator_;
-};
+/// Draws of the generators from the shared portable Rng (random.hpp).
+inline double between(Rng& rng, double lo, double hi) { return lo + (hi - lo) * rng.uniform(); }
+inline int integer(Rng& rng, int lo, int hi) { return lo + int(rng.uniform() * (hi - lo + 1)); }  ///< [lo,hi]
 
 }  // namespace terrapolis::terrain

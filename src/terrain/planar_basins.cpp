@@ -10,6 +10,7 @@
 #include <numeric>
 
 #include "core/error.hpp"
+#include "terrain/generators.hpp"
 
 namespace terrapolis::terrain {
 namespace {
@@ -40,9 +41,9 @@ BinaryTree random_increasing_tree(int internal, std::uint64_t seed) {
   t.right = {-1};
   t.parent = {-1};
   std::vector<int> leaves{0};
-  UniformDraw draw(seed);
+  Rng draw(seed);
   for (int k = 0; k < internal; ++k) {
-    const std::size_t pick = std::size_t(draw.integer(0, int(leaves.size()) - 1));
+    const std::size_t pick = std::size_t(integer(draw, 0, int(leaves.size()) - 1));
     const int n = leaves[pick];
     const int l = t.size(), r = l + 1;
     t.left[std::size_t(n)] = l;
@@ -144,13 +145,17 @@ PlanarMap build_planar_map(const BinaryTree& tree, double width_m, double height
   for (int n = 0; n < n_tree; ++n)
     if (tree.parent[std::size_t(n)] >= 0 && tree.parent[std::size_t(n)] > n) throw Error(ErrorKind::processing, "tree: a child precedes its parent");
 
-  // §6.3.1: level k on the half circle of radius k r0 around the root; sectors split by the
+  // §6.3.1: level k on the half circle of radius r_k around the root; sectors split by the
   // barycentric rule a_n = θ_i + Δ O_d/(O_d+O_g) with Strahler orders; the right child's sector is
-  // the one of smaller angles. The child of a node at level k stays within acos(k/(k+1)) of its
+  // the one of smaller angles. The child of a node at level k stays within acos(r_k/r_k+1) of its
   // parent's angle, so that the angle at the parent between its partition ray and the edge is < 90°.
+  // r_k linear in k, as the chapter suggests (a concave law, tried to fill more of the grid with the
+  // deep random trees, made narrower facets and fewer D8-consistent rivers).
   PlanarMap map;
   const double margin = 0.04 * std::min(width_m, height_m);
-  const double r0 = std::min(width_m / 2 - margin, height_m - 2 * margin) / (max_depth + 1.0);
+  const double reach_m = std::min(width_m / 2 - margin, height_m - 2 * margin);
+  const auto radius_of = [&](int k) { return reach_m * double(k) / (max_depth + 1.0); };
+  const double r0 = radius_of(1);
   const Point2 root{width_m / 2, height_m - margin - r0};
   const std::size_t count = std::size_t(n_tree);
   std::vector<double> angle(count), lo(count), hi(count);
@@ -170,12 +175,13 @@ PlanarMap build_planar_map(const BinaryTree& tree, double width_m, double height
       const int parent = tree.parent[i];
       double a = tree.leaf(n) ? 0.5 * (lo[i] + hi[i]) : split(n);
       if (parent > 0) {
-        const double k = depth[std::size_t(parent)], reach = 0.9 * std::acos(k / (k + 1));
+        const int k = depth[std::size_t(parent)];
+        const double reach = 0.9 * std::acos(radius_of(k) / radius_of(k + 1));
         a = std::clamp(a, angle[std::size_t(parent)] - reach, angle[std::size_t(parent)] + reach);
         a = std::clamp(a, lo[i], hi[i]);
       }
       angle[i] = a;
-      const double radius = depth[i] * r0;
+      const double radius = radius_of(depth[i]);
       map.p[i] = {root.x + radius * std::cos(a), root.y - radius * std::sin(a)};
     } else {
       angle[0] = split(0);
@@ -243,7 +249,7 @@ PlanarMap build_planar_map(const BinaryTree& tree, double width_m, double height
     }
     return it->second;
   };
-  UniformDraw draw(params.seed);
+  Rng draw(params.seed);
   std::vector<LinearRow> rows;
   std::vector<std::pair<int, int>> ridge_edges;
   const auto type1 = [&](int r1, int r2, int p) {
@@ -272,7 +278,7 @@ PlanarMap build_planar_map(const BinaryTree& tree, double width_m, double height
     } else if (river_sides == 1) {  // one river edge a-b: ridge vertices on b-c and c-a, joined by a ridge edge
       const int p = ridge_on(b, c), q = ridge_on(c, a);
       type2(c, p, q);
-      if (draw() < 0.5) {
+      if (draw.uniform() < 0.5) {
         type1(a, b, p);
         type2(a, p, q);
       } else {
@@ -331,12 +337,12 @@ PlanarMap build_planar_map(const BinaryTree& tree, double width_m, double height
       PlanarMap::Kind kind = PlanarMap::Kind::other;
       const auto r = river_now.find(key);
       if (r != river_now.end()) {
-        const auto& f = map.facets[std::size_t(faces[std::size_t(draw.integer(0, int(faces.size()) - 1))])];
+        const auto& f = map.facets[std::size_t(faces[std::size_t(integer(draw, 0, int(faces.size()) - 1))])];
         const Point2 g = (1.0 / 3) * (map.p[std::size_t(f[0])] + map.p[std::size_t(f[1])] + map.p[std::size_t(f[2])]);
         m = (1.0 / (2 + params.meander)) * (pa + pb + params.meander * g);
         kind = PlanarMap::Kind::river;
       } else {
-        z += params.roughness * norm(pb - pa) * draw();
+        z += params.roughness * norm(pb - pa) * draw.uniform();
         if (ridge_now.count(key)) kind = PlanarMap::Kind::ridge;
       }
       middle[key] = int(map.p.size());
@@ -395,6 +401,38 @@ void rasterise(const PlanarMap& map, Raster<float>& grid, Progress* progress) {
       throw Error(ErrorKind::cancelled, "generate: interrupted");
   }
   if (progress) progress->end();
+}
+
+GeneratedTerrain generate_planar(const GenerateRequest& request) {
+  PlanarParams params = request.planar;
+  params.seed = request.seed;
+  const BinaryTree tree = params.tree.empty() ? random_increasing_tree(params.nodes, request.seed) : parse_tree(params.tree, "--tree");
+  const double cell = request.cell_m;
+  const PlanarMap map = build_planar_map(tree, request.grid.cols() * cell, request.grid.rows() * cell, params);
+  GeneratedTerrain out;
+  out.dem = request.grid;
+  rasterise(map, out.dem, request.progress);
+  const auto grid_point = [&](int v) { return GridPoint{map.p[std::size_t(v)].x / cell - 0.5, map.p[std::size_t(v)].y / cell - 0.5}; };
+  // One reach per river edge; it flows into the edge leaving its downstream vertex (none at the mouth).
+  std::map<int, int> leaving;
+  for (std::size_t i = 0; i < map.rivers.size(); ++i) leaving[map.rivers[i].up] = int(i);
+  for (const auto& e : map.rivers) {
+    RiverReach reach;
+    reach.line = {grid_point(e.up), grid_point(e.down)};
+    const auto next = leaving.find(e.down);
+    reach.downstream = next == leaving.end() ? -1 : next->second;
+    out.skeleton.rivers.push_back(reach);
+  }
+  assign_strahler(out.skeleton);
+  for (auto [a, b] : map.ridges)
+    out.skeleton.ridges.push_back({{grid_point(a), grid_point(b)}, {float(map.z[std::size_t(a)]), float(map.z[std::size_t(b)])}});
+  out.figures = {{"tree_nodes", double(tree.size())},
+                 {"map_vertices", double(map.p.size())},
+                 {"facets", double(map.facets.size())},
+                 {"linear_programs", double(map.lp_problems)},
+                 {"lp_unknowns", double(map.lp_variables)},
+                 {"lp_inequalities", double(map.lp_constraints)}};
+  return out;
 }
 
 }  // namespace terrapolis::terrain

@@ -32,6 +32,8 @@ BinaryTree parse_tree(const std::string& text, const std::string& option);
 std::vector<int> strahler_orders(const BinaryTree& tree);
 
 struct PlanarParams {
+  std::string tree;           ///< the river tree as parse_tree text; empty: random_increasing_tree(nodes)
+  int nodes = 150;            ///< confluences of the random tree
   double drop_m = 30;         ///< CRIV of DALT(n) = CRIV / Strahler(n)^a (§6.3.4.1), metres
   double drop_exponent = 1;   ///< a
   double bank_slope = 0.08;   ///< least slope (m/m) of a facet towards its river or away from its ridge

@@ -9,6 +9,7 @@
 #include <numbers>
 
 #include "core/error.hpp"
+#include "terrain/generators.hpp"
 #include "terrain/subdivision.hpp"
 
 namespace terrapolis::terrain {
@@ -182,13 +183,13 @@ int RiverGraph::add(int from, Point2 p, double z, int priority) {
 }
 
 std::vector<std::vector<Point2>> synthetic_coast(double width_m, double height_m, std::uint64_t seed) {
-  UniformDraw draw(seed ^ 0xC0A57ull);
+  Rng draw(seed ^ 0xC0A57ull);
   const Point2 centre{width_m / 2, height_m / 2};
   const double radius = 0.36 * std::min(width_m, height_m);
   double amplitude[9] = {}, phase[9] = {};
   for (int k = 2; k <= 8; ++k) {
-    amplitude[k] = draw.between(0.3, 1.0) * 0.22 / k;
-    phase[k] = draw.between(0, 2 * kPi);
+    amplitude[k] = between(draw, 0.3, 1.0) * 0.22 / k;
+    phase[k] = between(draw, 0, 2 * kPi);
   }
   std::vector<Point2> ring;
   const int n = 360;
@@ -253,7 +254,7 @@ void place_mouths(RiverGraph& graph, const std::vector<std::vector<Point2>>& coa
 
 /// Grows the forest (§4.2): mixed selection, then the production of the chosen candidate; each
 /// child β is instantiated if valid (3.1) or dropped (3.2).
-void grow(RiverGraph& graph, std::vector<Point2> directions, const CoastParams& params, UniformDraw& draw, Progress* progress) {
+void grow(RiverGraph& graph, std::vector<Point2> directions, const CoastParams& params, Rng& draw, Progress* progress) {
   struct Candidate {
     int node;
     Point2 dir;
@@ -282,29 +283,29 @@ void grow(RiverGraph& graph, std::vector<Point2> directions, const CoastParams& 
       int priority;
     };
     std::vector<Child> children;
-    const double side = draw() < 0.5 ? -1 : 1;
-    switch (choose_rule(s, draw(), params)) {
+    const double side = draw.uniform() < 0.5 ? -1 : 1;
+    switch (choose_rule(s, draw.uniform(), params)) {
       case GrammarRule::fill: {
-        const int p = draw.integer(1, 5);
-        children.push_back({draw.between(-20, 20) * deg, 0});
-        for (int i = 1; i < p; ++i) children.push_back({(i % 2 ? side : -side) * draw.between(35, 75) * deg, 0});
+        const int p = integer(draw, 1, 5);
+        children.push_back({between(draw, -20, 20) * deg, 0});
+        for (int i = 1; i < p; ++i) children.push_back({(i % 2 ? side : -side) * between(draw, 35, 75) * deg, 0});
         break;
       }
-      case GrammarRule::continuation: children.push_back({draw.between(-20, 20) * deg, s}); break;
+      case GrammarRule::continuation: children.push_back({between(draw, -20, 20) * deg, s}); break;
       case GrammarRule::asymmetric:
-        children.push_back({draw.between(-15, 15) * deg, s});
-        children.push_back({side * draw.between(40, 75) * deg, draw.integer(0, s - 1)});
+        children.push_back({between(draw, -15, 15) * deg, s});
+        children.push_back({side * between(draw, 40, 75) * deg, integer(draw, 0, s - 1)});
         break;
       case GrammarRule::symmetric:
-        children.push_back({side * draw.between(20, 45) * deg, s - 1});
-        children.push_back({-side * draw.between(20, 45) * deg, s - 1});
+        children.push_back({side * between(draw, 20, 45) * deg, s - 1});
+        children.push_back({-side * between(draw, 20, 45) * deg, s - 1});
         break;
     }
     for (const Child& child : children) {
       const Point2 dir = rotate(c.dir, child.angle);
       const Point2 p = from.p + params.edge_m * dir;
       // Altitudes grow upstream (§4.2.2); low-priority streams are steeper.
-      const double grade = params.river_grade * std::pow(std::sqrt(2.0), params.max_priority - child.priority) * draw.between(0.6, 1.4);
+      const double grade = params.river_grade * std::pow(std::sqrt(2.0), params.max_priority - child.priority) * between(draw, 0.6, 1.4);
       const double zc = from.z + grade * params.edge_m;
       if (graph.valid(c.node, p, zc)) open.push_back({graph.add(c.node, p, zc, child.priority), dir});
     }
@@ -363,14 +364,11 @@ void refine_courses(std::vector<RiverNode>& nodes, const CoastParams& params) {
 CoastTerrain generate_coast_terrain(Raster<float>& grid, const std::vector<std::vector<Point2>>& coast, const CoastParams& params,
                                     Progress* progress) {
   if (!(params.sigma_m > params.edge_m / std::sqrt(2.0)))
-    throw bad_input("--sigma: must exceed e/sqrt(2) = " + std::to_string(params.edge_m / std::sqrt(2.0)) + " m (Génévaux §4.2.2)");
-  const double sum = params.p_continue + params.p_symmetric + params.p_asymmetric;
-  if (std::abs(sum - 1) > 1e-6 || params.p_continue < 0 || params.p_symmetric < 0 || params.p_asymmetric < 0)
-    throw bad_input("--grammar: P_c, P_s, P_a must be non-negative and sum to 1");
+    throw bad_input("--sigma: must exceed e/sqrt(2) = " + std::to_string(params.edge_m / std::sqrt(2.0)) + " m (Génévaux et al. §4.2.2)");
   const double cell = std::abs(grid.georef().transform[1]) * (grid.georef().crs.linear_unit_m > 0 ? grid.georef().crs.linear_unit_m : 1.0);
   const double width = grid.cols() * cell, height = grid.rows() * cell;
   CoastTerrain out;
-  UniformDraw draw(params.seed);
+  Rng draw(params.seed);
 
   // 1. Graph: mouths and grammar.
   auto t0 = Clock::now();
@@ -564,6 +562,53 @@ CoastTerrain generate_coast_terrain(Raster<float>& grid, const std::vector<std::
   if (progress) progress->end();
   out.terrain_s = seconds_since(t0);
   out.nodes = std::move(nodes);
+  return out;
+}
+
+GeneratedTerrain generate_coast(const GenerateRequest& request) {
+  const double cell = request.cell_m;
+  // Plan metres have the centre of cell (c,r) at ((c+0.5) cell, (r+0.5) cell); GridPoint at (c,r).
+  const auto plan = [&](const GridPoint& g) { return Point2{(g[0] + 0.5) * cell, (g[1] + 0.5) * cell}; };
+  const auto grid_point = [&](Point2 p) { return GridPoint{p.x / cell - 0.5, p.y / cell - 0.5}; };
+  std::vector<std::vector<Point2>> coast;
+  for (const auto& ring : request.polygons) {
+    std::vector<Point2> r;
+    for (const GridPoint& g : ring) r.push_back(plan(g));
+    coast.push_back(std::move(r));
+  }
+  if (coast.empty()) coast = synthetic_coast(request.grid.cols() * cell, request.grid.rows() * cell, request.seed);
+  CoastParams params = request.coast;
+  params.seed = request.seed;
+  GeneratedTerrain out;
+  out.dem = request.grid;
+  const CoastTerrain t = generate_coast_terrain(out.dem, coast, params, request.progress);
+
+  // One reach per grammar edge, upstream to downstream; an edge flows into its parent's edge, or
+  // out at a mouth. Width: the channel the primitives carve (Leopold & Maddock, see above).
+  std::vector<int> reach_of(t.nodes.size(), -1);
+  for (std::size_t i = 0; i < t.nodes.size(); ++i)
+    if (t.nodes[i].parent >= 0) reach_of[i] = int(out.skeleton.rivers.size()), out.skeleton.rivers.emplace_back();
+  for (std::size_t i = 0; i < t.nodes.size(); ++i) {
+    const RiverNode& n = t.nodes[i];
+    if (n.parent < 0) continue;
+    RiverReach& reach = out.skeleton.rivers[std::size_t(reach_of[i])];
+    for (Point2 p : n.course) reach.line.push_back(grid_point(p));
+    reach.downstream = reach_of[std::size_t(n.parent)];
+    reach.width_m = 2.5 * std::sqrt(std::max(n.discharge_m3s, 0.01));
+  }
+  assign_strahler(out.skeleton);
+  for (const RidgeSegment& s : t.ridges) out.skeleton.ridges.push_back({{grid_point(s.a), grid_point(s.b)}, {float(s.za), float(s.zb)}});
+  out.timings = {{"grammar graph", t.graph_s}, {"analysis", t.analysis_s}, {"terrain", t.terrain_s}};
+  std::size_t streams = 0, low = 0;
+  for (const RiverNode& n : t.nodes)
+    if (n.parent >= 0) ++streams, low += n.priority <= 1 ? 1 : 0;
+  out.figures = {{"mouths", double(t.mouths)},
+                 {"land_km2", t.land_km2},
+                 {"river_km_per_km2", t.land_km2 > 0 ? t.river_km / t.land_km2 : 0.0},
+                 {"terrain_primitives", double(t.terrain_primitives)},
+                 {"terrain_primitives_per_km2", t.land_km2 > 0 ? t.terrain_primitives / t.land_km2 : 0.0},
+                 {"river_primitives", double(t.river_primitives)},
+                 {"low_priority_stream_share", streams ? double(low) / streams : 0.0}};
   return out;
 }
 

@@ -19,8 +19,8 @@ namespace terrapolis::terrain {
 /// Parameters of the coast method. Lengths in metres; the paper gives the rules, not the figures:
 /// the defaults are ours, chosen so that the drainage density and primitive counts match its Tab. 2.
 struct CoastParams {
-  double edge_m = 1000;        ///< e: length of a grammar edge (§4)
-  double sigma_m = 1600;       ///< σ: least distance between two edges (> e/√2, §4.2.2)
+  double edge_m = 2000;        ///< e: length of a grammar edge (§4)
+  double sigma_m = 1500;       ///< σ: least distance between two edges (> e/√2, §4.2.2)
   double delta_m = 300;        ///< δ: least distance from an edge to the coast
   double kappa = 0.3;          ///< κ: greatest slope (m/m) between a new node and the nodes near it
   double zeta_m = 10;          ///< ζ: altitude window of the mixed selection (0: lowest first; large: priority first)
@@ -28,7 +28,7 @@ struct CoastParams {
   double p_symmetric = 0.7;    ///< P_s
   double p_asymmetric = 0.1;   ///< P_a
   int max_priority = 4;        ///< priority of the most accessible mouth; others get less (§4.1)
-  double mouth_spacing_m = 3000;  ///< least distance between two mouths ([DL78]: mouths are far apart)
+  double mouth_spacing_m = 6000;  ///< least distance between two mouths ([DL78]: mouths are far apart)
   double river_grade = 0.004;  ///< rise per metre of a priority-max edge; each lower priority steepens it by √2
   double lambda = 0.1;         ///< λ of q_z = max(p_z) + λd (§5.1), damped within 5 e of the coast
   double primitive_spacing_m = 316;  ///< spacing of the terrain primitives (Tab. 2: about 10 per km²)

@@ -1,0 +1,41 @@
+// What every terrain generator of `terrapolis generate --method` takes and gives.
+// SPDX-License-Identifier: MIT
+#pragma once
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/progress.hpp"
+#include "core/raster.hpp"
+#include "terrain/planar_basins.hpp"
+#include "terrain/river_grammar.hpp"
+#include "terrain/skeleton.hpp"
+#include "terrain/subdivision.hpp"
+
+namespace terrapolis::terrain {
+
+struct GenerateRequest {
+  Raster<float> grid;            ///< the empty grid (NaN), georeferenced; square cells of cell_m
+  double cell_m = 30;
+  std::uint64_t seed = 1;
+  double relief_m = 1000;        ///< height of the highest crest above the outlets
+  DmmcParams dmmc;               ///< the DMMC that fills between the skeleton's cells
+  std::vector<std::vector<GridPoint>> lines;  ///< user lines (flow: ridges), cell coordinates
+  std::vector<GridPoint> points;               ///< user points (tectonic: mountain points)
+  std::vector<std::vector<GridPoint>> polygons;  ///< user polygon rings (coast: the land; empty: a seeded island)
+  CoastParams coast;             ///< coast: Génévaux et al.'s parameters (seed taken from `seed`)
+  PlanarParams planar;           ///< planar: the planar-maps chapter's parameters (seed taken from `seed`)
+  Progress* progress = nullptr;
+};
+
+struct GeneratedTerrain {
+  Raster<float> dem;                  ///< metres, on the request's grid
+  Skeleton skeleton;                  ///< what the DEM was built from (empty for plain DMMC)
+  std::optional<double> sea_level_m;  ///< cells at or below it are sea
+  std::vector<std::pair<std::string, double>> timings;  ///< seconds by phase, for logs only (never in files)
+  std::vector<std::pair<std::string, double>> figures;  ///< the method's own figures (e.g. the paper's Tab. 2), for the report
+};
+
+}  // namespace terrapolis::terrain

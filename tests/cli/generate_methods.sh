@@ -1,0 +1,97 @@
+#!/usr/bin/env bash
+# terrapolis generate --method flow | tectonic: the DEM holds the generator's rivers. The report's
+# figures must be in range, and an independent check (Python, on `terrapolis hydro`'s own streams
+# and the skeleton GeoJSON) must find the same consistency. Same seed, same bytes at any thread count.
+set -euo pipefail
+BIN=$1
+T=$(mktemp -d)
+trap 'rm -rf "$T"' EXIT
+for method in flow tectonic; do
+  "$BIN" --quiet generate "$T/$method.tif" --method $method --size 257x257 --cell 30 --seed 3
+  "$BIN" --quiet --threads 1 generate "$T/${method}1.tif" --method $method --size 257x257 --cell 30 --seed 3
+  cmp "$T/$method.tif" "$T/${method}1.tif"
+  cmp "$T/$method.skeleton.geojson" "$T/${method}1.skeleton.geojson"
+  cmp "$T/$method.report.json" "$T/${method}1.report.json"
+  threshold=$(/usr/bin/python3 -c "import json; print(json.load(open('$T/$method.report.json'))['d8_consistency']['d8_stream_threshold_km2'])")
+  "$BIN" --quiet hydro "$T/$method.tif" "$T/$method-hydro" --hydrometry accumulation --outputs streams --streams-threshold "$threshold"
+  /usr/bin/python3 - "$T/$method" <<'PY'
+import json, math, sys
+import numpy as np
+from osgeo import gdal, ogr, osr
+base = sys.argv[1]
+report = json.load(open(base + ".report.json"))
+c, h = report["d8_consistency"], report["horton"]
+problems = []
+if c["share_within_2_cells"] < 0.9: problems.append("consistency %s < 0.9" % c["share_within_2_cells"])
+if c["mouths_ending_in_pit"] != 0: problems.append("%d mouths end in a pit" % c["mouths_ending_in_pit"])
+if c["mouths"] < 1: problems.append("no river reaches an outlet")
+rb, rl = h["bifurcation_ratio"], h["length_ratio"]
+if rb is None or not 3 <= rb <= 5: problems.append("Rb %s outside 3-5" % rb)
+if rl is None or not 1.5 <= rl <= 3.5: problems.append("Rl %s outside 1.5-3.5" % rl)
+# Independent re-computation: hydro's streams and the skeleton, both read back from GeoJSON.
+ds = gdal.Open(base + ".tif")
+gt, cols, rows = ds.GetGeoTransform(), ds.RasterXSize, ds.RasterYSize
+srs = osr.SpatialReference(); srs.ImportFromWkt(ds.GetProjection())
+srs.SetAxisMappingStrategy(osr.OAMS_TRADITIONAL_GIS_ORDER)
+def lines(path, kind=None):
+    layer = ogr.Open(path).GetLayer()
+    src = layer.GetSpatialRef(); src.SetAxisMappingStrategy(osr.OAMS_TRADITIONAL_GIS_ORDER)
+    tr = osr.CoordinateTransformation(src, srs)
+    for f in layer:
+        if kind and f.GetField("kind") != kind: continue
+        g = f.GetGeometryRef().Clone(); g.Transform(tr)
+        pts = [((x - gt[0]) / gt[1] - 0.5, (y - gt[3]) / gt[5] - 0.5) for x, y, *_ in g.GetPoints()]
+        yield f.GetField("strahler"), pts
+order = np.zeros((rows, cols), np.int32)
+for o, pts in lines(base + "-hydro/streams.geojson"):
+    for x, y in pts:
+        order[int(round(y)), int(round(x))] = max(order[int(round(y)), int(round(x))], o)
+total = matched = 0.0
+for o, pts in lines(base + ".skeleton.geojson", "river"):
+    for (x0, y0), (x1, y1) in zip(pts, pts[1:]):
+        n = max(1, math.ceil(math.hypot(x1 - x0, y1 - y0) * 2))
+        for s in range(n):
+            t = (s + 0.5) / n
+            x, y = x0 + t * (x1 - x0), y0 + t * (y1 - y0)
+            cx, cy = int(round(x)), int(round(y))
+            win = order[max(0, cy - 2):cy + 3, max(0, cx - 2):cx + 3]
+            yy, xx = np.mgrid[max(0, cy - 2):cy + 3, max(0, cx - 2):cx + 3][:, :win.shape[0], :win.shape[1]]
+            near = ((xx - cx) ** 2 + (yy - cy) ** 2 <= 4) & (win > 0) & (np.abs(win - o) <= 1)
+            d = math.hypot(x1 - x0, y1 - y0) / n
+            total += d; matched += d if near.any() else 0
+share = matched / total
+if abs(share - c["share_within_2_cells"]) > 0.02: problems.append("independent share %.4f vs report %.4f" % (share, c["share_within_2_cells"]))
+if problems:
+    print(base + ": " + "; ".join(problems)); sys.exit(1)
+PY
+done
+# A different seed gives a different region.
+"$BIN" --quiet generate "$T/other.tif" --method flow --size 257x257 --cell 30 --seed 4
+! cmp -s "$T/flow.tif" "$T/other.tif"
+# Ridges given as lines: the flow method follows them.
+/usr/bin/python3 - "$T/ridges.geojson" <<'PY'
+import json, sys
+# Two ridges across a 257 x 257 grid of 30 m cells in EPSG:3035 centred on its origin.
+x0, y0 = 4321000 - 257 * 15, 3210000 + 257 * 15
+line = lambda a, b: {"type": "Feature", "properties": {}, "geometry": {"type": "LineString", "coordinates": [a, b]}}
+from osgeo import osr
+s = osr.SpatialReference(); s.ImportFromEPSG(3035); w = osr.SpatialReference(); w.ImportFromEPSG(4326)
+w.SetAxisMappingStrategy(osr.OAMS_TRADITIONAL_GIS_ORDER); s.SetAxisMappingStrategy(osr.OAMS_TRADITIONAL_GIS_ORDER)
+tr = osr.CoordinateTransformation(s, w)
+ll = lambda c, r: list(tr.TransformPoint(x0 + c * 30, y0 - r * 30)[:2])
+fc = {"type": "FeatureCollection", "features": [line(ll(60, 128), ll(200, 110)), line(ll(128, 40), ll(128, 100))]}
+json.dump(fc, open(sys.argv[1], "w"))
+PY
+"$BIN" --quiet generate "$T/given.tif" --method flow --size 257x257 --cell 30 --ridges "$T/ridges.geojson"
+/usr/bin/python3 -c "
+from osgeo import gdal; import sys
+a = gdal.Open('$T/given.tif').GetRasterBand(1).ReadAsArray()
+sys.exit(0 if a[119, 130] > a[30, 30] + 500 else 1)"
+# Bad input: one line, exit 2, nothing written.
+set +e
+"$BIN" generate "$T/bad.tif" --method nope --size 65x65 --cell 30 2>"$T/err"; rc=$?
+[ $rc -eq 2 ] && grep -q -- "--method" "$T/err" && [ ! -e "$T/bad.tif" ] || { echo "bad method: rc=$rc"; cat "$T/err"; exit 1; }
+echo '{"type":"FeatureCollection","features":[]}' > "$T/empty.geojson"
+"$BIN" generate "$T/bad.tif" --method flow --size 65x65 --cell 30 --ridges "$T/empty.geojson" 2>"$T/err"; rc=$?
+[ $rc -eq 2 ] && grep -q "empty.geojson" "$T/err" && [ ! -e "$T/bad.tif" ] && [ ! -e "$T/bad.skeleton.geojson" ] || { echo "empty ridges: rc=$rc"; cat "$T/err"; exit 1; }
+exit 0
