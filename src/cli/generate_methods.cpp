@@ -32,6 +32,8 @@ void CoastPlanarOptions::add(CLI::App& app) {
   auto& p = planar;
   app.add_option("--tree", p.tree, "planar: the river tree as nested pairs, '.' a source and '(LR)' a confluence, e.g. '((..).)' "
                                    "(default: a random increasing binary tree)");
+  app.add_option("--tree-law", tree_law, "planar: law of the random tree: increasing (balanced, §6.4.1 'croissant') or uniform (Rémy)")
+      ->capture_default_str()->check(CLI::IsMember({"increasing", "uniform"}));
   app.add_option("--nodes", p.nodes, "planar: confluences of the random tree")->capture_default_str()->check(CLI::Range(1, 100000));
   app.add_option("--drop", p.drop_m, "planar: CRIV (m) of DALT = CRIV / Strahler^a, the rise of a river vertex above the next one down")
       ->capture_default_str()->check(CLI::PositiveNumber);
@@ -54,6 +56,7 @@ void CoastPlanarOptions::apply(terrain::GenerateRequest& request) const {
   request.coast.p_symmetric = ps;
   request.coast.p_asymmetric = pa;
   request.planar = planar;
+  request.planar.uniform_tree = tree_law == "uniform";
 }
 
 }  // namespace terrapolis::cli

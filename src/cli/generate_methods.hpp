@@ -13,7 +13,7 @@ namespace terrapolis::cli {
 struct CoastPlanarOptions {
   terrain::CoastParams coast;
   terrain::PlanarParams planar;
-  std::string coast_path, grammar = "0.2,0.7,0.1";
+  std::string coast_path, grammar = "0.2,0.7,0.1", tree_law = "increasing";
 
   void add(CLI::App& app);
   /// Copies the parameters into `request`; throws bad_input naming the option at fault.

@@ -59,6 +59,42 @@ BinaryTree random_increasing_tree(int internal, std::uint64_t seed) {
   return t;
 }
 
+BinaryTree random_binary_tree(int internal, std::uint64_t seed) {
+  if (internal < 1) throw bad_input("--nodes: give at least 1 internal node");
+  // Rémy's algorithm (1985): a uniformly drawn node gets a new parent whose other child is a new
+  // leaf, on a side drawn at random; every binary tree of `internal` internal nodes is equally likely.
+  std::vector<int> left{-1}, right{-1}, parent{-1};
+  int root = 0;
+  Rng draw(seed);
+  for (int k = 0; k < internal; ++k) {
+    const int x = integer(draw, 0, int(left.size()) - 1);
+    const int node = int(left.size()), leaf = node + 1;
+    const bool leaf_left = draw.uniform() < 0.5;
+    left.push_back(leaf_left ? leaf : x);
+    right.push_back(leaf_left ? x : leaf);
+    parent.push_back(parent[std::size_t(x)]);
+    left.push_back(-1);
+    right.push_back(-1);
+    parent.push_back(node);
+    const int up = parent[std::size_t(x)];
+    if (up < 0) root = node;
+    else (left[std::size_t(up)] == x ? left : right)[std::size_t(up)] = node;
+    parent[std::size_t(x)] = node;
+  }
+  // Renumbered breadth-first so that parents precede children.
+  BinaryTree t;
+  std::vector<int> order{root}, id(left.size(), -1);
+  for (std::size_t h = 0; h < order.size(); ++h)
+    if (left[std::size_t(order[h])] >= 0) order.push_back(left[std::size_t(order[h])]), order.push_back(right[std::size_t(order[h])]);
+  for (std::size_t i = 0; i < order.size(); ++i) id[std::size_t(order[i])] = int(i);
+  for (int old : order) {
+    t.left.push_back(left[std::size_t(old)] < 0 ? -1 : id[std::size_t(left[std::size_t(old)])]);
+    t.right.push_back(right[std::size_t(old)] < 0 ? -1 : id[std::size_t(right[std::size_t(old)])]);
+    t.parent.push_back(parent[std::size_t(old)] < 0 ? -1 : id[std::size_t(parent[std::size_t(old)])]);
+  }
+  return t;
+}
+
 BinaryTree parse_tree(const std::string& text, const std::string& option) {
   BinaryTree t;
   std::size_t pos = 0;
@@ -406,7 +442,9 @@ void rasterise(const PlanarMap& map, Raster<float>& grid, Progress* progress) {
 GeneratedTerrain generate_planar(const GenerateRequest& request) {
   PlanarParams params = request.planar;
   params.seed = request.seed;
-  const BinaryTree tree = params.tree.empty() ? random_increasing_tree(params.nodes, request.seed) : parse_tree(params.tree, "--tree");
+  const BinaryTree tree = !params.tree.empty()     ? parse_tree(params.tree, "--tree")
+                           : params.uniform_tree ? random_binary_tree(params.nodes, request.seed)
+                                                 : random_increasing_tree(params.nodes, request.seed);
   const double cell = request.cell_m;
   const PlanarMap map = build_planar_map(tree, request.grid.cols() * cell, request.grid.rows() * cell, params);
   GeneratedTerrain out;

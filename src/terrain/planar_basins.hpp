@@ -25,6 +25,9 @@ struct BinaryTree {
 /// A random increasing binary tree of `internal` internal nodes: `internal` times, a uniformly
 /// drawn leaf gets two children (the chapter's §6.4.1 "arbre binaire aléatoire croissant").
 BinaryTree random_increasing_tree(int internal, std::uint64_t seed);
+/// A uniformly random binary tree of `internal` internal nodes (Rémy 1985), numbered parents first:
+/// the chapter's "arbre binaire aléatoire" (§6.4.1), Shreve's topologically random network.
+BinaryTree random_binary_tree(int internal, std::uint64_t seed);
 /// A tree written as nested pairs: "." is a leaf, "(LR)" an internal node with left L and right R,
 /// e.g. "((..).)". Throws bad_input naming `option` on a malformed text.
 BinaryTree parse_tree(const std::string& text, const std::string& option);
@@ -32,8 +35,9 @@ BinaryTree parse_tree(const std::string& text, const std::string& option);
 std::vector<int> strahler_orders(const BinaryTree& tree);
 
 struct PlanarParams {
-  std::string tree;           ///< the river tree as parse_tree text; empty: random_increasing_tree(nodes)
+  std::string tree;           ///< the river tree as parse_tree text; empty: random_binary_tree(nodes)
   int nodes = 150;            ///< confluences of the random tree
+  bool uniform_tree = false;  ///< random tree law: uniform (Rémy) rather than increasing
   double drop_m = 30;         ///< CRIV of DALT(n) = CRIV / Strahler(n)^a (§6.3.4.1), metres
   double drop_exponent = 1;   ///< a
   double bank_slope = 0.08;   ///< least slope (m/m) of a facet towards its river or away from its ridge

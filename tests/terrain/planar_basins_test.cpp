@@ -27,6 +27,16 @@ TEST(PlanarBasins, ParsesTreesAndOrders) {
   const BinaryTree r = random_increasing_tree(40, 9);
   EXPECT_EQ(r.size(), 81);
   for (int n = 1; n < r.size(); ++n) EXPECT_LT(r.parent[std::size_t(n)], n);
+  const BinaryTree u = random_binary_tree(40, 9);  // Rémy: renumbered so that parents come first
+  ASSERT_EQ(u.size(), 81);
+  EXPECT_EQ(u.parent[0], -1);
+  int leaves = 0;
+  for (int n = 0; n < u.size(); ++n) {
+    leaves += u.leaf(n) ? 1 : 0;
+    if (n > 0) EXPECT_LT(u.parent[std::size_t(n)], n);
+    if (!u.leaf(n)) EXPECT_EQ(u.parent[std::size_t(u.left[std::size_t(n)])], n);
+  }
+  EXPECT_EQ(leaves, 41);
 }
 
 TEST(PlanarBasins, FacetInequalitiesByHand) {
