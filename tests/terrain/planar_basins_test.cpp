@@ -33,8 +33,12 @@ TEST(PlanarBasins, ParsesTreesAndOrders) {
   int leaves = 0;
   for (int n = 0; n < u.size(); ++n) {
     leaves += u.leaf(n) ? 1 : 0;
-    if (n > 0) EXPECT_LT(u.parent[std::size_t(n)], n);
-    if (!u.leaf(n)) EXPECT_EQ(u.parent[std::size_t(u.left[std::size_t(n)])], n);
+    if (n > 0) {
+      EXPECT_LT(u.parent[std::size_t(n)], n);
+    }
+    if (!u.leaf(n)) {
+      EXPECT_EQ(u.parent[std::size_t(u.left[std::size_t(n)])], n);
+    }
   }
   EXPECT_EQ(leaves, 41);
 }
