@@ -609,6 +609,15 @@ GeneratedTerrain generate_coast(const GenerateRequest& request) {
                  {"terrain_primitives_per_km2", t.land_km2 > 0 ? t.terrain_primitives / t.land_km2 : 0.0},
                  {"river_primitives", double(t.river_primitives)},
                  {"low_priority_stream_share", streams ? double(low) / streams : 0.0}};
+  // River types of §5.2 (the skeleton layer carries widths, from the discharge; the types are counted here).
+  for (const hydro::RiverType type : {hydro::RiverType::B, hydro::RiverType::E, hydro::RiverType::D, hydro::RiverType::delta}) {
+    std::size_t count = 0;
+    for (const RiverNode& n : t.nodes) count += n.parent >= 0 && n.type == type ? 1 : 0;
+    out.figures.emplace_back(std::string("reaches_type_") + hydro::river_type_name(type), double(count));
+  }
+  double top_discharge = 0;
+  for (const RiverNode& n : t.nodes) top_discharge = std::max(top_discharge, n.discharge_m3s);
+  out.figures.emplace_back("largest_discharge_m3s", top_discharge);
   return out;
 }
 
