@@ -93,6 +93,8 @@ class GenerateCommand final : public Command {
     if (!method) throw bad_input("--method: unknown generator '" + method_ + "' (expected " + method_names() + ")");
     const bool skeleton_method = method_ != "dmmc";
     if (skeleton_method && !sketch_.empty()) throw bad_input("--constraints: only --method dmmc takes a sketch");
+    if (!lines_path_.empty() && method_ != "flow") throw bad_input("--ridges: only --method flow takes ridge lines");
+    if (!points_path_.empty() && method_ != "tectonic") throw bad_input("--mountains: only --method tectonic takes mountain points");
     if (skeleton_method && grid_.crs.empty()) default_local_grid();
     // Between a skeleton's cells the noise must stay below the relief it carves, or it makes pits.
     if (skeleton_method && app_->get_option("--roughness")->count() == 0) options_.roughness_m = 0.05 * relief_m_;

@@ -38,7 +38,7 @@ std::string skeleton_report(const terrain::GeneratedTerrain& terrain, double cel
 
   double river_m = 0;
   for (const auto& r : skeleton.rivers) river_m += terrain::line_length_m(r.line, cell_m);
-  const double threshold_m2 = terrain::matching_threshold_m2(d8.accumulation, river_m / cell_m);
+  const double threshold_m2 = terrain.channel_head_m2 ? *terrain.channel_head_m2 : terrain::channel_head_threshold_m2(skeleton, d8.accumulation);
   const VectorLayer streams = hydro::extract_streams(d8.d8, d8.accumulation, cell_metrics(dem.georef(), dem.cols(), dem.rows()),
                                                      {threshold_m2 / 1e6}, progress);
   const auto order = terrain::stream_order_raster(streams, dem.georef(), dem.cols(), dem.rows());

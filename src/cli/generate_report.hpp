@@ -8,8 +8,8 @@
 
 namespace terrapolis::cli {
 
-/// Runs the hydro stage's D8 (priority-flood fill, D8, upstream area, streams with the threshold
-/// that matches the generated drainage density) on `terrain.dem`, checks the skeleton against
+/// Runs the hydro stage's D8 (priority-flood fill, D8, upstream area, streams from the generator's
+/// channel-head area) on `terrain.dem`, checks the skeleton against
 /// it (terrain/skeleton_checks.hpp), logs the summary and returns the report as JSON text.
 std::string skeleton_report(const terrain::GeneratedTerrain& terrain, double cell_m, const std::string& method,
                             const Log& log, Progress& progress);

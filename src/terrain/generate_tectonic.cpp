@@ -12,6 +12,7 @@
 #include <queue>
 
 #include "core/neighbours.hpp"
+#include "terrain/distance_field.hpp"
 #include "terrain/generators.hpp"
 #include "terrain/random.hpp"
 
@@ -37,31 +38,6 @@ double fbm(std::uint64_t seed, double x, double y, int octaves, double hurst = 0
     x *= 2, y *= 2;
   }
   return sum / norm;
-}
-
-/// Chamfer distance (in cells, 8 neighbours) to the cells where `source` is set, with the index
-/// of the nearest source cell.
-void distance_to(const std::vector<char>& source, int cols, int rows, std::vector<double>& dist, std::vector<std::size_t>& nearest) {
-  const std::size_t n = std::size_t(cols) * rows;
-  dist.assign(n, 1e30);
-  nearest.assign(n, 0);
-  using Item = std::pair<double, std::size_t>;
-  std::priority_queue<Item, std::vector<Item>, std::greater<>> queue;
-  for (std::size_t i = 0; i < n; ++i)
-    if (source[i]) dist[i] = 0, nearest[i] = i, queue.push({0.0, i});
-  while (!queue.empty()) {
-    const auto [d, i] = queue.top();
-    queue.pop();
-    if (d > dist[i]) continue;
-    const int c = int(i % std::size_t(cols)), r = int(i / std::size_t(cols));
-    for (int k = 0; k < 8; ++k) {
-      const int nc = c + dcol[std::size_t(k)], nr = r + drow[std::size_t(k)];
-      if (nc < 0 || nr < 0 || nc >= cols || nr >= rows) continue;
-      const std::size_t j = std::size_t(nr) * std::size_t(cols) + std::size_t(nc);
-      const double nd = d + (is_diagonal(k) ? std::sqrt(2.0) : 1.0);
-      if (nd < dist[j]) dist[j] = nd, nearest[j] = nearest[i], queue.push({nd, j});
-    }
-  }
 }
 
 struct Plates {
@@ -193,9 +169,9 @@ GeneratedTerrain generate_tectonic(const GenerateRequest& request) {
       folds[i] = fold * kind * std::exp(-std::pow(to_boundary[i] / damping, 2));
     }
 
-  // River base map, grown from the ocean (the grid border) along a random drainage tree: a
-  // priority flood whose step costs are noisy, so the front invades the land like a river network
-  // grows headwards. Heights then rise from the ocean along the tree with Flint's slope-area law
+  // River base map, grown from the ocean (the grid border) along a random drainage tree: invasion
+  // percolation (Stark 1991, Nature 352), the front always taking the land cell of least resistance,
+  // so the network grows headwards; low folds resist least, so rivers take the fold valleys. Heights then rise from the ocean along the tree with Flint's slope-area law
   // S = k A^-0.5 (Flint 1974), the concave long profiles of real rivers.
   std::vector<std::size_t> receiver(n, n);
   std::vector<double> cost(n, 1e300);
@@ -212,7 +188,7 @@ GeneratedTerrain generate_tectonic(const GenerateRequest& request) {
         }
     std::vector<char> done(n, 0);
     while (!queue.empty()) {
-      const auto [d, i] = queue.top();
+      const std::size_t i = queue.top().second;
       queue.pop();
       if (done[i]) continue;
       done[i] = 1;
@@ -224,8 +200,8 @@ GeneratedTerrain generate_tectonic(const GenerateRequest& request) {
         const std::size_t j = std::size_t(nr) * std::size_t(cols) + std::size_t(nc);
         if (done[j]) continue;
         // Folds steer the growth: rivers grow more easily where the folds are low (the valleys).
-        const double step = (is_diagonal(k) ? std::sqrt(2.0) : 1.0) * (0.2 + (position_noise(request.seed ^ 0xa5u, nc, nr) + 1) + 3 * folds[j]);
-        if (d + step < cost[j]) cost[j] = d + step, receiver[j] = i, queue.push({d + step, j});
+        const double resistance = position_noise(request.seed ^ 0xa5u, nc, nr) + 1 + 3 * folds[j];
+        if (resistance < cost[j]) cost[j] = resistance, receiver[j] = i, queue.push({resistance, j});
       }
     }
   }
@@ -233,7 +209,7 @@ GeneratedTerrain generate_tectonic(const GenerateRequest& request) {
   for (std::size_t k = order.size(); k-- > 0;)
     if (receiver[order[k]] < n) area[receiver[order[k]]] += area[order[k]];
   const double cell_km2 = request.cell_m * request.cell_m / 1e6;
-  const double channel_cells = std::max(8.0, 0.25 / cell_km2);  // channels from 0.25 km² upstream
+  const double channel_cells = std::max(8.0, 0.1 / cell_km2);  // channels from 0.1 km² upstream
   std::vector<double> base(n, 0.0);
   const double k_s = 0.5 * request.relief_m / (size * request.cell_m) * std::sqrt(channel_cells);
   for (std::size_t i : order) {
@@ -292,6 +268,7 @@ GeneratedTerrain generate_tectonic(const GenerateRequest& request) {
     for (const auto& q : p.line)
       p.width_m.push_back(std::max(1.0, std::log2(area[std::size_t(q[1]) * std::size_t(cols) + std::size_t(q[0])] / channel_cells)) * request.cell_m);
   out.skeleton.rivers = reaches_from_paths(paths);
+  out.channel_head_m2 = channel_cells * request.cell_m * request.cell_m;
   out.timings.emplace_back("tectonic", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   return out;
 }

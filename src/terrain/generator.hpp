@@ -34,6 +34,9 @@ struct GeneratedTerrain {
   Raster<float> dem;                  ///< metres, on the request's grid
   Skeleton skeleton;                  ///< what the DEM was built from (empty for plain DMMC)
   std::optional<double> sea_level_m;  ///< cells at or below it are sea
+  /// Upstream area (m²) at which the generator starts its rivers: the D8 stream threshold of the
+  /// consistency check. None: the median D8 area at the generated channel heads.
+  std::optional<double> channel_head_m2;
   std::vector<std::pair<std::string, double>> timings;  ///< seconds by phase, for logs only (never in files)
   std::vector<std::pair<std::string, double>> figures;  ///< the method's own figures (e.g. the paper's Tab. 2), for the report
 };

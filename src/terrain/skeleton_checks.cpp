@@ -120,15 +120,19 @@ Raster<std::uint8_t> stream_order_raster(const VectorLayer& streams, const Geore
   return order;
 }
 
-double matching_threshold_m2(const Raster<double>& area_m2, double river_cells) {
-  std::vector<double> areas;
-  areas.reserve(area_m2.size());
-  for (std::size_t i = 0; i < area_m2.size(); ++i)
-    if (std::isfinite(area_m2[i]) && area_m2[i] > 0) areas.push_back(area_m2[i]);
-  if (areas.empty()) return 1.0;
-  const std::size_t k = std::min(areas.size() - 1, std::size_t(std::max(0.0, river_cells - 1)));
-  std::nth_element(areas.begin(), areas.begin() + std::ptrdiff_t(k), areas.end(), std::greater<>());
-  return areas[k];
+double channel_head_threshold_m2(const Skeleton& skeleton, const Raster<double>& area_m2) {
+  std::vector<char> fed(skeleton.rivers.size(), 0);
+  for (const auto& r : skeleton.rivers)
+    if (r.downstream >= 0) fed[std::size_t(r.downstream)] = 1;
+  std::vector<double> heads;
+  for (std::size_t i = 0; i < skeleton.rivers.size(); ++i) {
+    if (fed[i] || skeleton.rivers[i].line.empty()) continue;
+    const int c = nearest(skeleton.rivers[i].line.front()[0]), r = nearest(skeleton.rivers[i].line.front()[1]);
+    if (area_m2.inside(c, r) && std::isfinite(area_m2(c, r))) heads.push_back(area_m2(c, r));
+  }
+  if (heads.empty()) return 1.0;
+  std::nth_element(heads.begin(), heads.begin() + std::ptrdiff_t(heads.size() / 2), heads.end());
+  return std::max(1.0, heads[heads.size() / 2]);
 }
 
 double drainage_density(const Skeleton& skeleton, const Raster<float>& dem, double cell_m, std::optional<double> sea_level_m) {

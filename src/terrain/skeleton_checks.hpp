@@ -42,10 +42,10 @@ D8Consistency d8_consistency(const Skeleton& skeleton, const Raster<std::uint8_t
 /// onto `grid`: the highest order through each cell, 0 elsewhere.
 Raster<std::uint8_t> stream_order_raster(const VectorLayer& streams, const Georef& georef, int cols, int rows);
 
-/// The upstream area (m²) above which the D8 network has as many cells as `river_cells`: the
-/// stream threshold that gives the D8 network the generated network's drainage density, so both
-/// are ordered on the same footing.
-double matching_threshold_m2(const Raster<double>& area_m2, double river_cells);
+/// The D8 stream threshold (m²) that starts D8 streams where the generator starts its rivers: the
+/// median D8 upstream area at the first point of the source reaches (those nothing flows into).
+/// 1 m² when there is no source.
+double channel_head_threshold_m2(const Skeleton& skeleton, const Raster<double>& area_m2);
 
 /// Total river length (km) per land area (km²): cells that are finite and above `sea_level_m`.
 double drainage_density(const Skeleton& skeleton, const Raster<float>& dem, double cell_m,

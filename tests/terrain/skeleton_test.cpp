@@ -96,15 +96,17 @@ TEST(SkeletonChecks, ConsistencyOnATinyRaster) {
   EXPECT_EQ(d8_consistency(s, order, dem, 10.0, 2.0, 0.0).ending_in_pit, 1);
 }
 
-TEST(SkeletonChecks, DrainageDensityAndMatchingThreshold) {
+TEST(SkeletonChecks, DrainageDensityAndChannelHeadThreshold) {
   Skeleton s;
   s.rivers.push_back({row_line(0, 0, 10), -1, 1, 0});  // 10 cells of 100 m: 1 km
   Raster<float> dem(10, 10, Georef{}, 1.0f);            // 1 km2
   dem(0, 0) = std::numeric_limits<float>::quiet_NaN();
   EXPECT_NEAR(drainage_density(s, dem, 100.0), 1.0 / 0.99, 1e-12);
-  Raster<double> area(4, 1, Georef{}, 0.0);
-  area[0] = 5, area[1] = 40, area[2] = 10, area[3] = 20;
-  EXPECT_EQ(matching_threshold_m2(area, 2), 20.0);  // exactly 2 cells have at least 20 m2
+  // Channel heads: the sources of a binary tree sit on rows 0-3 at x = 0; their areas are 5, 40,
+  // 10, 20 m2: the median (upper of the two middle values) is 20.
+  Raster<double> area(41, 21, Georef{}, 1e6);
+  area(0, 0) = 5, area(0, 1) = 40, area(0, 2) = 10, area(0, 3) = 20;
+  EXPECT_EQ(channel_head_threshold_m2(binary_tree(), area), 20.0);
 }
 
 TEST(SkeletonChecks, StreamOrderRasterFromLines) {
