@@ -5,13 +5,14 @@
 # in 0.35-0.5 s, its DMMC in 0.1-0.15 s on 2007 hardware; Horton's ranges of real basins; Génévaux
 # et al. Tab. 2: 0.42-0.46 km of river per km²).
 # Usage: bench/generate.sh [SIZE]   (default 513: the thesis's grid)
-# Env: TERRAPOLIS_BIN (default build/src/cli/terrapolis), REPEAT (default 5), METHODS (default "dmmc flow tectonic"), SEED (default 1)
+# Env: TERRAPOLIS_BIN (default build/src/cli/terrapolis), REPEAT (default 5), METHODS (default "dmmc flow tectonic coast planar"), TABLE1 (1: also the coast method at the sizes of Génévaux et al. Tab. 1), SEED (default 1)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BIN=$(realpath "${TERRAPOLIS_BIN:-build/src/cli/terrapolis}")
 SIZE=${1:-513}
 REPEAT=${REPEAT:-5}
-METHODS=${METHODS:-dmmc flow tectonic}
+METHODS=${METHODS:-dmmc flow tectonic coast planar}
+TABLE1=${TABLE1:-1}
 SEED=${SEED:-1}
 WORK=$(mktemp -d)
 trap 'rm -rf "$WORK"' EXIT
@@ -40,3 +41,26 @@ print(c['share_within_2_cells'], c['mouths_ending_in_pit'], h['bifurcation_ratio
 done
 echo "documents: flow skeleton 513² 0.35-0.5 s, DMMC 0.1-0.15 s (Belhadj 2007, 2007 hardware); Rb 3-5, Rl 1.5-3.5 (Horton 1945,"
 echo "Strahler 1957); drainage density 0.42-0.46 km/km² (Génévaux et al., Tab. 2). dmmc alone has no skeleton."
+# Génévaux et al. Tab. 1-2: the coast method on islands of the paper's land areas (the seeded island
+# covers about 41 % of its grid), 100 m cells; the three phases the command logs with --verbose.
+if [ "$TABLE1" = 1 ]; then
+  printf "\n%-7s %6s %9s %9s %8s %9s %8s %10s %8s   %s\n" region cells land_km2 wall_s graph_s analysis_s terrain_s km/km2 prim/km2 "paper Tab. 1 (graph, analysis, tree s)"
+  for spec in "Mini:487:0.9,0.2,0.6" "Lambda:819:3.4,1.3,1.7" "Hoya:909:4.5,1.7,2.3" "Imbros:1332:39.2,8.7,5.1"; do
+    IFS=: read -r region n paper <<<"$spec"
+    : >"$WORK/wall"; : >"$WORK/graph"; : >"$WORK/analysis"; : >"$WORK/terrain"
+    for i in $(seq "$REPEAT"); do
+      rm -f "$WORK"/coast.*
+      /usr/bin/time -f %e -o "$WORK/t" "$BIN" --verbose generate "$WORK/coast.tif" --method coast --size "${n}x${n}" --cell 100 --seed "$SEED" 2>"$WORK/log"
+      cat "$WORK/t" >>"$WORK/wall"
+      for phase in graph analysis terrain; do
+        sed -n "s/.*generate: \(grammar \)\{0,1\}$phase in \([0-9.]*\) s.*/\2/p" "$WORK/log" >>"$WORK/$phase"
+      done
+    done
+    read -r land dd prim < <(/usr/bin/python3 -c "
+import json; f = json.load(open('$WORK/coast.report.json'))['figures']
+print(round(f['land_km2']), f['river_km_per_km2'], f['terrain_primitives_per_km2'])")
+    printf "%-7s %6s %9s %9s %8s %9s %8s %10s %8s   %s\n" "$region" "${n}x${n}" "$land" "$(median <"$WORK/wall")" "$(median <"$WORK/graph")" \
+      "$(median <"$WORK/analysis")" "$(median <"$WORK/terrain")" "$dd" "$prim" "$paper"
+  done
+  echo "paper: Intel Core i7 3 GHz; Tab. 2: 0.42-0.46 km of river and about 10 terrain primitives per km²."
+fi

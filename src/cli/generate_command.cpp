@@ -9,6 +9,7 @@
 
 #include "cli/command.hpp"
 #include "cli/commands_list.hpp"
+#include "cli/generate_methods.hpp"
 #include "cli/generate_report.hpp"
 #include "cli/terrain_options.hpp"
 #include "cli/schema_options.hpp"
@@ -41,6 +42,8 @@ constexpr Method kMethods[] = {
     {"dmmc", generate_dmmc},
     {"flow", terrain::generate_flow},
     {"tectonic", terrain::generate_tectonic},
+    {"coast", terrain::generate_coast},
+    {"planar", terrain::generate_planar},
 };
 
 std::string method_names() {
@@ -80,6 +83,7 @@ class GenerateCommand final : public Command {
     file_kind(app.add_option("--constraints", sketch_, "dmmc: sketch raster: cells with a value are fixed heights (m), nodata cells are generated. "
                                              "Warped onto the grid if it has a CRS, else it must have the grid's size"), FileKind::raster_in);
     options_.add(app, false, 1000.0);
+    skeleton_options_.add(app);
     app.add_flag("--overwrite", overwrite_, "Replace OUT if it exists");
   }
 
@@ -97,7 +101,7 @@ class GenerateCommand final : public Command {
     if (skeleton_method && app_->get_option("--roughness")->count() == 0) options_.roughness_m = 0.05 * relief_m_;
     terrain::FillParams params = options_.params();
     Raster<float> grid = grid_.make();
-    OutputSet outputs("generate", {sketch_, lines_path_, points_path_}, overwrite_);
+    OutputSet outputs("generate", {sketch_, lines_path_, points_path_, skeleton_options_.coast_path}, overwrite_);
     const std::string out = outputs.file(output_);
     const std::string skeleton_out = skeleton_method ? outputs.file(stem_of(output_) + ".skeleton.geojson") : "";
     const std::string report_out = skeleton_method ? outputs.file(stem_of(output_) + ".report.json") : "";
@@ -127,6 +131,8 @@ class GenerateCommand final : public Command {
     request.progress = &context.progress;
     if (!lines_path_.empty()) request.lines = read_lines(lines_path_, grid.georef());
     if (!points_path_.empty()) request.points = read_points(points_path_, grid.georef());
+    if (!skeleton_options_.coast_path.empty()) request.polygons = read_rings(skeleton_options_.coast_path, grid.georef());
+    skeleton_options_.apply(request);
     request.grid = std::move(grid);
     const terrain::GeneratedTerrain terrain = method->generate(request);
     for (const auto& [phase, seconds] : terrain.timings)
@@ -197,6 +203,20 @@ class GenerateCommand final : public Command {
     if (lines.empty()) throw bad_input(path + ": holds no line");
     return lines;
   }
+  static std::vector<std::vector<terrain::GridPoint>> read_rings(const std::string& path, const Georef& georef) {
+    const VectorLayer layer = read_vector(path, georef.crs);
+    if (layer.geometry != GeometryType::polygon) throw bad_input(path + ": expected polygons (the land)");
+    std::vector<std::vector<terrain::GridPoint>> rings;
+    for (const auto& f : layer.features)
+      for (const auto& part : f.parts) {
+        std::vector<terrain::GridPoint> ring;
+        for (const auto& p : part) ring.push_back(to_cell(georef, p));
+        if (ring.size() > 1 && ring.front() == ring.back()) ring.pop_back();
+        if (ring.size() >= 3) rings.push_back(std::move(ring));
+      }
+    if (rings.empty()) throw bad_input(path + ": holds no polygon");
+    return rings;
+  }
   static std::vector<terrain::GridPoint> read_points(const std::string& path, const Georef& georef) {
     const VectorLayer layer = read_vector(path, georef.crs);
     std::vector<terrain::GridPoint> points;
@@ -213,6 +233,7 @@ class GenerateCommand final : public Command {
   CLI::App* app_ = nullptr;
   GridOptions grid_;
   TerrainOptions options_;
+  CoastPlanarOptions skeleton_options_;
   bool overwrite_ = false;
 };
 

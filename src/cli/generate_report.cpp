@@ -72,6 +72,16 @@ std::string skeleton_report(const terrain::GeneratedTerrain& terrain, double cel
   report["horton"] = {{"streams_by_order", n}, {"mean_length_m_by_order", l},
                       {"bifurcation_ratio", optional_ratio(horton.bifurcation)}, {"length_ratio", optional_ratio(horton.length)}};
   report["drainage_density_km_per_km2"] = rounded(density, 1e-4);
+  if (!terrain.figures.empty()) {
+    std::string line;
+    json figures;
+    for (const auto& [name, value] : terrain.figures) {
+      figures[name] = rounded(value, 1e-4);
+      line += (line.empty() ? "" : ", ") + name + " " + fixed(value, 3);
+    }
+    report["figures"] = figures;
+    log.info("generate: " + line);
+  }
   return report.dump(2) + "\n";
 }
 

@@ -9,6 +9,8 @@
 
 #include "core/progress.hpp"
 #include "core/raster.hpp"
+#include "terrain/planar_basins.hpp"
+#include "terrain/river_grammar.hpp"
 #include "terrain/skeleton.hpp"
 #include "terrain/subdivision.hpp"
 
@@ -22,6 +24,9 @@ struct GenerateRequest {
   DmmcParams dmmc;               ///< the DMMC that fills between the skeleton's cells
   std::vector<std::vector<GridPoint>> lines;  ///< user lines (flow: ridges), cell coordinates
   std::vector<GridPoint> points;               ///< user points (tectonic: mountain points)
+  std::vector<std::vector<GridPoint>> polygons;  ///< user polygon rings (coast: the land; empty: a seeded island)
+  CoastParams coast;             ///< coast: Génévaux et al.'s parameters (seed taken from `seed`)
+  PlanarParams planar;           ///< planar: the planar-maps chapter's parameters (seed taken from `seed`)
   Progress* progress = nullptr;
 };
 
@@ -33,6 +38,7 @@ struct GeneratedTerrain {
   /// consistency check. None: the median D8 area at the generated channel heads.
   std::optional<double> channel_head_m2;
   std::vector<std::pair<std::string, double>> timings;  ///< seconds by phase, for logs only (never in files)
+  std::vector<std::pair<std::string, double>> figures;  ///< the method's own figures (e.g. the paper's Tab. 2), for the report
 };
 
 }  // namespace terrapolis::terrain

@@ -13,4 +13,12 @@ GeneratedTerrain generate_flow(const GenerateRequest& request);
 /// (request.points, or random chains), folds, a river base map from the border, blended.
 GeneratedTerrain generate_tectonic(const GenerateRequest& request);
 
+/// Génévaux et al. (river_grammar.cpp): mouths on the coast (request.polygons, or a seeded island),
+/// the open grammar, Voronoi ridges, discharge and types, blended primitives carved by the rivers.
+GeneratedTerrain generate_coast(const GenerateRequest& request);
+
+/// The planar-maps chapter §6.2-6.3 (planar_basins.cpp): a binary river tree on a planar map,
+/// ridge altitudes by linear programming, fractalised facets.
+GeneratedTerrain generate_planar(const GenerateRequest& request);
+
 }  // namespace terrapolis::terrain

