@@ -12,18 +12,12 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "core/random.hpp"
 
 namespace terrapolis::roads {
 namespace {
 
 constexpr double kDeg = 180.0 / std::numbers::pi;
-
-std::uint64_t splitmix64(std::uint64_t x) {
-  x += 0x9e3779b97f4a7c15ULL;
-  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
-  return x ^ (x >> 31);
-}
 
 int sector_of(double angle_rad, int m) {
   const double w = 2 * std::numbers::pi / m;

@@ -10,6 +10,7 @@
 #include <mutex>
 
 #include "core/error.hpp"
+#include "core/random.hpp"
 
 namespace terrapolis::roads {
 namespace {
@@ -32,17 +33,6 @@ std::optional<Cell> snap_to_land(const TerrainField& t, Cell c, int radius) {
     }
   return best;
 }
-
-namespace {
-
-std::uint64_t mix(std::uint64_t x) {
-  x += 0x9e3779b97f4a7c15ULL;
-  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
-  return x ^ (x >> 31);
-}
-
-}  // namespace
 
 std::optional<Cell> cell_at(const TerrainField& terrain, double x, double y) {
   // Inverse of the affine geotransform (no CRS operation needed).
@@ -152,7 +142,7 @@ NetworkResult route_network(const TerrainField& t, const RoadGraph& graph, const
       if (const auto end = snap_to_land(t, edges[groups[g].front()].b, options.snap_cells)) shared.emplace(graph, *end);
       for (const std::size_t i : groups[g]) {
         RoutingOptions o = options;
-        o.bezier.seed = mix(options.bezier.seed ^ mix(i));
+        o.bezier.seed = splitmix64(options.bezier.seed ^ splitmix64(i));
         const Edge& e = edges[i];
         if (e.a == e.b) continue;
         out[i] = route_road(t, graph, e.a, e.b, o, nullptr, shared ? &*shared : nullptr);

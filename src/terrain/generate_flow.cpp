@@ -11,7 +11,7 @@
 #include "core/neighbours.hpp"
 #include "terrain/distance_field.hpp"
 #include "terrain/generators.hpp"
-#include "terrain/random.hpp"
+#include "core/random.hpp"
 
 namespace terrapolis::terrain {
 namespace {

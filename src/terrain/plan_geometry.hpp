@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "terrain/random.hpp"
+#include "core/random.hpp"
 
 namespace terrapolis::terrain {
 

@@ -11,6 +11,8 @@
 #include <optional>
 #include <utility>
 
+#include "core/random.hpp"
+
 namespace terrapolis::terrain {
 namespace {
 
@@ -76,11 +78,7 @@ double shape_curve(double a, double d, double d_max, double shape) {
 
 double position_noise(std::uint64_t seed, int col, int row) {
   // SplitMix64 finaliser of (seed, position): one number per cell, whatever the order of work.
-  std::uint64_t z = seed * 0x9E3779B97F4A7C15ull + (std::uint64_t(std::uint32_t(col)) << 32 | std::uint32_t(row));
-  z += 0x9E3779B97F4A7C15ull;
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-  z ^= z >> 31;
+  const std::uint64_t z = splitmix64(seed * 0x9E3779B97F4A7C15ull + (std::uint64_t(std::uint32_t(col)) << 32 | std::uint32_t(row)));
   return double(z >> 11) * (2.0 / 9007199254740992.0) - 1.0;
 }
 

@@ -5,7 +5,7 @@ source "$(dirname "$0")/lib.sh" "$@"
 cd "$WORK"
 dem=$SAMPLES/spDataLarge_srtm_zion.tif
 # Belhadj's hydrometry to a threshold it never reaches: a long run with a progress tick per iteration.
-long=(--iterations 100000000 --threshold 1e-300)
+long=(--iterations 100000 --threshold 1e-300)  # the schema's largest count
 
 # start_and_signal SIGNAL OUT CMD...: starts CMD, waits for its staging folder OUT.tmp-PID, sends
 # SIGNAL, and sets rc to the exit code.
