@@ -46,17 +46,28 @@ CostModel random_model(std::mt19937_64& rng) {
   return m;
 }
 
+/// A random problem on a 16 x 16 grid: terrain, cost model and graph, built in place (the graph
+/// holds references to the terrain and the model).
+struct RandomProblem {
+  Dem dem;
+  CostModel model;
+  TerrainField terrain;
+  RoadGraph graph;
+  explicit RandomProblem(std::mt19937_64& rng)
+      : dem(random_dem(rng, 16)),
+        model(random_model(rng)),
+        terrain(dem, 0.0, 10.0, 0.0),
+        graph(terrain, model, GraphOptions{1 + int(rng() % 3), int(std::vector<int>{1, 3, 8}[rng() % 3]), rng()}) {}
+};
+
 }  // namespace
 
 TEST(AnisotropicSearch, AStarBidirectionalAndDijkstraAgreeOnRandomProblems) {
   std::mt19937_64 rng(42);
   int found = 0;
   for (int trial = 0; trial < 80; ++trial) {
-    const Dem dem = random_dem(rng, 16);
-    const CostModel model = random_model(rng);
-    const TerrainField terrain(dem, 0.0, 10.0, 0.0);
-    const GraphOptions go{1 + int(rng() % 3), int(std::vector<int>{1, 3, 8}[rng() % 3]), rng()};
-    const RoadGraph graph(terrain, model, go);
+    const RandomProblem problem(rng);
+    const RoadGraph& graph = problem.graph;
     const Cell a{int(rng() % 16), int(rng() % 16)}, b{int(rng() % 16), int(rng() % 16)};
     const SearchResult d = shortest_path(graph, a, b, SearchMethod::dijkstra);
     const SearchResult s = shortest_path(graph, a, b, SearchMethod::astar);
@@ -89,11 +100,8 @@ TEST(AnisotropicSearch, RoadsSharingATargetSearchKeepDijkstrasCosts) {
   std::mt19937_64 rng(7);
   int found = 0;
   for (int trial = 0; trial < 30; ++trial) {
-    const Dem dem = random_dem(rng, 16);
-    const CostModel model = random_model(rng);
-    const TerrainField terrain(dem, 0.0, 10.0, 0.0);
-    const GraphOptions go{1 + int(rng() % 3), int(std::vector<int>{1, 3, 8}[rng() % 3]), rng()};
-    const RoadGraph graph(terrain, model, go);
+    const RandomProblem problem(rng);
+    const RoadGraph& graph = problem.graph;
     const Cell target{int(rng() % 16), int(rng() % 16)};
     for (SearchMethod method : {SearchMethod::astar, SearchMethod::astar_distance, SearchMethod::bidirectional, SearchMethod::dijkstra}) {
       TargetSearch shared(graph, target);
