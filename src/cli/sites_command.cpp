@@ -52,8 +52,7 @@ class SitesCommand final : public Command {
   }
 
   void run(Context& context) override {
-    // The command has always used the allometry's exact 5/6 (the scenario's default is 0.8333).
-    const pipeline::Scenario scenario = schema_.scenario({"sites.area_exponent=" + nlohmann::json(5.0 / 6.0).dump()});
+    const pipeline::Scenario scenario = schema_.scenario();
     const sites::SitesOptions options = schema_.settings([&] { return pipeline::sites_options(scenario); });
     OutputSet outputs("sites", {dir_}, overwrite_);
     const std::filesystem::path out_dir = outputs.folder(out_);
