@@ -190,7 +190,7 @@ class CalibrateCommand final : public Command {
     const Dem dem = read_dem(dem_path);
     hydro::HydroResult hydro = hydro::run_hydro(dem, pipeline::hydro_options(scenario), context.progress);
     density::DensityOptions options = pipeline::density_options(scenario);
-    pipeline::read_density_files(scenario, dem, options);
+    pipeline::read_density_files(scenario, dem, scenario.path("/water/water_mask"), options);
     options.terrain_terms = true;
     options.rivers = pipeline::river_cells(hydro.accumulation, scenario);
     const density::DensityResult model = density::compute_density(dem, hydro.hydrometry, options, context.progress);

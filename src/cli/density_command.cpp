@@ -106,7 +106,7 @@ class DensityCommand final : public Command {
     const auto t0 = clock::now();
     const plugin::PluginSet plugins = plugins_.load(context.log);
     const Dem dem = dem_.read();
-    pipeline::read_density_files(scenario, dem, options);
+    pipeline::read_density_files(scenario, dem, scenario.path("/water/water_mask"), options);
     const Hydrometry hydrometry = obtain_hydrometry(dem, options, hydrometry_path_, context.progress);
     plugin::add_to_density(plugin::density_factors(plugins, dem, context.progress, context.log), options);
     const auto t1 = clock::now();

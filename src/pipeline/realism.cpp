@@ -52,13 +52,10 @@ std::vector<std::string> settlement_warnings(const RunState& s, const sites::Sit
   return warnings;
 }
 
-json realism_figures(RunState& s, const sites::SitesResult& r, const std::string& reference, std::vector<std::string>& warnings,
-                     Progress& progress) {
-  // The terrain terms for the baselines and the land mask: the run's density options, terms on.
-  density::DensityOptions options = s.settings.density;
-  read_density_files(s.scenario, s.dem, options);
+json realism_figures(RunState& s, density::DensityOptions options, const sites::SitesResult& r, const std::string& reference,
+                     std::vector<std::string>& warnings, Progress& progress) {
+  // The terrain terms for the baselines and the land mask: the run's density inputs, terms on.
   options.terrain_terms = true;
-  if (s.rivers) options.rivers = *s.rivers;
   const density::DensityResult terms = density::compute_density(s.dem, *s.hydrometry, options, progress);
   const std::vector<std::uint8_t> land = density::land_cells(terms);
   int dropped = 0;

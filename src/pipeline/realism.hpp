@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "density/density.hpp"
 #include "pipeline/run_state.hpp"
 #include "sites/sites.hpp"
 
@@ -20,7 +21,9 @@ std::vector<std::string> settlement_warnings(const RunState& state, const sites:
 /// population-weighted AUC) and the single-factor baselines', and how many of the ten largest
 /// real places have one of the ten largest generated settlements within 10 km, against the same
 /// count for random land points. Appends warnings (skill below a baseline) to `warnings`.
-nlohmann::ordered_json realism_figures(RunState& state, const sites::SitesResult& result, const std::string& reference,
+/// `density` is the run's density inputs (the terrain terms are switched on for the baselines).
+nlohmann::ordered_json realism_figures(RunState& state, density::DensityOptions density, const sites::SitesResult& result,
+                                       const std::string& reference,
                                        std::vector<std::string>& warnings, Progress& progress);
 
 }  // namespace terrapolis::pipeline

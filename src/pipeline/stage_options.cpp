@@ -96,7 +96,7 @@ density::DensityOptions density_options(const Scenario& scenario) {
   return o;
 }
 
-void read_density_files(const Scenario& scenario, const Dem& dem, density::DensityOptions& o) {
+void read_density_files(const Scenario& scenario, const Dem& dem, const std::string& water_mask, density::DensityOptions& o) {
   const json& d = scenario.resolved["density"];
   std::vector<density::DensityOptions::Factor> layers;
   for (const auto& layer : d["layers"]) {
@@ -108,8 +108,7 @@ void read_density_files(const Scenario& scenario, const Dem& dem, density::Densi
   o.factors.insert(o.factors.begin(), std::make_move_iterator(layers.begin()), std::make_move_iterator(layers.end()));
   for (const auto& file : d["exclusions"])
     o.exclusion_masks.push_back(read_mask(scenario.file(file.get<std::string>()), dem.georef(), dem.cols(), dem.rows()));
-  if (const std::string mask = scenario.path("/water/water_mask"); !mask.empty())
-    o.water_mask = read_mask(mask, dem.georef(), dem.cols(), dem.rows());
+  if (!water_mask.empty()) o.water_mask = read_mask(water_mask, dem.georef(), dem.cols(), dem.rows());
 }
 
 std::vector<std::string> density_files(const Scenario& scenario) {

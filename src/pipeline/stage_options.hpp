@@ -29,8 +29,9 @@ hydro::D8Codes d8_codes(const Scenario& scenario);
 /// The density section, with the water section (its files are read by read_density_files).
 density::DensityOptions density_options(const Scenario& scenario);
 /// The density's files read onto the DEM's grid: density.layers as factors (ahead of any
-/// plugin's), density.exclusions as masks, water.water_mask as the water mask.
-void read_density_files(const Scenario& scenario, const Dem& dem, density::DensityOptions& options);
+/// plugin's), density.exclusions as masks, and `water_mask` (a command: water.water_mask; a run:
+/// its inland_water.tif, which holds it) as the water mask, when not empty.
+void read_density_files(const Scenario& scenario, const Dem& dem, const std::string& water_mask, density::DensityOptions& options);
 /// The files read_density_files reads (the water mask, the layers, the exclusions), as paths.
 std::vector<std::string> density_files(const Scenario& scenario);
 /// The sites section, with the scenario's seed.

@@ -139,12 +139,18 @@ void hydro_load(RunState& s) {
 
 // ---- density (Belhadj 2007 §4.2; docs/density.md) -----------------------------------------
 
-void density_run(RunState& s, Progress& progress, const Log& log) {
+/// The density model's inputs in a run: the settings, the scenario's layers and exclusions, and
+/// the hydro stage's inland water (which holds water.water_mask).
+density::DensityOptions density_inputs(const RunState& s) {
   density::DensityOptions options = s.settings.density;
-  read_density_files(s.scenario, s.dem, options);
-  options.water_mask = read_mask(saved(s, kInlandWater), s.dem.georef(), s.dem.cols(), s.dem.rows());  // holds water.water_mask too
-  plugin::add_to_density(plugin::density_factors(s.plugins, s.dem, progress, log), options);
+  read_density_files(s.scenario, s.dem, saved(s, kInlandWater), options);
   if (s.rivers) options.rivers = *s.rivers;
+  return options;
+}
+
+void density_run(RunState& s, Progress& progress, const Log& log) {
+  density::DensityOptions options = density_inputs(s);
+  plugin::add_to_density(plugin::density_factors(s.plugins, s.dem, progress, log), options);
   density::DensityResult r = density::compute_density(s.dem, *s.hydrometry, options, progress);
   const std::pair<const char*, const Raster<float>*> characteristics[] = {{"coast", &r.coast}, {"plateau", &r.plateau}, {"plain", &r.plain}};
   for (const auto& [name, raster] : characteristics)
@@ -214,7 +220,7 @@ void sites_run(RunState& s, Progress& progress, const Log& log) {
   }
   std::vector<std::string> warnings = settlement_warnings(s, r);
   const std::string reference = s.scenario.path("/sites/reference");
-  const json realism = reference.empty() ? json() : realism_figures(s, r, reference, warnings, progress);
+  const json realism = reference.empty() ? json() : realism_figures(s, density_inputs(s), r, reference, warnings, progress);
   for (const auto& w : warnings) log.warn(w);
   summary["warnings"] = warnings;
   if (!reference.empty()) s.summary["realism"] = realism;  // last: inserting moves the entries `summary` points into
