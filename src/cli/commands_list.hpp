@@ -15,6 +15,7 @@ std::unique_ptr<Command> make_compare_command();
 std::unique_ptr<Command> make_hydro_command();
 std::unique_ptr<Command> make_catchment_command();
 std::unique_ptr<Command> make_lake_command();
+std::unique_ptr<Command> make_skeleton_command();
 std::unique_ptr<Command> make_sites_command();
 std::unique_ptr<Command> make_network_command();
 std::unique_ptr<Command> make_path_command();

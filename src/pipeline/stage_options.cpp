@@ -154,6 +154,17 @@ Raster<std::uint8_t> river_cells(const Raster<double>& accumulation_m2, const Sc
   return rivers;
 }
 
+skeleton::SkeletonOptions skeleton_options(const Scenario& scenario) {
+  const json& k = scenario.resolved["skeleton"];
+  skeleton::SkeletonOptions o;
+  const std::string lines = k["lines"].get<std::string>();
+  o.lines = lines == "ridges" ? skeleton::Lines::ridges : lines == "valleys" ? skeleton::Lines::valleys : skeleton::Lines::both;
+  o.tolerance = k["tolerance"].get<double>();
+  o.seed_share = k["seed_share"].get<double>();
+  o.min_cells = k["min_cells"].get<int>();
+  return o;
+}
+
 network::NetworkOptions network_options(const Scenario& scenario) {
   network::NetworkOptions o;
   o.k = scenario.resolved["network"]["k"].get<double>();

@@ -15,6 +15,7 @@
 #include "hydro/flat_water.hpp"
 #include "roads/road_network.hpp"
 #include "sites/sites.hpp"
+#include "skeleton/ridges_valleys.hpp"
 
 namespace terrapolis::pipeline {
 
@@ -24,6 +25,8 @@ hydro::HydroOptions hydro_options(const Scenario& scenario);
 std::optional<hydro::RiverTypeOptions> river_type_options(const Scenario& scenario);
 /// The water section's reservoirs (docs/lakes.md), in the scenario's order.
 std::vector<lake::LakeSpec> reservoir_specs(const Scenario& scenario);
+/// The skeleton section (terrapolis skeleton, docs/skeleton.md).
+skeleton::SkeletonOptions skeleton_options(const Scenario& scenario);
 /// Code convention of flowdir.tif.
 hydro::D8Codes d8_codes(const Scenario& scenario);
 /// The density section, with the water section (its files are read by read_density_files).
