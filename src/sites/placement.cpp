@@ -160,7 +160,9 @@ SitesResult place_sites(const Raster<float>& density, const Raster<std::uint8_t>
     result.population_assumed = !(options.population > 0);
     result.land_area_km2 = land_km2;
     result.target_population = result.population_assumed ? std::round(options.people_per_km2 * land_km2) : options.population;
-    table = rank_size_quotas(cell_size, rank_size_populations(result.target_population, options.zipf_exponent, options.min_population),
+    table = rank_size_quotas(cell_size,
+                             rank_size_populations(result.target_population, options.zipf_exponent, options.min_population,
+                                                   settleable_count(land_km2, options)),
                              options);
     if (options.refill_rounds < 0 || options.candidates < 0) throw bad_input("sites: candidates and refill rounds must be >= 0");
     if (options.r_min_m > 0 || options.r_max_m > 0)
