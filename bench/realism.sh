@@ -2,11 +2,11 @@
 # Realism of the settlements against real places (GeoNames, CC BY 4.0) on every shared region with
 # places: the density's skill after calibration on the other regions (leave one region out), the
 # counts, largest and rank-size exponent with sites.population set to the reference total (the
-# default, settlements at most land / hexagon(sites.spacing_km), and the rank-size law alone,
-# spacing_km = 0, in the same run), the ten largest real places near a generated top-10 settlement
+# default: settlements at most land / hexagon(sites.spacing_km)), the ten largest real places near a generated top-10 settlement
 # against random land points, and the default run's total on the bundled DEM. Prints one table
 # (docs/benchmarks.md, "Settlements").
-# Usage: bench/realism.sh [TERRAPOLIS] [DEMS_DIR] [PLACES_DIR] [KEEP_DIR]  (KEEP_DIR: keep the runs there)
+# Usage: bench/realism.sh [TERRAPOLIS] [DEMS_DIR] [PLACES_DIR] [KEEP_DIR]  (KEEP_DIR: keep the runs there;
+# REALISM_SET=sites.spacing_km=0: one more --set for the region runs, e.g. the rank-size law alone)
 set -euo pipefail
 TP=$(realpath "${1:-build/src/cli/terrapolis}")
 DEMS=$(realpath "${2:-../shared/dems}")
@@ -52,10 +52,7 @@ PY
 )
   sets=(--set dem="\"$DEMS/$f\"" --set sites.population="$total" --set sites.reference="\"$PLACES/$name.geojson\""
         --set density.weights="$weights")
-  "$TP" --quiet run "$scen" -o "run_$name" --until sites "${sets[@]}"
-  # The law alone on the same density: only the sites stage again.
-  cp -r "run_$name" "law_$name"
-  "$TP" --quiet run "$scen" -o "law_$name" --only sites "${sets[@]}" --set sites.spacing_km=0
+  "$TP" --quiet run "$scen" -o "run_$name" --until sites "${sets[@]}" ${REALISM_SET:+--set "$REALISM_SET"}
 done
 # The default run on the bundled DEM: no population given.
 "$TP" --quiet run -o run_default --until sites --set dem="\"$SRC/sample_dems/gebco2022_15s_north_corsica_capcorse.asc\"" \
@@ -64,10 +61,9 @@ done
 /usr/bin/python3 - calibration.json "${regions[@]}" <<'PY'
 import json, sys
 cal = {r["region"]: r for r in json.load(open(sys.argv[1]))["regions"]}
-print("| region | places | AUC held out (weighted) | best baseline | AUC in-region | thesis AUC | count gen/ref (law alone) | largest gen/ref (law alone) | q gen / ref (law alone) | top-10 within 10 km (random) |")
+print("| region | places | AUC held out (weighted) | best baseline | AUC in-region | thesis AUC | count gen/ref | largest gen/ref | q gen / ref | top-10 within 10 km (random) |")
 print("|---|---|---|---|---|---|---|---|---|---|")
 ok = {"count": 0, "largest": 0, "q": 0, "auc": 0}
-law = {"count": 0, "largest": 0, "q": 0}
 
 
 def bars(m, tally):
@@ -85,20 +81,18 @@ for f in sys.argv[2:]:
     name = f.rsplit(".", 1)[0]
     c = cal[name]
     m = json.load(open(f"run_{name}/run.json"))["summary"]["realism"]
-    a = json.load(open(f"law_{name}/run.json"))["summary"]["realism"]
     base = max(v["auc"] for v in c["baselines"].values())
     best = max(c["baselines"], key=lambda k: c["baselines"][k]["auc"])
     held = c["held_out_region"]
     qg, qr = bars(m, ok)
-    qa, _ = bars(a, law)
     ok["auc"] += held["auc"] >= 0.75 and held["auc"] > base
     print(f"| {name} | {c['places']} | {held['auc']:.3f} ({held['weighted_auc']:.3f}) | {base:.3f} ({best}) | {c['fitted_in_sample']['auc']:.3f} "
-          f"| {c['belhadj2007']['auc']:.3f} | {m['count']['generated']}/{m['count']['reference']} ({a['count']['generated']}) "
-          f"| {m['largest']['generated']:.0f}/{m['largest']['reference']:.0f} ({a['largest']['generated']:.0f}) "
-          f"| {qg} / {qr} ({qa}) | {m['top10']['within_10km']} ({m['top10']['random_within_10km']:.1f}) |")
+          f"| {c['belhadj2007']['auc']:.3f} | {m['count']['generated']}/{m['count']['reference']} "
+          f"| {m['largest']['generated']:.0f}/{m['largest']['reference']:.0f} "
+          f"| {qg} / {qr} | {m['top10']['within_10km']} ({m['top10']['random_within_10km']:.1f}) |")
 n = len(sys.argv) - 2
-print(f"\nregions meeting each bar (of {n}): count within x1.5 {ok['count']} (law alone {law['count']}), largest within x2 {ok['largest']} "
-      f"({law['largest']}), rank-size exponent within 0.25 {ok['q']} ({law['q']}), held-out AUC >= 0.75 and above the best baseline {ok['auc']}")
+print(f"\nregions meeting each bar (of {n}): count within x1.5 {ok['count']}, largest within x2 {ok['largest']}, "
+      f"rank-size exponent within 0.25 {ok['q']}, held-out AUC >= 0.75 and above the best baseline {ok['auc']}")
 d = json.load(open("run_default/run.json"))["summary"]
 r = d["realism"]
 print(f"default run on the bundled DEM: {d['sites']['target_population']:.0f} people ({d['sites']['population_source']}); "

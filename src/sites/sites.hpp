@@ -119,6 +119,8 @@ struct SitesResult {
   double target_population = 0;     ///< rank_size: the region's people the law was fitted to
   double land_area_km2 = 0;         ///< rank_size: the land area used for the default population
   bool population_assumed = false;  ///< rank_size: target from people_per_km2 (no census figure given)
+  std::int64_t room = 0;            ///< rank_size: settlements the land holds at spacing_km (settleable_count); 0: no limit
+  bool count_limited = false;       ///< rank_size: the law would have made more settlements than `room`
 };
 
 /// f(x) of Belhadj eq. 4.1: urban units of x people. For x >= x_max the base is clamped at 0

@@ -134,6 +134,8 @@ TEST(RankSize, SpacingLimitsTheCountOnCrowdedLand) {
       int quota = 0;
       for (const auto& q : r.quotas) quota += q.quota;
       EXPECT_EQ(quota, 9) << people;
+      EXPECT_EQ(r.room, 9);
+      EXPECT_TRUE(r.count_limited);
       if (people > 1e6) continue;  // a city of 700,000 on 400 km2 leaves no room for all the others
       ASSERT_EQ(r.sites.size(), 9u);
       std::int64_t sum = 0;
@@ -143,6 +145,9 @@ TEST(RankSize, SpacingLimitsTheCountOnCrowdedLand) {
   o.population = 24000;
   const SitesResult few = place_sites(coarse.density, coarse.buildable, o, progress);
   EXPECT_EQ(few.sites.size(), 8u);
+  EXPECT_FALSE(few.count_limited);
+  o.spacing_km = 0;
+  EXPECT_EQ(place_sites(coarse.density, coarse.buildable, o, progress).room, 0);  // no limit
 }
 
 // 1000 people at 100 per km2, factor 1: 10 km2, a disc of sqrt(10e6 / pi) = 1784.12 m.
