@@ -1,11 +1,13 @@
 #!/usr/bin/python3
-"""Which size law predicts a region's settlements from its population alone? For every shared
+"""Which size law predicts a region's settlements from its population (and land)? For every shared
 region with GeoNames places (CC BY 4.0), the total P of its places of 1,000 or more is given to each
 candidate law, which predicts the count of 1,000+ settlements and the largest; a law fitted across
 regions is fitted on the other regions only (leave one region out). Prints the count of regions
 within x1.5 of the real count and x2 of the real largest (the bars of bench/realism.sh).
-With DEMS_DIR, also the region's people per km2 of land (cells above 0 m) against the default
-sites.people_per_km2 = 60 and against the median of the other regions.
+With DEMS_DIR, also the laws that use the land area (cells above 0 m): Zipf with the count held to
+the hexagons of sites.spacing_km the land holds (Christaller's 7 km, and 6 and 8 km around it), and
+the region's people per km2 of land against the default sites.people_per_km2 = 60 and against the
+median of the other regions.
 Usage: bench/rank_size_laws.py [PLACES_DIR [DEMS_DIR]]"""
 import json
 import math
@@ -25,13 +27,33 @@ for r in REGIONS:
     ref[r] = (sum(sizes), len(sizes), sizes[0])
 
 
-def zipf_from_total(total, q):
-    """The rank-size law of sites.zipf_exponent q fitted to the total (rank_size_populations)."""
+def zipf_from_total(total, q, max_count=math.inf):
+    """The rank-size law of sites.zipf_exponent q fitted to the total, at most max_count ranks (rank_size_populations)."""
     h, n = 0.0, 0
-    while total * (n + 1) ** -q / (h + (n + 1) ** -q) >= MIN:
+    while n < max_count and total * (n + 1) ** -q / (h + (n + 1) ** -q) >= MIN:
         h += (n + 1) ** -q
         n += 1
     return n, total / h if n else 0
+
+
+def land_km2(path):
+    """km2 of cells above 0 m with data (cell areas from the latitude on geographic grids)."""
+    from osgeo import gdal, osr
+    ds = gdal.Open(path)
+    band, t = ds.GetRasterBand(1), ds.GetGeoTransform()
+    z, nodata = band.ReadAsArray().astype(float), band.GetNoDataValue()
+    geographic = osr.SpatialReference(wkt=ds.GetProjection()).IsGeographic()
+    km2 = 0.0
+    for row in range(ds.RasterYSize):
+        lat = t[3] + t[5] * (row + 0.5)
+        cell = abs(t[1] * t[5]) * (111320 * math.cos(math.radians(lat)) * 110574 if geographic else 1) / 1e6
+        km2 += cell * sum(1 for v in z[row] if v == v and v != nodata and v > 0)
+    return km2
+
+
+def hexagons(km2, spacing_km):
+    """Settlements of MIN people the land holds spacing_km apart on a hexagonal lattice (sites::settleable_count)."""
+    return max(1, math.floor(km2 / (math.sqrt(3) / 2 * spacing_km ** 2 * MIN / 1000) + 1e-9))
 
 
 def zipf_from_largest(total, largest):
@@ -57,6 +79,13 @@ def loglog_fit(held_out, y):
 
 laws = {f"zipf q={q}": (lambda r, q=q: zipf_from_total(ref[r][0], q)) for q in (0.8, 0.9, 1.0, 1.1, 1.2)}
 laws["largest = a P^b (held out), q from the total"] = lambda r: zipf_from_largest(ref[r][0], loglog_fit(r, lambda s: ref[s][2])(ref[r][0]))
+files = {"N47E009": "N47E009.hgt", "N57E011": "N57E011.hgt", "gebco2022_15s_la_palma": "gebco2022_15s_la_palma.asc",
+         "gebco2022_15s_north_corsica_capcorse": "gebco2022_15s_north_corsica_capcorse.asc",
+         "gebco2022_15s_tenerife_east": "gebco2022_15s_tenerife_east.asc"}
+land = {r: land_km2(f"{sys.argv[2]}/{files.get(r, r + '.tif')}") for r in REGIONS} if len(sys.argv) > 2 else {}
+for spacing in (6, 7, 8) if land else ():
+    laws[f"zipf q=1, at most land / hexagon({spacing} km)" + (" (the default)" if spacing == 7 else "")] = (
+        lambda r, spacing=spacing: zipf_from_total(ref[r][0], 1.0, hexagons(land[r], spacing)))
 print("| law | count within x1.5 | largest within x2 |")
 print("|---|---|---|")
 for name, law in laws.items():
@@ -72,23 +101,8 @@ for r in REGIONS:
     total, n, p1 = ref[r]
     print(f"| {r} | {total} | {n} | {p1} | {p1 / (MIN * n):.2f} |")
 
-if len(sys.argv) > 2:
-    from osgeo import gdal, osr
-    files = {"N47E009": "N47E009.hgt", "N57E011": "N57E011.hgt", "gebco2022_15s_la_palma": "gebco2022_15s_la_palma.asc",
-             "gebco2022_15s_north_corsica_capcorse": "gebco2022_15s_north_corsica_capcorse.asc",
-             "gebco2022_15s_tenerife_east": "gebco2022_15s_tenerife_east.asc"}
-    density = {}
-    for r in REGIONS:
-        ds = gdal.Open(f"{sys.argv[2]}/{files.get(r, r + '.tif')}")
-        band, t = ds.GetRasterBand(1), ds.GetGeoTransform()
-        z, nodata = band.ReadAsArray().astype(float), band.GetNoDataValue()
-        geographic = osr.SpatialReference(wkt=ds.GetProjection()).IsGeographic()
-        km2 = 0.0
-        for row in range(ds.RasterYSize):
-            lat = t[3] + t[5] * (row + 0.5)
-            cell = abs(t[1] * t[5]) * (111320 * math.cos(math.radians(lat)) * 110574 if geographic else 1) / 1e6
-            km2 += cell * sum(1 for v in z[row] if v == v and v != nodata and v > 0)
-        density[r] = ref[r][0] / km2
+if land:
+    density = {r: ref[r][0] / land[r] for r in REGIONS}
     print("\n| region | people per km2 of land | x of 60 | x of the others' median |")
     print("|---|---|---|---|")
     within = {"60": 0, "median": 0}

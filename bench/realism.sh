@@ -1,17 +1,24 @@
 #!/usr/bin/env bash
 # Realism of the settlements against real places (GeoNames, CC BY 4.0) on every shared region with
 # places: the density's skill after calibration on the other regions (leave one region out), the
-# counts, largest and rank-size exponent with sites.population set to the reference total, the ten
-# largest real places near a generated top-10 settlement against random land points, and the
-# default run's total on the bundled DEM. Prints one table (docs/benchmarks.md, "Settlements").
-# Usage: bench/realism.sh [TERRAPOLIS] [DEMS_DIR] [PLACES_DIR]
+# counts, largest and rank-size exponent with sites.population set to the reference total (the
+# default: settlements at most land / hexagon(sites.spacing_km)), the ten largest real places near a generated top-10 settlement
+# against random land points, and the default run's total on the bundled DEM. Prints one table
+# (docs/benchmarks.md, "Settlements").
+# Usage: bench/realism.sh [TERRAPOLIS] [DEMS_DIR] [PLACES_DIR] [KEEP_DIR]  (KEEP_DIR: keep the runs there;
+# REALISM_SET=sites.spacing_km=0: one more --set for the region runs, e.g. the rank-size law alone)
 set -euo pipefail
 TP=$(realpath "${1:-build/src/cli/terrapolis}")
 DEMS=$(realpath "${2:-../shared/dems}")
 PLACES=$(realpath "${3:-../shared/reference/geonames}")
 SRC=$(cd "$(dirname "$0")/.." && pwd)
-OUT=$(mktemp -d)
-trap 'rm -rf "$OUT"' EXIT
+if [[ -n ${4:-} ]]; then
+  mkdir "$4"  # refuses an existing folder: never mixes runs
+  OUT=$(realpath "$4")
+else
+  OUT=$(mktemp -d)
+  trap 'rm -rf "$OUT"' EXIT
+fi
 cd "$OUT"
 
 # The regions with 10 or more places on their land; NZ's sea is nodata (NaN).
@@ -43,8 +50,9 @@ r = next(x for x in json.load(open(sys.argv[1]))["regions"] if x["region"] == sy
 print(int(r["settlements"]["total"]), json.dumps(r["held_out_weights"], separators=(",", ":")))
 PY
 )
-  "$TP" --quiet run "$scen" -o "run_$name" --until sites --set dem="\"$DEMS/$f\"" --set sites.population="$total" \
-    --set sites.reference="\"$PLACES/$name.geojson\"" --set density.weights="$weights"
+  sets=(--set dem="\"$DEMS/$f\"" --set sites.population="$total" --set sites.reference="\"$PLACES/$name.geojson\""
+        --set density.weights="$weights")
+  "$TP" --quiet run "$scen" -o "run_$name" --until sites "${sets[@]}" ${REALISM_SET:+--set "$REALISM_SET"}
 done
 # The default run on the bundled DEM: no population given.
 "$TP" --quiet run -o run_default --until sites --set dem="\"$SRC/sample_dems/gebco2022_15s_north_corsica_capcorse.asc\"" \
@@ -56,6 +64,19 @@ cal = {r["region"]: r for r in json.load(open(sys.argv[1]))["regions"]}
 print("| region | places | AUC held out (weighted) | best baseline | AUC in-region | thesis AUC | count gen/ref | largest gen/ref | q gen / ref | top-10 within 10 km (random) |")
 print("|---|---|---|---|---|---|---|---|---|---|")
 ok = {"count": 0, "largest": 0, "q": 0, "auc": 0}
+
+
+def bars(m, tally):
+    """Counts the bars `m` meets into `tally`; returns its count, largest and q ratios for the table."""
+    cr = m["count"]["generated"] / max(1, m["count"]["reference"])
+    lr = m["largest"]["generated"] / max(1, m["largest"]["reference"])
+    qg, qr = m["rank_size_exponent"]["generated"], m["rank_size_exponent"]["reference"]
+    tally["count"] += 1 / 1.5 <= cr <= 1.5
+    tally["largest"] += 0.5 <= lr <= 2
+    tally["q"] += qg is not None and qr is not None and abs(qg - qr) <= 0.25
+    return qg if qg is None else round(qg, 2), qr if qr is None else round(qr, 2)
+
+
 for f in sys.argv[2:]:
     name = f.rsplit(".", 1)[0]
     c = cal[name]
@@ -63,22 +84,19 @@ for f in sys.argv[2:]:
     base = max(v["auc"] for v in c["baselines"].values())
     best = max(c["baselines"], key=lambda k: c["baselines"][k]["auc"])
     held = c["held_out_region"]
-    cr = m["count"]["generated"] / max(1, m["count"]["reference"])
-    lr = m["largest"]["generated"] / max(1, m["largest"]["reference"])
-    qg, qr = m["rank_size_exponent"]["generated"], m["rank_size_exponent"]["reference"]
-    ok["count"] += 1 / 1.5 <= cr <= 1.5
-    ok["largest"] += 0.5 <= lr <= 2
-    ok["q"] += qg is not None and qr is not None and abs(qg - qr) <= 0.25
+    qg, qr = bars(m, ok)
     ok["auc"] += held["auc"] >= 0.75 and held["auc"] > base
     print(f"| {name} | {c['places']} | {held['auc']:.3f} ({held['weighted_auc']:.3f}) | {base:.3f} ({best}) | {c['fitted_in_sample']['auc']:.3f} "
-          f"| {c['belhadj2007']['auc']:.3f} | {m['count']['generated']}/{m['count']['reference']} | {m['largest']['generated']:.0f}/{m['largest']['reference']:.0f} "
-          f"| {qg if qg is None else round(qg, 2)} / {qr if qr is None else round(qr, 2)} | {m['top10']['within_10km']} ({m['top10']['random_within_10km']:.1f}) |")
+          f"| {c['belhadj2007']['auc']:.3f} | {m['count']['generated']}/{m['count']['reference']} "
+          f"| {m['largest']['generated']:.0f}/{m['largest']['reference']:.0f} "
+          f"| {qg} / {qr} | {m['top10']['within_10km']} ({m['top10']['random_within_10km']:.1f}) |")
 n = len(sys.argv) - 2
 print(f"\nregions meeting each bar (of {n}): count within x1.5 {ok['count']}, largest within x2 {ok['largest']}, "
       f"rank-size exponent within 0.25 {ok['q']}, held-out AUC >= 0.75 and above the best baseline {ok['auc']}")
 d = json.load(open("run_default/run.json"))["summary"]
 r = d["realism"]
 print(f"default run on the bundled DEM: {d['sites']['target_population']:.0f} people ({d['sites']['population_source']}); "
-      f"reference {r['total']['reference']:.0f}: ratio {r['total']['ratio']}")
+      f"reference {r['total']['reference']:.0f}: ratio {r['total']['ratio']}; {r['count']['generated']} settlements of 1,000+ for "
+      f"{r['count']['reference']}, largest {r['largest']['generated']:.0f} for {r['largest']['reference']:.0f}")
 print("fitted weights (all regions):", json.dumps(json.load(open("fitted.json"))["density"]["weights"]))
 PY

@@ -86,6 +86,9 @@ class SitesCommand final : public Command {
     if (options.quotas == sites::SitesOptions::Quotas::rank_size)
       std::printf("sites: %.0f people (%s), rank-size law down to %.0f\n", result.target_population,
                   result.population_assumed ? "assumed: default people/km2 x buildable land" : "given", options.min_population);
+    if (result.count_limited)
+      std::printf("sites: count held to the %lld settlements the land holds %g km apart (--spacing)\n", static_cast<long long>(result.room),
+                  options.spacing_km);
     std::printf("sites: %zu cities (%d roots, %zu suburbs) from %d candidates, dr %.0f m, seed %llu\n", result.sites.size(), roots,
                 result.sites.size() - std::size_t(roots), result.candidates, result.dr_m, static_cast<unsigned long long>(result.seed));
   }

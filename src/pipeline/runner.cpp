@@ -243,6 +243,8 @@ std::string format_summary(const json& manifest) {
     if (c.contains("population_source"))
       line("           %.0f people in the region, %s; largest %.0f\n", c["target_population"].get<double>(),
            c["population_source"].get<std::string>().c_str(), c["largest"].get<double>());
+    if (c.value("count_limited_by_spacing", false))
+      line("           count held to the %lld settlements the land holds at sites.spacing_km\n", c["room"].get<long long>());
     for (const auto& [k, v] : c["per_class"].items())
       line("           class %s (radius %.0f m): %d\n", k.c_str(), v["radius_m"].get<double>(), v["cities"].get<int>());
     if (c.contains("warnings"))

@@ -160,8 +160,16 @@ SitesResult place_sites(const Raster<float>& density, const Raster<std::uint8_t>
     result.population_assumed = !(options.population > 0);
     result.land_area_km2 = land_km2;
     result.target_population = result.population_assumed ? std::round(options.people_per_km2 * land_km2) : options.population;
-    table = rank_size_quotas(cell_size, rank_size_populations(result.target_population, options.zipf_exponent, options.min_population),
-                             options);
+    const auto law = [&](std::size_t max_count) {
+      return rank_size_populations(result.target_population, options.zipf_exponent, options.min_population, max_count);
+    };
+    const std::size_t room = settleable_count(land_km2, options);
+    const auto sizes = law(room);
+    if (room != std::numeric_limits<std::size_t>::max()) {
+      result.room = std::int64_t(room);
+      result.count_limited = sizes.size() == room && law(room + 1).size() > room;
+    }
+    table = rank_size_quotas(cell_size, sizes, options);
     if (options.refill_rounds < 0 || options.candidates < 0) throw bad_input("sites: candidates and refill rounds must be >= 0");
     if (options.r_min_m > 0 || options.r_max_m > 0)
       throw bad_input("sites: r_min and r_max set the classes of the belhadj2007 quotas; with rank_size the radii come from the populations");

@@ -2,6 +2,7 @@
 // SPDX-License-Identifier: MIT
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <string>
 
@@ -10,7 +11,7 @@
 
 namespace terrapolis::sites {
 
-std::vector<std::int64_t> rank_size_populations(double total, double q, double min_population) {
+std::vector<std::int64_t> rank_size_populations(double total, double q, double min_population, std::size_t max_count) {
   if (!(std::isfinite(total) && total >= 0)) throw bad_input("sites: population must be a number of people >= 0");
   if (!(std::isfinite(q) && q > 0)) throw bad_input("sites: zipf_exponent must be positive");
   if (!(std::isfinite(min_population) && min_population >= 1)) throw bad_input("sites: min_population must be at least 1 person");
@@ -19,7 +20,7 @@ std::vector<std::int64_t> rank_size_populations(double total, double q, double m
   // count is the last N with g(N) >= min_population.
   double harmonic = 0;
   std::size_t count = 0;
-  for (std::size_t n = 1;; ++n) {
+  for (std::size_t n = 1; n <= max_count; ++n) {
     const double h = harmonic + std::pow(double(n), -q);
     if (total * std::pow(double(n), -q) / h < min_population) break;
     harmonic = h;
@@ -45,6 +46,15 @@ std::vector<std::int64_t> rank_size_populations(double total, double q, double m
   // Equal shares can leave a later rank one person above an earlier one: keep the order.
   std::sort(sizes.begin(), sizes.end(), std::greater<>());
   return sizes;
+}
+
+std::size_t settleable_count(double land_area_km2, const SitesOptions& o) {
+  if (!(std::isfinite(o.spacing_km) && o.spacing_km >= 0)) throw bad_input("sites: spacing_km must be >= 0 (0: no limit)");
+  if (o.spacing_km == 0) return std::numeric_limits<std::size_t>::max();
+  // One hexagon of side-to-side width `spacing` per settlement of 1,000 people; a floor of
+  // m people is reached by 1000 / m times fewer of them (q = 1), so the lattice widens as sqrt(m / 1000).
+  const double hexagon_km2 = std::sqrt(3.0) / 2 * o.spacing_km * o.spacing_km * (o.min_population / 1000.0);
+  return std::size_t(std::max(1.0, std::floor(land_area_km2 / hexagon_km2 + 1e-9)));
 }
 
 double urban_radius_m(double people, const SitesOptions& o) {

@@ -2,6 +2,7 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "core/geodesy.hpp"
@@ -42,6 +43,12 @@ struct SitesOptions {
   double zipf_exponent = 1;
   /// The smallest settlement, people: the law stops at the last rank still this large.
   double min_population = 1000;
+  /// Central places of min_population people lie at least this far apart, km, on a hexagonal
+  /// lattice (Christaller 1933: the Marktorte, the smallest central places, of about 1,000 people,
+  /// 7 km apart): the land holds at most land / (sqrt(3)/2 spacing^2 x min_population / 1000) of
+  /// them, and a population the law would split into more is split over that many (the smallest
+  /// then above min_population). 0: no limit, the count follows the law alone.
+  double spacing_km = 7;
   /// b of the urban-area allometry A = A_0 (P / 1000)^b: built-up area grows slower than
   /// population (Bettencourt 2013, Science 340: b between 2/3 and 5/6).
   double area_exponent = 5.0 / 6.0;
@@ -112,6 +119,8 @@ struct SitesResult {
   double target_population = 0;     ///< rank_size: the region's people the law was fitted to
   double land_area_km2 = 0;         ///< rank_size: the land area used for the default population
   bool population_assumed = false;  ///< rank_size: target from people_per_km2 (no census figure given)
+  std::int64_t room = 0;            ///< rank_size: settlements the land holds at spacing_km (settleable_count); 0: no limit
+  bool count_limited = false;       ///< rank_size: the law would have made more settlements than `room`
 };
 
 /// f(x) of Belhadj eq. 4.1: urban units of x people. For x >= x_max the base is clamped at 0
@@ -128,9 +137,14 @@ QuotaTable compute_quotas(double cell_size_m, const SitesOptions& options);
 
 /// The rank-size law fitted to `total` people: P_k = total k^-q / H_N(q), H_N(q) = sum_{k<=N} k^-q,
 /// with N the largest count whose smallest settlement P_N still reaches min_population (none when
-/// total < min_population). Rounded to whole people by largest remainders: the sizes add up to
-/// round(total) exactly. Largest first.
-std::vector<std::int64_t> rank_size_populations(double total, double zipf_exponent, double min_population);
+/// total < min_population), and at most `max_count`. Rounded to whole people by largest
+/// remainders: the sizes add up to round(total) exactly. Largest first.
+std::vector<std::int64_t> rank_size_populations(double total, double zipf_exponent, double min_population,
+                                                std::size_t max_count = std::numeric_limits<std::size_t>::max());
+
+/// The most settlements of min_population people `land_area_km2` holds at options.spacing_km
+/// apart on a hexagonal lattice (at least 1; unlimited when spacing_km is 0).
+std::size_t settleable_count(double land_area_km2, const SitesOptions& options);
 
 /// q of the rank-size law fitted to `sizes` by least squares on ln P_k = c - q ln(k - 1/2)
 /// (the rank shifted by 1/2 against the small-sample bias, Gabaix & Ibragimov 2011); NaN for

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 #include "core/error.hpp"
@@ -37,6 +38,26 @@ TEST(RankSize, TotalsSumToTheTarget) {
     }
 }
 
+// 100,000 people at most 5 settlements (the law alone gives 25: 100000 / (25 H_25) = 1048): P_k = 100000 / (k H_5),
+// H_5 = 137/60: 43795.62, 21897.81, 14598.54, 10948.91, 8759.12; the floors add up to 99,997 and
+// the three largest fractions (.91, .81, .62) get one person each.
+TEST(RankSize, CountLimitedBySpacing) {
+  EXPECT_EQ(rank_size_populations(100000, 1.0, 1000).size(), 25u);
+  EXPECT_EQ(rank_size_populations(100000, 1.0, 1000, 5), (std::vector<std::int64_t>{43796, 21898, 14598, 10949, 8759}));
+  EXPECT_EQ(rank_size_populations(100000, 1.0, 1000, 30).size(), 25u);  // a limit above the law's count changes nothing
+  // Hexagons of sqrt(3)/2 x 7^2 = 42.435 km2: 1000 km2 hold 23 of them (23.57); with a floor of
+  // 4000 people, 4 x 42.435 km2 each: 5 (5.89); at least one; spacing 0: no limit.
+  SitesOptions o;
+  EXPECT_EQ(settleable_count(1000, o), 23u);
+  EXPECT_EQ(settleable_count(10, o), 1u);
+  o.min_population = 4000;
+  EXPECT_EQ(settleable_count(1000, o), 5u);
+  o.spacing_km = 0;
+  EXPECT_EQ(settleable_count(1000, o), std::numeric_limits<std::size_t>::max());
+  o.spacing_km = -1;
+  EXPECT_THROW(settleable_count(1000, o), Error);
+}
+
 TEST(RankSize, ExponentOfAPerfectLaw) {
   std::vector<double> sizes;
   for (int k = 1; k <= 300; ++k) sizes.push_back(1e6 * std::pow(k, -1.2));
@@ -67,11 +88,13 @@ TEST(RankSize, ClassesCoverTheRadii) {
   EXPECT_EQ(t.total(), 3);
 }
 
-// Same land (400 km2), cells of 100 m or 50 m: the same settlements. Ten times the people: more of them.
+// Same land (400 km2), cells of 100 m or 50 m: the same settlements. Ten times the people: more of
+// them (the law alone: no spacing limit, which would hold 400 km2 to 9).
 TEST(RankSize, CountsFollowThePopulationNotTheGrid) {
   SilentProgress progress;
   SitesOptions o;
   o.population = 200000;
+  o.spacing_km = 0;
   const auto coarse = fixtures::flat_scenario(200, 200, 100.0), fine = fixtures::flat_scenario(400, 400, 50.0);
   const SitesResult a = place_sites(coarse.density, coarse.buildable, o, progress);
   const SitesResult b = place_sites(fine.density, fine.buildable, o, progress);
@@ -95,6 +118,36 @@ TEST(RankSize, CountsFollowThePopulationNotTheGrid) {
   EXPECT_TRUE(d.population_assumed);
   EXPECT_NEAR(d.land_area_km2, 400.0, 1e-6);
   EXPECT_EQ(d.target_population, 24000.0);
+}
+
+// The default spacing (7 km): 400 km2 hold 9 settlements (400 / 42.435 = 9.43), however many
+// people, on either grid; the sizes still add up to the population. 24,000 people: the law's own
+// count, 8 (24000 / (8 H_8) = 1104 >= 1000 > 24000 / (9 H_9) = 943), is below the limit and stays.
+TEST(RankSize, SpacingLimitsTheCountOnCrowdedLand) {
+  SilentProgress progress;
+  SitesOptions o;
+  const auto coarse = fixtures::flat_scenario(200, 200, 100.0), fine = fixtures::flat_scenario(400, 400, 50.0);
+  for (double people : {200000.0, 2000000.0})
+    for (const auto* g : {&coarse, &fine}) {
+      o.population = people;
+      const SitesResult r = place_sites(g->density, g->buildable, o, progress);
+      int quota = 0;
+      for (const auto& q : r.quotas) quota += q.quota;
+      EXPECT_EQ(quota, 9) << people;
+      EXPECT_EQ(r.room, 9);
+      EXPECT_TRUE(r.count_limited);
+      if (people > 1e6) continue;  // a city of 700,000 on 400 km2 leaves no room for all the others
+      ASSERT_EQ(r.sites.size(), 9u);
+      std::int64_t sum = 0;
+      for (const auto& s : r.sites) sum += s.population;
+      EXPECT_EQ(sum, std::int64_t(people));
+    }
+  o.population = 24000;
+  const SitesResult few = place_sites(coarse.density, coarse.buildable, o, progress);
+  EXPECT_EQ(few.sites.size(), 8u);
+  EXPECT_FALSE(few.count_limited);
+  o.spacing_km = 0;
+  EXPECT_EQ(place_sites(coarse.density, coarse.buildable, o, progress).room, 0);  // no limit
 }
 
 // 1000 people at 100 per km2, factor 1: 10 km2, a disc of sqrt(10e6 / pi) = 1784.12 m.
@@ -133,6 +186,7 @@ TEST(Suburbs, PlacementLinksSmallerSettlements) {
   SilentProgress progress;
   SitesOptions o;
   o.population = 200000;
+  o.spacing_km = 0;  // the law's 45 settlements on 400 km2
   const auto flat = fixtures::flat_scenario(200, 200, 100.0);
   const auto suburbs = [&](const SitesResult& r) {
     int n = 0;
