@@ -616,6 +616,11 @@ class RelaxedDistance {
       }
       if (f.points.empty()) table.assign(kSteps + 1, 0.0);
     }
+    ring_offset_.assign(graph.rings().size(), 0.0);
+    for (std::size_t r = 0; r < graph.rings().size(); ++r) {
+      const int st = int(graph.rings()[r].structure);
+      ring_offset_[r] = 0.75 * ring_margin(st) * graph.rings()[r].min_length_m;
+    }
     relax(t_.index(target.col, target.row), 0.0);
   }
   ~RelaxedDistance() {
@@ -653,7 +658,7 @@ class RelaxedDistance {
     source_ = source;
     for (Entry& e : heap_) {
       const Cell c{int(e.cell % std::size_t(t_.cols())), int(e.cell / std::size_t(t_.cols()))};
-      e.f = e.g + graph_.lower_bound(c, source_);
+      e.f = e.g + graph_.lower_bound(c, source_) + (e.ring >= 0 ? ring_offset_[std::size_t(e.ring)] : 0.0);
     }
     std::make_heap(heap_.begin(), heap_.end());
   }
@@ -662,7 +667,11 @@ class RelaxedDistance {
   struct Entry {
     double f, g;
     std::size_t cell;
-    bool operator<(const Entry& o) const { return f != o.f ? f > o.f : cell > o.cell; }  // min-heap, fixed ties
+    int ring;  ///< -1: settle the cell; r >= 0: relax the long arcs of ring r into the (settled) cell
+    bool operator<(const Entry& o) const {  // min-heap, fixed ties
+      if (f != o.f) return f > o.f;
+      return cell != o.cell ? cell > o.cell : ring > o.ring;
+    }
   };
   struct Scratch {
     std::vector<double> g;
@@ -679,8 +688,24 @@ class RelaxedDistance {
     if (s.g[i] == kInfinity) s.touched.push_back(i);
     s.g[i] = g;
     const Cell c{int(i % std::size_t(t_.cols())), int(i / std::size_t(t_.cols()))};
-    heap_.push_back({g + graph_.lower_bound(c, source_), g, i});
+    push({g + graph_.lower_bound(c, source_), g, i, -1});
+  }
+  void push(const Entry& e) {
+    heap_.push_back(e);
     std::push_heap(heap_.begin(), heap_.end());
+  }
+  /// The least of (relaxed long-arc cost - lower_bound across the arc) per metre for structure st,
+  /// >= 0: an arc of length L into v gives its source w a key at least f(v) + L x margin, since
+  /// lower_bound(v, w) <= L envelope(grade) (the envelope is convex and non-decreasing). Each grade
+  /// step of the table is taken against the envelope at the step's steep end.
+  double ring_margin(int st) const {
+    const auto& table = slope_floor_[st];
+    double margin = kInfinity;
+    for (std::size_t i = 0; i < table.size(); ++i) {
+      if (table[i] == kInfinity) continue;
+      margin = std::min(margin, (1 - 1e-6) * (table[i] + fixed_[st]) - graph_.envelope(double(i + 1) * grade_step_[st]) - 0.01);
+    }
+    return margin == kInfinity ? 0.0 : std::max(0.0, margin);
   }
   /// Settles the next cell; false when the queue is empty.
   bool settle_next() {
@@ -689,6 +714,10 @@ class RelaxedDistance {
       std::pop_heap(heap_.begin(), heap_.end());
       const Entry e = heap_.back();
       heap_.pop_back();
+      if (e.ring >= 0) {
+        relax_ring(e);
+        continue;
+      }
       if (s.closed[e.cell] || e.g > s.g[e.cell]) continue;
       s.closed[e.cell] = 1;
       ++settled_;
@@ -712,28 +741,46 @@ class RelaxedDistance {
       const double e = cache_.get(u, ui, int(a));
       if (e < kInfinity) relax(ui, d + e);
     }
-    if (graph_.rings().empty() || t_.water(v.col, v.row)) return;  // long arcs join two land cells
-    const double zv = t_.surface(v.col, v.row);
+    // Long arcs join two land cells. They wait in the queue, one entry per ring, keyed by f(v) plus
+    // a lower bound of what an arc of the ring adds to its source's key (ring_margin), as the
+    // forward search's rings do: most are never relaxed, the search ending first.
+    if (graph_.rings().empty() || t_.water(v.col, v.row)) return;
+    const double f = d + graph_.lower_bound(v, source_);
+    for (Structure st : {Structure::bridge, Structure::tunnel}) {
+      const int r = graph_.first_ring(st);
+      if (r >= 0) push({f + ring_offset_[std::size_t(r)], d, i, r});
+    }
+  }
+  /// Relaxes the long arcs of ring e.ring into the settled cell e.cell, then queues its next ring.
+  void relax_ring(const Entry& e) {
+    const Cell v{int(e.cell % std::size_t(t_.cols())), int(e.cell / std::size_t(t_.cols()))};
+    const auto& arcs = graph_.arcs();
+    const double d = e.g, zv = t_.surface(v.col, v.row);
+    const RoadGraph::Ring& ring = graph_.rings()[std::size_t(e.ring)];
+    const int st = int(ring.structure);
+    const double floor = fixed_[st] + slope_floor_[st].front();
+    const auto& table = slope_floor_[st];
     // Sampled pairs are unordered: the long arcs out of v list the cells w whose arc w -> v exists.
-    for (std::size_t r = 0; r < graph_.rings().size(); ++r) {
-      const Structure st = graph_.rings()[r].structure;
-      for (int a : graph_.arcs_from(v, 0, int(r) + 1)) {
-        const Cell w{v.col + arcs[std::size_t(a)].dcol, v.row + arcs[std::size_t(a)].drow};
-        if (!t_.inside(w.col, w.row) || t_.water(w.col, w.row)) continue;
-        const std::size_t wi = t_.index(w.col, w.row);
-        if (scratch().closed[wi]) continue;
-        // As arc_cost prices the arc w -> v: the deck slope from the two surfaces over its length,
-        // here bounded from the table (no atan, no curve lookup per arc).
-        const double length = t_.length_m({double(w.col), double(w.row)}, {double(v.col), double(v.row)});
-        const double floor = fixed_[int(st)] + slope_floor_[int(st)].front();
-        if (d + (1 - 1e-6) * length * floor >= scratch().g[wi]) continue;  // cannot improve w
-        const double grade = std::fabs(zv - double(t_.surface(w.col, w.row))) / length;
-        if (grade > tan_max_[int(st)] * (1 + 1e-9)) continue;  // the deck breaks the slope threshold
-        const auto& table = slope_floor_[int(st)];
-        const double slope = table[std::min(table.size() - 1, std::size_t(grade / grade_step_[int(st)]))];
-        // 1e-6 covers the float rounding of the priced long arcs.
-        relax(wi, d + (1 - 1e-6) * length * (slope + fixed_[int(st)]));
-      }
+    for (int a : graph_.arcs_from(v, 0, e.ring + 1)) {
+      const Cell w{v.col + arcs[std::size_t(a)].dcol, v.row + arcs[std::size_t(a)].drow};
+      if (!t_.inside(w.col, w.row) || t_.water(w.col, w.row)) continue;
+      const std::size_t wi = t_.index(w.col, w.row);
+      if (scratch().closed[wi]) continue;
+      // As arc_cost prices the arc w -> v: the deck slope from the two surfaces over its length,
+      // here bounded from the table (no atan, no curve lookup per arc).
+      const double length = t_.length_m({double(w.col), double(w.row)}, {double(v.col), double(v.row)});
+      if (d + (1 - 1e-6) * length * floor >= scratch().g[wi]) continue;  // cannot improve w
+      const double grade = std::fabs(zv - double(t_.surface(w.col, w.row))) / length;
+      if (grade > tan_max_[st] * (1 + 1e-9)) continue;  // the deck breaks the slope threshold
+      const double slope = table[std::min(table.size() - 1, std::size_t(grade / grade_step_[st]))];
+      // 1e-6 covers the float rounding of the priced long arcs.
+      relax(wi, d + (1 - 1e-6) * length * (slope + fixed_[st]));
+    }
+    if (ring.next >= 0) {
+      Entry next = e;
+      next.ring = ring.next;
+      next.f = d + graph_.lower_bound(v, source_) + ring_offset_[std::size_t(ring.next)];
+      push(next);
     }
   }
 
@@ -746,6 +793,7 @@ class RelaxedDistance {
   double fixed_[3] = {0, 0, 0};
   std::vector<double> slope_floor_[3];  ///< per structure: lower bounds of the deck slope cost by grade step
   double grade_step_[3] = {1, 1, 1}, tan_max_[3] = {kInfinity, kInfinity, kInfinity};
+  std::vector<double> ring_offset_;     ///< per ring: 0.75 x ring_margin x the ring's shortest arc
   std::size_t settled_ = 0;
 };
 

@@ -97,6 +97,8 @@ class RoadGraph {
   /// and the height difference Z, min over L >= D of L g(Z/L), where g is the lower convex envelope
   /// of the per-metre cost against the grade (Z = 0 gives the paper's D x cheapest cost per metre).
   double lower_bound(Cell a, Cell b) const;
+  /// The lower convex envelope g of lower_bound at a grade (cost per metre; non-decreasing).
+  double envelope(double grade) const;
   /// A lower bound of arc_cost(from, arc) for a surface arc, from its two ends and one sample only:
   /// by Jensen's inequality on the lower convex envelope of the road's slope cost, an arc that climbs
   /// Z over L costs at least L x envelope(Z / L), and infinity when Z / L passes the threshold (some
@@ -124,7 +126,6 @@ class RoadGraph {
   double road_floor_ = 0;                ///< surface roads' water and vegetation terms at their minima
   double kappa_ = 0, best_grade_ = 0;    ///< cheapest cost per metre of climb, and its grade
   void build_rings();
-  double envelope(double grade) const;   ///< the lower convex envelope g at a grade
   std::vector<int> ring_of_;             ///< ring of each long arc (index - surface_arcs_)
   std::vector<Ring> rings_;
   int first_ring_[3] = {-1, -1, -1};
