@@ -128,7 +128,7 @@ void section_corridor(const TerrainField& t, const EarthworkOptions& o, const Ro
                       const std::vector<GridPoint>& pts, SectionCorridor& s) {
   std::vector<GridPoint> lane_left, lane_right, zone_left, zone_right;
   const bool surface = s.structure == "road";
-  double sum_r = 0, cover_m2 = 0;
+  double sum_r = 0, cover_m2 = 0, zone_m2 = 0;  // the cross-sections' cover and widths, integrated along the road
   for (std::size_t j = 0; j < pts.size(); ++j) {
     const Direction along = tangent(t, pts, j), left{along.y, -along.x}, right{-along.y, along.x};
     const double mx = t.metres_x(pts[j].row), my = t.metres_y(pts[j].row);
@@ -146,6 +146,7 @@ void section_corridor(const TerrainField& t, const EarthworkOptions& o, const Ro
       s.totals.cut_m3 += share * side.cut_m2;
       s.totals.fill_m3 += share * side.fill_m2;
       cover_m2 += share * side.cover_m;
+      zone_m2 += share * side.half_width_m;
       if (side.walled) s.walled_m += share;
     }
   }
@@ -154,7 +155,8 @@ void section_corridor(const TerrainField& t, const EarthworkOptions& o, const Ro
   s.zone = ring_of(std::move(zone_left), zone_right);
   s.mean_half_width_m = sum_r / double(2 * pts.size());
   s.totals.land_take_ha = polygon_area_m2(t.georef().crs, to_crs(t, s.zone)) / 1e4;
-  s.totals.cleared_ha = cover_m2 / 1e4;
+  // The zone's mean cover over its polygon's area (so a fully covered zone is cleared entirely).
+  s.totals.cleared_ha = zone_m2 > 0 ? s.totals.land_take_ha * cover_m2 / zone_m2 : 0;
 }
 
 void add(CorridorTotals& to, const CorridorTotals& from) {

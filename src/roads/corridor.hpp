@@ -33,7 +33,7 @@ struct CorridorOptions {
 struct CorridorTotals {
   double land_take_ha = 0;   ///< the earthworks zone: carriageway and side slopes (geodesic polygon area)
   double cut_m3 = 0, fill_m3 = 0;
-  double cleared_ha = 0;     ///< vegetation cleared in the zone (the layer's cover, clamped to 0-1)
+  double cleared_ha = 0;     ///< vegetation cleared: the zone's area times its mean cover (the layer clamped to 0-1)
 };
 
 /// One section of a road: the carriageway (half-width r) and, on surface sections, the earthworks
