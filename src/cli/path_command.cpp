@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 
 #include "cli/command.hpp"
 #include "cli/commands_list.hpp"
@@ -15,6 +16,7 @@
 #include "io/crs.hpp"
 #include "io/output_set.hpp"
 #include "io/raster_io.hpp"
+#include "io/text_io.hpp"
 #include "io/vector_io.hpp"
 #include "roads/road_network.hpp"
 
@@ -35,6 +37,9 @@ class PathCommand final : public Command {
     app.add_option("--search", search_, "Search: astar (heuristic: relaxed 2-D distance), astar-distance (heuristic: straight-line bound), bidir (bidirectional A*, straight-line bound), dijkstra")
         ->check(CLI::IsMember({"astar", "astar-distance", "bidir", "dijkstra"}));
     file_kind(app.add_option("--sections", sections_, "Also write the road/bridge/tunnel sections to this file"), FileKind::vector_out);
+    file_kind(app.add_option("--corridor", corridor_, "Also write the carriageway and earthworks zone of each section to this file "
+                                            "(polygons with cut, fill, clearing); the road gains land take, cut, fill and clearing"),
+              FileKind::vector_out);
     file_kind(app.add_option("--evaluate", evaluate_, "Instead of routing, print the cost under the cost model of the first line of this file "
                                             "(e.g. another tool's path), walked cell by cell; OUT is not written"), FileKind::vector_in);
     options_.setup(app, name());
@@ -52,12 +57,17 @@ class PathCommand final : public Command {
     const std::string out = evaluate_.empty() ? outputs.file(out_) : "";
     const std::string sections = evaluate_.empty() && !sections_.empty() ? outputs.file(sections_) : "";
     const std::string earthworks = evaluate_.empty() && !options_.earthworks.empty() ? outputs.file(options_.earthworks) : "";
+    const std::string corridor = evaluate_.empty() && !corridor_.empty() ? outputs.file(corridor_) : "";
+    // QGIS loads a .qml beside a layer of the same name.
+    const std::string corridor_style =
+        corridor.empty() ? "" : outputs.file(std::filesystem::path(corridor_).replace_extension(".qml").string());
     const roads::CostModel model = options_.cost_model();
     const plugin::PluginSet plugins = options_.plugins.load(context.log);
     const Dem dem = dem_.read();
     const hydro::FlatWater lakes = options_.flat_water(dem);
     roads::TerrainField terrain(dem, options_.sea_level(), model.unknown_water_depth_m, model.road_radius_m, &lakes.mask);
     options_.load_layers(terrain, plugins, dem, context.progress, context.log);
+    const roads::CorridorOptions corridor_options = options_.corridor_options(dem);
     const auto a = locate("--from", from_, terrain), b = locate("--to", to_, terrain);
     if (a == b) throw bad_input("--from/--to: both points fall in the same cell");
     for (const auto& [opt, c] : {std::pair{"--from", a}, std::pair{"--to", b}}) {
@@ -82,12 +92,23 @@ class PathCommand final : public Command {
     roads[0].from = 0;
     roads[0].to = 1;
     roads[0].road_class = road->ferry ? roads::RoadClass::maritime : roads::RoadClass::departmental;
-    const VectorLayer layer = roads::roads_layer(terrain, roads);
+    VectorLayer layer = roads::roads_layer(terrain, roads);
     const VectorLayer sections_layer = roads::sections_layer(terrain, roads);
-    const Dem levelled = options_.earthworks_dem(dem, terrain, roads);
+    roads::Corridors corridors;
+    double corridor_seconds = 0;
+    if (!corridor.empty()) {
+      const auto t1 = std::chrono::steady_clock::now();
+      corridors = roads::corridors(terrain, RoadOptions::geometries(roads), corridor_options);
+      corridor_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+      roads::add_corridor_fields(layer, corridors);
+    }
     write_vector(out, layer);
     if (!sections.empty()) write_vector(sections, sections_layer);
-    options_.write_earthworks(earthworks, levelled);
+    if (!corridor.empty()) {
+      write_vector(corridor, roads::corridors_layer(terrain, corridors));
+      write_text_file(corridor_style, roads::corridors_qml(), false);
+    }
+    options_.write_earthworks(earthworks, dem, terrain, roads, corridor_options);
     outputs.commit();
     const auto& s = road->stats;
     char cost[64] = "none (it breaks a threshold of the cost model)";  // Bézier roads may
@@ -98,6 +119,7 @@ class PathCommand final : public Command {
                   road->router.c_str(), s.length_m, cost, s.max_grade_pct, s.mean_grade_pct, s.bridge_m, s.tunnel_m,
                   road->expanded, road->rings_priced, road->nodes, road->relaxed_settled, seconds);
     context.log.info(line);
+    if (!corridor.empty()) context.log.info("corridor: " + roads::corridor_summary(corridors, corridor_seconds));
     const auto& g = road->geometry;
     if (g.clothoid_corners + g.g1_corners + g.sharp_corners > 0)
       context.log.detail("corners: " + std::to_string(g.clothoid_corners) + " clothoid pairs, " + std::to_string(g.g1_corners) +
@@ -141,7 +163,7 @@ class PathCommand final : public Command {
 
   std::string evaluate_;
   DemInput dem_;
-  std::string from_, to_, out_, crs_ = "lonlat", search_ = "astar", sections_;
+  std::string from_, to_, out_, crs_ = "lonlat", search_ = "astar", sections_, corridor_;
   RoadOptions options_;
 };
 

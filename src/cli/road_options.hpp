@@ -11,7 +11,7 @@
 #include "hydro/flat_water.hpp"
 #include "io/raster_io.hpp"
 #include "pipeline/stage_options.hpp"
-#include "roads/earthworks.hpp"
+#include "roads/corridor.hpp"
 #include "roads/road_network.hpp"
 
 namespace terrapolis::cli {
@@ -27,7 +27,7 @@ struct RoadOptions {
   void setup(CLI::App& app, const std::string& command) {
     schema.setup(app, command);
     file_kind(app.add_option("--earthworks", earthworks,
-                             "Also write the DEM after cut-and-fill along the surface roads (GeoTIFF; 8 m carriageway, 2:3 sides)"),
+                             "Also write the DEM after cut-and-fill along the surface roads (GeoTIFF; carriageway --half-width, sides at the --material's angle)"),
               FileKind::raster_out);
     plugins.setup(app, "adds its road cost term (characteristic priced by its transfer functions; galin router)");
     app.add_flag("--overwrite", overwrite, "Replace the outputs a previous terrapolis command wrote");
@@ -45,21 +45,30 @@ struct RoadOptions {
   double sea_level() const { return scenario().resolved["water"]["sea_level_m"].get<double>(); }
 
   /// The files these options read (the outputs may not replace them).
-  std::vector<std::string> inputs() const { return {scenario().path("/roads/costs"), settings().vegetation}; }
-
-  /// The DEM after the earthworks of the roads (empty when --earthworks is not given).
-  Dem earthworks_dem(const Dem& dem, const roads::TerrainField& terrain, const std::vector<roads::Road>& roads) const {
-    if (earthworks.empty()) return Dem();
-    std::vector<const roads::RoadGeometry*> geometries;
-    for (const roads::Road& r : roads) geometries.push_back(&r.geometry);
-    return roads::earthworks(dem, terrain, geometries);
+  std::vector<std::string> inputs() const {
+    return {scenario().path("/roads/costs"), settings().vegetation, scenario().path("/roads/corridor/side_angles")};
   }
-  /// Writes the levelled DEM to `path` (where the command's OutputSet stages --earthworks).
-  void write_earthworks(const std::string& path, const Dem& levelled) const {
+
+  /// The schema's roads.corridor options, the side-angle map read onto the DEM's grid.
+  roads::CorridorOptions corridor_options(const Dem& dem) const {
+    pipeline::CorridorSettings c = pipeline::corridor_settings(scenario());
+    if (!c.side_angles.empty()) c.options.side_angles_deg = read_resampled(c.side_angles, dem.georef(), dem.cols(), dem.rows(), Resampling::nearest);
+    return c.options;
+  }
+  /// Writes the DEM after the earthworks of the roads to `path` (where the command's OutputSet
+  /// stages --earthworks), with the corridor options; nothing when --earthworks is not given.
+  void write_earthworks(const std::string& path, const Dem& dem, const roads::TerrainField& terrain, const std::vector<roads::Road>& roads,
+                        const roads::CorridorOptions& corridor) const {
     if (earthworks.empty()) return;
+    Raster<float> slopes;
     WriteOptions w;
     w.description = "terrain after cut-and-fill along the roads (m)";
-    write_raster(path, levelled, w);
+    write_raster(path, roads::earthworks(dem, terrain, geometries(roads), roads::earthwork_options(corridor, slopes)), w);
+  }
+  static std::vector<const roads::RoadGeometry*> geometries(const std::vector<roads::Road>& roads) {
+    std::vector<const roads::RoadGeometry*> out;
+    for (const roads::Road& r : roads) out.push_back(&r.geometry);
+    return out;
   }
 
   /// Lakes the DEM flattens (hydro::detect_flat_water), for the TerrainField.

@@ -14,6 +14,7 @@
 #include "core/error.hpp"
 #include "io/output_set.hpp"
 #include "io/raster_io.hpp"
+#include "io/text_io.hpp"
 #include "io/vector_io.hpp"
 #include "network/layers.hpp"
 #include "roads/road_network.hpp"
@@ -31,6 +32,9 @@ class RoadsCommand final : public Command {
     file_kind(app.add_option("NETWORK", network_, "network.geojson from the network stage (LineStrings: from, to, kept)")->required(), FileKind::vector_in);
     file_kind(app.add_option("OUTDIR", outdir_, "Folder for roads.geojson and road_sections.geojson (its parent must exist)")->required(), FileKind::folder_out);
     file_kind(app.add_option("--cities", cities_, "Cities (Points: id, class); default: cities.geojson beside NETWORK when present"), FileKind::vector_in);
+    app.add_flag("--corridor", corridor_,
+                 "Also write corridors.geojson (per section: carriageway and earthworks zone) and add land take, cut, fill and "
+                 "vegetation cleared to roads.geojson");
     options_.setup(app, name());
   }
 
@@ -54,6 +58,7 @@ class RoadsCommand final : public Command {
     const hydro::FlatWater lakes = options_.flat_water(dem);
     roads::TerrainField terrain(dem, options_.sea_level(), model.unknown_water_depth_m, model.road_radius_m, &lakes.mask);
     options_.load_layers(terrain, plugins, dem, context.progress, context.log);
+    const roads::CorridorOptions corridor = options_.corridor_options(dem);
     VectorLayer network = read_vector(network_, dem.georef().crs);
     network.name = network_;  // errors name the file
     std::optional<VectorLayer> cities;
@@ -70,10 +75,20 @@ class RoadsCommand final : public Command {
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     for (const std::string& f : result.failed) context.log.warn("no road under the cost model for edge " + f + " (left out)");
     for (const std::string& f : result.over_budget) context.log.warn("not routed: budget (--max-seconds) for edge " + f);
-    const Dem levelled = options_.earthworks_dem(dem, terrain, result.roads);
-    write_vector((dir / "roads.geojson").string(), roads::roads_layer(terrain, result.roads));
+    VectorLayer roads_layer = roads::roads_layer(terrain, result.roads);
+    roads::Corridors corridors;
+    double corridor_seconds = 0;
+    if (corridor_) {
+      const auto t1 = std::chrono::steady_clock::now();
+      corridors = roads::corridors(terrain, RoadOptions::geometries(result.roads), corridor);
+      corridor_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+      roads::add_corridor_fields(roads_layer, corridors);
+      write_vector((dir / "corridors.geojson").string(), roads::corridors_layer(terrain, corridors));
+      write_text_file((dir / "corridors.qml").string(), roads::corridors_qml(), false);
+    }
+    write_vector((dir / "roads.geojson").string(), roads_layer);
     write_vector((dir / "road_sections.geojson").string(), roads::sections_layer(terrain, result.roads));
-    options_.write_earthworks(earthworks_path, levelled);
+    options_.write_earthworks(earthworks_path, dem, terrain, result.roads, corridor);
     outputs.commit();
     std::size_t ferries = 0;
     double km = 0;
@@ -85,11 +100,13 @@ class RoadsCommand final : public Command {
     std::snprintf(line, sizeof line, "%zu roads (%zu maritime links, %zu failed, %zu not routed: budget), %.1f km, %.2f s",
                   result.roads.size(), ferries, result.failed.size(), result.over_budget.size(), km, seconds);
     context.log.info(line);
+    if (corridor_) context.log.info("corridors: " + roads::corridor_summary(corridors, corridor_seconds));
   }
 
  private:
   DemInput dem_;
   std::string network_, outdir_, cities_;
+  bool corridor_ = false;
   RoadOptions options_;
 };
 

@@ -191,6 +191,17 @@ RoadsSettings roads_settings(const Scenario& scenario) {
   return s;
 }
 
+CorridorSettings corridor_settings(const Scenario& scenario) {
+  const json& c = scenario.resolved["roads"]["corridor"];
+  CorridorSettings s;
+  s.options.half_width_m = c["half_width_m"].get<double>();
+  const double angle = c["side_angle_deg"].get<double>();
+  s.options.side_angle_deg = angle > 0 ? angle : roads::repose_angle_deg(c["material"].get<std::string>());
+  s.options.max_height_m = c["max_height_m"].get<double>();
+  s.side_angles = scenario.path("/roads/corridor/side_angles");
+  return s;
+}
+
 hydro::FlatWaterOptions flat_water_options(const Scenario& scenario) {
   const json& w = scenario.resolved["water"];
   hydro::FlatWaterOptions o;

@@ -11,6 +11,7 @@
 #include "lake/lake.hpp"
 #include "network/network.hpp"
 #include "pipeline/scenario.hpp"
+#include "roads/corridor.hpp"
 #include "roads/cost_model.hpp"
 #include "hydro/flat_water.hpp"
 #include "roads/road_network.hpp"
@@ -52,6 +53,14 @@ struct RoadsSettings {
   std::string vegetation;  ///< resolved path, "" for none
 };
 RoadsSettings roads_settings(const Scenario& scenario);
+
+/// roads.corridor: the corridor options (the side angle from the material unless given) and the
+/// resolved path of the side-angle raster ("" for none; the caller reads it onto the DEM's grid).
+struct CorridorSettings {
+  roads::CorridorOptions options;
+  std::string side_angles;
+};
+CorridorSettings corridor_settings(const Scenario& scenario);
 
 /// The water section's detection of lakes the DEM flattens (water.flat_water_*, water.sea_level_m).
 hydro::FlatWaterOptions flat_water_options(const Scenario& scenario);

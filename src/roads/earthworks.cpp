@@ -15,7 +15,10 @@ Dem earthworks(const Dem& dem, const TerrainField& terrain, const std::vector<co
   if (!(o.half_width_m > 0) || !(o.side_slope > 0) || !(o.max_height_m >= 0)) throw bad_input("earthworks: widths and slopes must be > 0");
   const std::size_t n = dem.size();
   std::vector<double> best_d(n, std::numeric_limits<double>::infinity()), deck(n, 0.0);
-  const double reach_m = o.half_width_m + o.side_slope * o.max_height_m;
+  double gentlest = o.side_slope;
+  if (o.side_slopes)
+    for (std::size_t k = 0; k < n; ++k) gentlest = std::max(gentlest, o.slope_at(k));
+  const double reach_m = o.half_width_m + gentlest * o.max_height_m;
   for (const RoadGeometry* road : roads) {
     for (std::size_t i = 0; i + 1 < road->points.size(); ++i) {
       if (road->segments[i] != Structure::road) continue;
@@ -48,7 +51,9 @@ Dem earthworks(const Dem& dem, const TerrainField& terrain, const std::vector<co
     if (best_d[k] == std::numeric_limits<double>::infinity() || dem.is_nodata(k)) continue;
     const int c = int(k % std::size_t(dem.cols())), r = int(k / std::size_t(dem.cols()));
     if (terrain.water(c, r)) continue;
-    const double allowed = std::max(0.0, best_d[k] - o.half_width_m) / o.side_slope;
+    const double slope = o.slope_at(k);
+    if (best_d[k] > o.half_width_m + slope * o.max_height_m) continue;  // beyond this cell's own reach
+    const double allowed = std::max(0.0, best_d[k] - o.half_width_m) / slope;
     out[k] = float(std::clamp(double(dem[k]), deck[k] - allowed, deck[k] + allowed));
   }
   return out;

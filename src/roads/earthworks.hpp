@@ -13,6 +13,15 @@ struct EarthworkOptions {
   double half_width_m = 4;     ///< half the carriageway: the ground is levelled to the deck within it (m, > 0)
   double side_slope = 1.5;     ///< embankment and cutting sides: metres across per metre up or down (1.5 = 2:3, 33.7 deg)
   double max_height_m = 50;    ///< deepest cut / highest fill reached by the sides (bounds the work area), m
+  /// Optional per-cell side slope (same grid as the DEM, metres across per metre; NaN or <= 0:
+  /// `side_slope`), e.g. from a map of materials.
+  const Raster<float>* side_slopes = nullptr;
+
+  /// The side slope at cell k.
+  double slope_at(std::size_t k) const {
+    const double s = side_slopes ? double((*side_slopes)[k]) : 0.0;
+    return s > 0 ? s : side_slope;
+  }
 };
 
 /// The DEM after the earthworks of the roads' surface sections (Peytavie 2010 §4.4.3: the terrain

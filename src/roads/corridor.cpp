@@ -1,0 +1,307 @@
+// Road corridors: carriageway and earthworks polygons, cut and fill, clearing and land take.
+// SPDX-License-Identifier: MIT
+#include "roads/corridor.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+
+#include "core/error.hpp"
+#include "core/polygon_area.hpp"
+
+namespace terrapolis::roads {
+namespace {
+
+constexpr double kRad = std::numbers::pi / 180.0;
+
+double side_slope_of(double angle_deg) { return 1.0 / std::tan(angle_deg * kRad); }
+
+/// A unit direction in the local metric plane at a station (x east, y south, metres).
+struct Direction {
+  double x = 1, y = 0;
+};
+
+/// Tangent at point j of `pts` from its neighbours (one-sided at the ends, so section ends are square).
+Direction tangent(const TerrainField& t, const std::vector<GridPoint>& pts, std::size_t j) {
+  const GridPoint a = pts[j > 0 ? j - 1 : j], b = pts[j + 1 < pts.size() ? j + 1 : j];
+  const double mx = t.metres_x(pts[j].row), my = t.metres_y(pts[j].row);
+  const double x = (b.col - a.col) * mx, y = (b.row - a.row) * my, l = std::hypot(x, y);
+  return l > 0 ? Direction{x / l, y / l} : Direction{};
+}
+
+/// One side of a station's cross-section.
+struct Side {
+  double half_width_m = 0;  ///< R
+  double cut_m2 = 0, fill_m2 = 0;  ///< areas between the ground and the works, per metre of road
+  double cover_m = 0;       ///< vegetation cover integrated over [0, R]
+  bool walled = false;
+};
+
+/// The cross-section on one side of a station, from the centreline outwards along the normal n
+/// (Peytavie §4.4.3: within r the ground takes the deck's height; between r and R the works blend
+/// into the ground, here by the side slope of earthworks(): |z' - deck| <= (d - r) / side_slope).
+/// R is the first distance where that side slope meets the ground (linear interpolation between
+/// steps of at most r / 8 and a quarter of the smallest cell); the areas by the midpoint rule on
+/// the same steps. Stops at the grid's edge and the shore, and where the side would pass
+/// max_height_m (walled).
+Side cross_section(const TerrainField& t, const EarthworkOptions& o, GridPoint p, Direction n, double deck) {
+  const double r = o.half_width_m;
+  const double step = r / std::ceil(r / std::min(0.25 * t.min_cell_m(), r / 8));
+  const double mx = t.metres_x(p.row), my = t.metres_y(p.row);
+  auto at = [&](double d) { return GridPoint{p.col + n.x * d / mx, p.row + n.y * d / my}; };
+  auto slope = [&](GridPoint q) {
+    const int c = std::clamp(int(std::lround(q.col)), 0, t.cols() - 1), rr = std::clamp(int(std::lround(q.row)), 0, t.rows() - 1);
+    return o.slope_at(t.index(c, rr));
+  };
+  // On the grid and on land (earthworks() leaves water and nodata alone: the works end at the shore).
+  auto on_land = [&](GridPoint q) {
+    if (!(q.col >= -0.5 && q.row >= -0.5 && q.col <= t.cols() - 0.5 && q.row <= t.rows() - 0.5)) return false;
+    return !t.water(std::clamp(int(std::lround(q.col)), 0, t.cols() - 1), std::clamp(int(std::lround(q.row)), 0, t.rows() - 1));
+  };
+  // How far the ground is beyond the side's reach at d (<= 0: the side has met it).
+  auto excess = [&](double d) {
+    const GridPoint q = at(d);
+    return std::fabs(t.surface_at(q.col, q.row) - deck) - std::max(0.0, d - r) / slope(q);
+  };
+  Side side;
+  auto integrate = [&](double d0, double d1) {  // the works over [d0, d1], midpoint rule
+    const GridPoint q = at(0.5 * (d0 + d1));
+    const double g = t.surface_at(q.col, q.row), allowed = std::max(0.0, 0.5 * (d0 + d1) - r) / slope(q);
+    const double z = std::clamp(g, deck - allowed, deck + allowed);
+    (z > g ? side.fill_m2 : side.cut_m2) += std::fabs(z - g) * (d1 - d0);
+    side.cover_m += std::clamp(double(t.vegetation_at(q.col, q.row)), 0.0, 1.0) * (d1 - d0);
+  };
+  double d = 0;
+  for (; d + 0.5 * step < r; d += step) integrate(d, d + step);  // the carriageway
+  d = r;
+  double e0 = excess(r);
+  while (e0 > 0) {
+    const double d1 = d + step;
+    if (!on_land(at(d1))) break;
+    const double e1 = excess(d1);
+    if (e1 <= 0) {
+      const double met = d + step * e0 / (e0 - e1);
+      integrate(d, met);
+      d = met;
+      break;
+    }
+    integrate(d, d1);
+    d = d1;
+    e0 = e1;
+    if ((d - r) / slope(at(d)) > o.max_height_m) {
+      side.walled = true;
+      break;
+    }
+  }
+  side.half_width_m = d;
+  return side;
+}
+
+/// Appends the offset point unless it runs back against the road's direction (the inner side of
+/// a corner tighter than the offset: skipping it keeps the ring simple).
+void push_offset(std::vector<GridPoint>& side, const TerrainField& t, GridPoint q, Direction along) {
+  if (!side.empty()) {
+    const GridPoint& last = side.back();
+    const double dx = (q.col - last.col) * t.metres_x(q.row), dy = (q.row - last.row) * t.metres_y(q.row);
+    if (dx * along.x + dy * along.y <= 0) return;
+  }
+  side.push_back(q);
+}
+
+/// A ring from the offsets: left side forward, right side back.
+std::vector<GridPoint> ring_of(std::vector<GridPoint> left, const std::vector<GridPoint>& right) {
+  left.insert(left.end(), right.rbegin(), right.rend());
+  return left;
+}
+
+std::vector<std::array<double, 2>> to_crs(const TerrainField& t, const std::vector<GridPoint>& pts) {
+  std::vector<std::array<double, 2>> out;
+  out.reserve(pts.size());
+  for (const GridPoint& p : pts) out.push_back(t.georef().cell_centre(p.col, p.row));
+  return out;
+}
+
+/// The carriageway and earthworks rings of one section (points pts, decks from road point
+/// `first`), and its cross-sections' volumes and clearing.
+void section_corridor(const TerrainField& t, const EarthworkOptions& o, const RoadGeometry& road, std::size_t first,
+                      const std::vector<GridPoint>& pts, SectionCorridor& s) {
+  std::vector<GridPoint> lane_left, lane_right, zone_left, zone_right;
+  const bool surface = s.structure == "road";
+  double sum_r = 0, cover_m2 = 0, zone_m2 = 0;  // the cross-sections' cover and widths, integrated along the road
+  for (std::size_t j = 0; j < pts.size(); ++j) {
+    const Direction along = tangent(t, pts, j), left{along.y, -along.x}, right{-along.y, along.x};
+    const double mx = t.metres_x(pts[j].row), my = t.metres_y(pts[j].row);
+    auto offset = [&](Direction n, double d) { return GridPoint{pts[j].col + n.x * d / mx, pts[j].row + n.y * d / my}; };
+    push_offset(lane_left, t, offset(left, o.half_width_m), along);
+    push_offset(lane_right, t, offset(right, o.half_width_m), along);
+    if (!surface) continue;
+    // The station's share of the section's length.
+    const double share = 0.5 * ((j > 0 ? t.length_m(pts[j - 1], pts[j]) : 0) + (j + 1 < pts.size() ? t.length_m(pts[j], pts[j + 1]) : 0));
+    for (const auto& [n, ring] : {std::pair{left, &zone_left}, std::pair{right, &zone_right}}) {
+      const Side side = cross_section(t, o, pts[j], n, road.z[first + j]);
+      push_offset(*ring, t, offset(n, side.half_width_m), along);
+      sum_r += side.half_width_m;
+      s.max_half_width_m = std::max(s.max_half_width_m, side.half_width_m);
+      s.totals.cut_m3 += share * side.cut_m2;
+      s.totals.fill_m3 += share * side.fill_m2;
+      cover_m2 += share * side.cover_m;
+      zone_m2 += share * side.half_width_m;
+      if (side.walled) s.walled_m += share;
+    }
+  }
+  s.carriageway = ring_of(std::move(lane_left), lane_right);
+  if (!surface) return;
+  s.zone = ring_of(std::move(zone_left), zone_right);
+  s.mean_half_width_m = sum_r / double(2 * pts.size());
+  s.totals.land_take_ha = polygon_area_m2(t.georef().crs, to_crs(t, s.zone)) / 1e4;
+  // The zone's mean cover over its polygon's area (so a fully covered zone is cleared entirely).
+  s.totals.cleared_ha = zone_m2 > 0 ? s.totals.land_take_ha * cover_m2 / zone_m2 : 0;
+}
+
+void add(CorridorTotals& to, const CorridorTotals& from) {
+  to.land_take_ha += from.land_take_ha;
+  to.cut_m3 += from.cut_m3;
+  to.fill_m3 += from.fill_m3;
+  to.cleared_ha += from.cleared_ha;
+}
+
+double round_to(double v, double unit) { return std::round(v / unit) * unit; }
+
+}  // namespace
+
+double repose_angle_deg(const std::string& material) {
+  if (material == "sand") return 30;
+  if (material == "earth") return 25;
+  if (material == "stones") return 40;
+  if (material == "rock") return std::atan(2.0) / kRad;
+  throw bad_input("material: '" + material + "' is none of sand, earth, stones, rock");
+}
+
+EarthworkOptions earthwork_options(const CorridorOptions& c, Raster<float>& slopes) {
+  if (!(c.half_width_m > 0) || !(c.side_angle_deg > 0 && c.side_angle_deg < 90) || !(c.max_height_m >= 0))
+    throw bad_input("corridor: the half-width must be > 0 and the side angle within 0-90 degrees");
+  EarthworkOptions o;
+  o.half_width_m = c.half_width_m;
+  o.side_slope = side_slope_of(c.side_angle_deg);
+  o.max_height_m = c.max_height_m;
+  if (c.side_angles_deg.size() > 0) {
+    slopes = c.side_angles_deg;
+    for (std::size_t k = 0; k < slopes.size(); ++k) {
+      const double a = slopes[k];
+      slopes[k] = a > 0 && a < 90 ? float(side_slope_of(a)) : 0.f;  // NaN and out of range: the default angle
+    }
+    o.side_slopes = &slopes;
+  }
+  return o;
+}
+
+Corridors corridors(const TerrainField& terrain, const std::vector<const RoadGeometry*>& roads, const CorridorOptions& options) {
+  Raster<float> slopes;
+  const EarthworkOptions o = earthwork_options(options, slopes);
+  Corridors out;
+  out.vegetation = terrain.has_vegetation();
+  out.half_width_m = o.half_width_m;
+  out.roads.resize(roads.size());
+  for (std::size_t ri = 0; ri < roads.size(); ++ri) {
+    const RoadGeometry& road = *roads[ri];
+    const auto sections = road_sections(terrain, road);
+    std::size_t first = 0;  // the section's first point in the road
+    for (std::size_t si = 0; si < sections.size(); ++si) {
+      SectionCorridor s;
+      s.road = ri;
+      s.section = si;
+      s.structure = sections[si].structure;
+      s.length_m = sections[si].length_m;
+      section_corridor(terrain, o, road, first, sections[si].points, s);
+      add(out.roads[ri], s.totals);
+      first += sections[si].points.size() - 1;
+      out.sections.push_back(std::move(s));
+    }
+    add(out.run, out.roads[ri]);
+  }
+  return out;
+}
+
+VectorLayer corridors_layer(const TerrainField& terrain, const Corridors& corridors) {
+  VectorLayer layer;
+  layer.name = "corridors";
+  layer.geometry = GeometryType::polygon;
+  layer.crs = terrain.georef().crs;
+  layer.fields = {{"road", FieldType::integer},         {"section", FieldType::integer},       {"structure", FieldType::string},
+                  {"part", FieldType::string},          {"length_m", FieldType::real},         {"area_ha", FieldType::real},
+                  {"half_width_m", FieldType::real},    {"max_half_width_m", FieldType::real}, {"cut_m3", FieldType::real},
+                  {"fill_m3", FieldType::real},         {"cleared_ha", FieldType::real},       {"walled_m", FieldType::real}};
+  const FieldValue none;
+  for (const SectionCorridor& s : corridors.sections) {
+    auto feature = [&](const std::vector<GridPoint>& ring, const std::string& part) {
+      Feature f;
+      f.parts.push_back(to_crs(terrain, ring));
+      const bool zone = part == "earthworks";
+      const double area_ha = zone ? s.totals.land_take_ha : polygon_area_m2(layer.crs, f.parts[0]) / 1e4;
+      const double mean_r = zone ? s.mean_half_width_m : corridors.half_width_m, max_r = zone ? s.max_half_width_m : corridors.half_width_m;
+      f.values = {std::int64_t(s.road), std::int64_t(s.section), s.structure, part, round_to(s.length_m, 0.01), round_to(area_ha, 1e-4),
+                  round_to(mean_r, 0.01), round_to(max_r, 0.01),
+                  zone ? FieldValue(round_to(s.totals.cut_m3, 0.1)) : none, zone ? FieldValue(round_to(s.totals.fill_m3, 0.1)) : none,
+                  zone && corridors.vegetation ? FieldValue(round_to(s.totals.cleared_ha, 1e-4)) : none,
+                  zone ? FieldValue(round_to(s.walled_m, 0.01)) : none};
+      layer.features.push_back(std::move(f));
+    };
+    if (!s.zone.empty()) feature(s.zone, "earthworks");
+    if (s.carriageway.size() >= 3) feature(s.carriageway, "carriageway");
+  }
+  return layer;
+}
+
+void add_corridor_fields(VectorLayer& layer, const Corridors& corridors) {
+  if (layer.features.size() != corridors.roads.size()) throw processing_error("corridor: the roads layer does not match the corridors");
+  for (const char* name : {"land_take_ha", "cut_m3", "fill_m3", "cleared_ha"}) layer.fields.push_back({name, FieldType::real});
+  for (std::size_t i = 0; i < corridors.roads.size(); ++i) {
+    const CorridorTotals& t = corridors.roads[i];
+    auto& v = layer.features[i].values;
+    v.emplace_back(round_to(t.land_take_ha, 1e-4));
+    v.emplace_back(round_to(t.cut_m3, 0.1));
+    v.emplace_back(round_to(t.fill_m3, 0.1));
+    if (corridors.vegetation) v.emplace_back(round_to(t.cleared_ha, 1e-4));
+    else v.emplace_back(std::monostate{});
+  }
+}
+
+std::string corridors_qml() {
+  struct Category { const char* value; const char* label; const char* fill; const char* outline; const char* style; };
+  const Category categories[] = {{"earthworks", "earthworks zone (cut and fill sides)", "217,179,120,170", "140,100,50,255", "solid"},
+                                 {"road", "carriageway", "82,82,82,255", "40,40,40,255", "solid"},
+                                 {"bridge", "bridge deck", "8,81,156,255", "8,48,107,255", "solid"},
+                                 {"tunnel", "tunnel (underground)", "150,150,150,90", "60,60,60,255", "dash"}};
+  std::string list, symbols;
+  for (int k = 0; k < 4; ++k) {
+    const Category& c = categories[k];
+    const std::string id = std::to_string(k);
+    list += std::string("<category render=\"true\" symbol=\"") + id + "\" value=\"" + c.value + "\" label=\"" + c.label + "\"/>";
+    symbols += "<symbol type=\"fill\" name=\"" + id + "\" alpha=\"1\"><layer class=\"SimpleFill\" enabled=\"1\"><Option type=\"Map\">"
+               "<Option type=\"QString\" name=\"color\" value=\"" + std::string(c.fill) + "\"/>"
+               "<Option type=\"QString\" name=\"outline_color\" value=\"" + c.outline + "\"/>"
+               "<Option type=\"QString\" name=\"outline_style\" value=\"" + c.style + "\"/>"
+               "<Option type=\"QString\" name=\"outline_width\" value=\"0.2\"/><Option type=\"QString\" name=\"outline_width_unit\" value=\"MM\"/>"
+               "</Option></layer></symbol>";
+  }
+  // Zones first, carriageways on top: ordered by part, descending ("earthworks" after "carriageway").
+  return "<!DOCTYPE qgis PUBLIC 'http://mrcc.com/qgis.dtd' 'SYSTEM'>\n<qgis version=\"3.22.16\" styleCategories=\"AllStyleCategories\">"
+         "<renderer-v2 type=\"categorizedSymbol\" attr=\"CASE WHEN &quot;part&quot; = 'earthworks' THEN 'earthworks' ELSE &quot;structure&quot; END\" "
+         "enableorderby=\"1\" forceraster=\"0\" symbollevels=\"0\"><categories>" + list + "</categories><symbols>" + symbols +
+         "</symbols><orderby><orderByClause asc=\"0\" nullsFirst=\"0\">\"part\"</orderByClause></orderby></renderer-v2></qgis>\n";
+}
+
+std::string corridor_summary(const Corridors& c, double seconds) {
+  char line[256];
+  std::snprintf(line, sizeof line, "land take %.2f ha, cut %.0f m³, fill %.0f m³", c.run.land_take_ha, c.run.cut_m3, c.run.fill_m3);
+  std::string out = line;
+  if (c.vegetation) {
+    std::snprintf(line, sizeof line, ", vegetation cleared %.2f ha", c.run.cleared_ha);
+    out += line;
+  }
+  std::snprintf(line, sizeof line, ", %.2f s", seconds);
+  return out + line;
+}
+
+}  // namespace terrapolis::roads
