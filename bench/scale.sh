@@ -83,7 +83,7 @@ same_cells() {  # raw copies compared byte for byte
 weak() {
   local copies=${WEAK_COPIES:-360} memory=${WEAK_MEMORY:-400} dem=${WEAK_DEM:-../shared/dems/N47E009.hgt} dir
   dir=$(mktemp -d "${WEAK_DIR:-$work}/continent.XXXXXX")
-  trap 'rm -rf "$work" "$dir"' EXIT
+  trap "rm -rf '$work' '$dir'" EXIT  # expanded now: dir is local
   # The four mirror images of the DEM, once (Int16).
   /usr/bin/python3 - "$dem" "$dir" <<'PY'
 import sys
