@@ -8,6 +8,13 @@
 # Needs GNU time (/usr/bin/time), gdal-bin, python3, cmake and Open MPI (mpirun); the DEMs in
 # ../shared/dems. BENCH_RANKS="1 2 4", BENCH_MPI_TILE (tile side on ranks; default: a third of the
 # DEM's side, 9 tiles), TAUDEM_TIMEOUT (CPU s a rank and step, default 600: a TauDEM step past it is reported as such).
+# WEAK=1: weak scaling instead, on a synthetic continent streamed from disk: WEAK_DEM (default
+# N47E009, the Alps) written once in its four mirror images, placed by a VRT as a mirror-tiled
+# mosaic (seamless edges) of WEAK_COPIES tiles a rank (default 360: 5.2e8 cells a rank, 1.04e9 on 2 ranks),
+# run by `terrapolis hydro --memory-limit WEAK_MEMORY` (MB, default 400) on one process and by
+# terrapolis-mpi on WEAK_RANKS (default "1 2"), one thread a rank: cells/s a rank, CPU, peak
+# resident memory of each rank (GNU time), the engine's reported state, disk written. WEAK_DIR:
+# where the mosaic and outputs go (default a temporary folder; removed at the end).
 # SPDX-License-Identifier: MIT
 set -euo pipefail
 bin=$(realpath "${1:-build/src/cli/terrapolis}")
@@ -71,6 +78,92 @@ same_cells() {  # raw copies compared byte for byte
   GDAL_PAM_ENABLED=NO gdal_translate -q -of ENVI "$2" "$work/b.bin"
   if cmp -s "$work/a.bin" "$work/b.bin"; then echo "    $(basename "$2"): same cells"; else echo "    $(basename "$2"): DIFFERENT"; fi
 }
+
+# Weak scaling on a synthetic continent (WEAK=1).
+weak() {
+  local copies=${WEAK_COPIES:-360} memory=${WEAK_MEMORY:-400} dem=${WEAK_DEM:-../shared/dems/N47E009.hgt} dir
+  dir=$(mktemp -d "${WEAK_DIR:-$work}/continent.XXXXXX")
+  trap "rm -rf '$work' '$dir'" EXIT  # expanded now: dir is local
+  # The four mirror images of the DEM, once (Int16).
+  /usr/bin/python3 - "$dem" "$dir" <<'PY'
+import sys
+import numpy as np
+from osgeo import gdal
+src = gdal.Open(sys.argv[1])
+z = src.GetRasterBand(1).ReadAsArray()
+for name, a in (("id", z), ("lr", z[:, ::-1]), ("ud", z[::-1, :]), ("both", z[::-1, ::-1])):
+    out = gdal.GetDriverByName("GTiff").Create(f"{sys.argv[2]}/{name}.tif", a.shape[1], a.shape[0], 1, gdal.GDT_Int16,
+                                               ["TILED=YES", "COMPRESS=DEFLATE", "PREDICTOR=2"])
+    out.SetGeoTransform(src.GetGeoTransform())
+    out.SetProjection(src.GetProjection())
+    band = out.GetRasterBand(1)
+    band.SetNoDataValue(-32768)
+    band.WriteArray(a)
+PY
+  # mosaic N: N copies about as many across as down, each mirrored where it meets its neighbours.
+  mosaic() {
+    /usr/bin/python3 - "$1" "$dir" <<'PY'
+import math, sys
+from osgeo import gdal
+n, d = int(sys.argv[1]), sys.argv[2]
+tile = gdal.Open(f"{d}/id.tif")
+side, step = tile.RasterXSize, tile.GetGeoTransform()[1]
+across = next(a for a in range(math.isqrt(n), 0, -1) if n % a == 0)
+down = n // across
+sources = "".join(
+    f"""<SimpleSource><SourceFilename relativeToVRT="1">{("id", "lr", "ud", "both")[(i % 2) + 2 * (j % 2)]}.tif</SourceFilename>
+<SourceBand>1</SourceBand><SrcRect xOff="0" yOff="0" xSize="{side}" ySize="{side}"/>
+<DstRect xOff="{i * side}" yOff="{j * side}" xSize="{side}" ySize="{side}"/></SimpleSource>"""
+    for j in range(down) for i in range(across))
+open(f"{d}/continent-{n}.vrt", "w").write(f"""<VRTDataset rasterXSize="{side * across}" rasterYSize="{side * down}">
+<SRS>EPSG:4326</SRS><GeoTransform>0.0, {step!r}, 0, 60.0, 0, {-step!r}</GeoTransform>
+<VRTRasterBand dataType="Int16" band="1"><NoDataValue>-32768</NoDataValue>{sources}</VRTRasterBand></VRTDataset>
+""")
+PY
+  }
+  local side cells_a_copy
+  side=$(gdalinfo "$dir/id.tif" | sed -n 's/^Size is \([0-9]*\),.*/\1/p')
+  cells_a_copy=$(( side * side ))
+  echo "weak scaling: $copies copies of $(basename "$dem") a rank ($(( copies * cells_a_copy )) cells), --memory-limit $memory, one thread a rank, $(nproc) cores"
+  local np
+  for np in ${WEAK_RANKS:-1 2}; do
+    local n=$(( copies * np )) out=$dir/out
+    mosaic "$n"
+    rm -rf "$out"
+    local cmd=("$bin" -v --threads 1 hydro "$dir/continent-$n.vrt" "$out" --outputs $outputs --memory-limit "$memory")
+    local start end
+    start=$(date +%s.%N)
+    if [[ $np == 1 && ${WEAK_SINGLE:-process} == process ]]; then
+      /usr/bin/time -f "%e %U %S %M" -o "$dir/time.0" "${cmd[@]}" 2>"$dir/log" >/dev/null || { cat "$dir/log"; return 1; }
+    else
+      [[ -x $mpi_bin ]] || { echo "  no terrapolis-mpi: np $np skipped"; continue; }
+      cmd[0]=$mpi_bin
+      mpirun -q --oversubscribe -np "$np" bash -c '/usr/bin/time -f "%e %U %S %M" -o "$0/time.$OMPI_COMM_WORLD_RANK" "$@"' \
+        "$dir" "${cmd[@]}" 2>"$dir/log" >/dev/null || { cat "$dir/log"; return 1; }
+    fi
+    end=$(date +%s.%N)
+    local written
+    written=$(du -sb "$out" | cut -f1)
+    /usr/bin/python3 - "$np" "$n" "$cells_a_copy" "$start" "$end" "$written" "$dir" <<'PY'
+import glob, sys
+np_, n, per, start, end, written, d = int(sys.argv[1]), int(sys.argv[2]), int(sys.argv[3]), float(sys.argv[4]), float(sys.argv[5]), int(sys.argv[6]), sys.argv[7]
+cells = n * per
+wall = end - start
+ranks = [list(map(float, open(f).read().split())) for f in sorted(glob.glob(f"{d}/time.*"))]
+cpu = [r[1] + r[2] for r in ranks]
+peak = [r[3] / 1024 for r in ranks]
+print(f"  np {np_}: {cells:.3e} cells, wall {wall:.0f} s, CPU a rank {min(cpu):.0f}-{max(cpu):.0f} s, "
+      f"{cells / np_ / wall / 1e6:.2f} M cells/s a rank (wall), {cells / sum(cpu) / 1e6:.2f} M cells/CPU s, "
+      f"peak {min(peak):.0f}-{max(peak):.0f} MB a rank, written {written / 1e9:.2f} GB ({written / cells:.2f} B a cell)")
+PY
+    grep "^tiles:" "$dir/log" | sed 's/^/    /'
+    rm -rf "$out" "$dir"/time.*
+  done
+}
+if [[ ${WEAK:-0} == 1 ]]; then
+  weak
+  exit
+fi
 
 for dem in "${dems[@]}"; do
   name=$(basename "$dem" .hgt)

@@ -15,6 +15,7 @@
 #include "cli/hydro_tiles.hpp"
 #include "cli/schema_options.hpp"
 #include "core/error.hpp"
+#include "hydro/catchment.hpp"
 #include "hydro/hydro.hpp"
 #include "hydro/river_types.hpp"
 #include "io/output_set.hpp"
@@ -50,7 +51,7 @@ class HydroCommand final : public Command {
     app.add_option("--area-units", units_, "Unit of accumulation.tif: m2, km2 or cells")
         ->check(CLI::IsMember({"m2", "km2", "cells"}))->capture_default_str();
     file_kind(app.add_option("--weights", weights_, "Raster of per-cell weights (resampled bilinearly onto the DEM)"), FileKind::raster_in);
-    app.add_option("--outputs", outputs_, "Outputs to write, comma-separated: filled,flowdir,accumulation,hydrometry,streams")
+    app.add_option("--outputs", outputs_, "Outputs to write, comma-separated: filled,flowdir,accumulation,hydrometry,streams,basins")
         ->capture_default_str();
     app.add_option("--tile-size", tile_size_, "Work tile by tile, tiles of at most N x N cells (writes one GeoTIFF a tile + a VRT)");
     app.add_option("--memory-limit", memory_limit_mb_, "Work tile by tile within this much memory (MB), tiles sized to fit");
@@ -69,13 +70,13 @@ class HydroCommand final : public Command {
     const std::string fill = h["fill"], flow = h["flow"], hydrometry = h["hydrometry"];
     o.unit = units_ == "cells" ? AccumulationUnit::cells : AccumulationUnit::area_m2;
 
-    const std::string names[5] = {"filled.tif", "flowdir.tif", "accumulation.tif", "hydrometry.tif", "streams.geojson"};
-    bool wanted[5] = {false, false, false, false, false};
+    const std::string names[6] = {"filled.tif", "flowdir.tif", "accumulation.tif", "hydrometry.tif", "streams.geojson", "basins.tif"};
+    bool wanted[6] = {false, false, false, false, false, false};
     for (std::size_t start = 0; start <= outputs_.size();) {
       const std::size_t comma = std::min(outputs_.find(',', start), outputs_.size());
       const std::string item = outputs_.substr(start, comma - start);
       bool known = false;
-      for (int i = 0; i < 5; ++i)
+      for (int i = 0; i < 6; ++i)
         if (item + (i == 4 ? ".geojson" : ".tif") == names[i]) wanted[i] = known = true;
       if (!known) throw bad_input("--outputs: unknown output '" + item + "'");
       start = comma + 1;
@@ -104,6 +105,7 @@ class HydroCommand final : public Command {
     const ReadOptions read = dem_.options();
     const std::string flowdir_description = "D8 flow direction, " + describe(codes);
     const std::vector<std::pair<std::string, std::string>> flowdir_metadata = {{"D8_CODES", h["d8_codes"].get<std::string>()}, {"D8_CODES_DESCRIPTION", describe(codes)}};
+    const std::string basins_description = "Drainage basin: 1 + rank of its outlet cell in row-major order (0: nodata)";
     const std::string acc_unit = units_ == "cells" ? "cells" : units_;
     const std::string acc_description = "Upstream " + std::string(units_ == "cells" ? "cell count" : "area (" + acc_unit + ")") + ", " +
                                         flow + " routing" + (weights_.empty() ? "" : ", weighted");
@@ -114,7 +116,7 @@ class HydroCommand final : public Command {
       // The default outputs on tiles: all but the hydrometry, and the streams when the accumulation is an area.
       const bool explicit_outputs = outputs_ != kDefaultOutputs;
       if (explicit_outputs && wanted[3])
-        throw bad_input("--outputs: the hydrometry is not computed on tiles yet; ask for filled,flowdir,accumulation,streams");
+        throw bad_input("--outputs: the hydrometry is not computed on tiles yet; ask for filled,flowdir,accumulation,streams,basins");
       if (explicit_outputs && wanted[4] && o.unit == AccumulationUnit::cells)
         throw bad_input("--outputs: streams on tiles need --area-units m2 or km2");
       if (classify) throw bad_input("--classify: river types are not computed on tiles yet");
@@ -134,11 +136,13 @@ class HydroCommand final : public Command {
       q.filled = wanted[0];
       q.flowdir = wanted[1];
       q.accumulation = wanted[2];
+      q.basins = wanted[5];
       q.streams = wanted[4] && o.unit != AccumulationUnit::cells;
       q.streams_threshold_km2 = o.streams.threshold_km2;
       q.filled_file = opts("Conditioned elevation (m), " + fill + " depression handling");
       q.flowdir_file = opts(flowdir_description, flowdir_metadata);
       q.accumulation_file = opts(acc_description, {{"UNIT", acc_unit}});
+      q.basins_file = opts(basins_description);
       const std::string done = run_tiled_hydro_command(q, context);
       outputs.commit();
       context.log.info(done);
@@ -176,6 +180,7 @@ class HydroCommand final : public Command {
     if (wanted[3])
       writes.push_back([&, p = path(3)] { write_raster(p, result.hydrometry, opts("Hydrometry in [0,1] (" + hydrometry + ")")); });
     if (wanted[4]) writes.push_back([&, p = path(4)] { write_vector(p, result.streams); });
+    if (wanted[5]) writes.push_back([&, p = path(5)] { write_raster(p, drainage_basins(result.d8), opts(basins_description)); });
     if (classify) writes.push_back([&] { write_text_file((dir / "streams.qml").string(), river_types_qml(), false); });
     write_concurrently(writes);
     outputs.commit();

@@ -38,9 +38,10 @@ std::string tiles_of_this_process(const TiledHydroRequest& q, Context& context, 
     bool wanted;
     const WriteOptions* options;
   };
-  const Layer layers[3] = {{"filled", q.filled, &q.filled_file},
+  const Layer layers[4] = {{"filled", q.filled, &q.filled_file},
                            {"flowdir", q.flowdir, &q.flowdir_file},
-                           {"accumulation", q.accumulation, &q.accumulation_file}};
+                           {"accumulation", q.accumulation, &q.accumulation_file},
+                           {"basins", q.basins, &q.basins_file}};
   hydro::tiled::TiledOptions o;
   o.memory_limit_mb = q.memory_limit_mb;
   o.sea_level = q.sea_level;
@@ -81,6 +82,8 @@ std::string tiles_of_this_process(const TiledHydroRequest& q, Context& context, 
       for (std::size_t i = 0; i < v.size(); ++i) v[i] = float(acc[i] * q.accumulation_scale);
       write_raster(tile_path(layers[2], t), v, q.accumulation_file);
     };
+  if (q.basins)
+    sinks.basins = [&](int t, const Raster<std::uint32_t>& b) { write_raster(tile_path(layers[3], t), b, q.basins_file); };
   std::size_t reaches = 0;
   if (q.streams)
     sinks.streams = [&](hydro::StreamCells& cells) {

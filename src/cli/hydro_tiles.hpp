@@ -25,12 +25,13 @@ struct TiledHydroRequest {
   double accumulation_scale = 1;  ///< file value = accumulation x scale (km2: 1e-6)
   hydro::D8Codes codes = hydro::D8Codes::esri;
   bool filled = true, flowdir = true, accumulation = true;
+  bool basins = false;                ///< drainage basins, labels stitched across tiles
   bool streams = false;               ///< streams.geojson, reaches stitched across tiles (unit area_m2)
   double streams_threshold_km2 = 10;
-  WriteOptions filled_file, flowdir_file, accumulation_file;  ///< description, metadata, COG, overwrite
+  WriteOptions filled_file, flowdir_file, accumulation_file, basins_file;  ///< description, metadata, COG, overwrite
 };
 
-/// Writes OUTDIR/filled.vrt, flowdir.vrt, accumulation.vrt over one GeoTIFF a tile in
+/// Writes OUTDIR/filled.vrt, flowdir.vrt, accumulation.vrt (basins.vrt) over one GeoTIFF a tile in
 /// OUTDIR/filled/, flowdir/, accumulation/ (tile_RRRR_CCCC.tif); the same cells as the whole-grid
 /// command. Returns the log line. Under terrapolis-mpi, the request goes to every rank first.
 std::string run_tiled_hydro_command(const TiledHydroRequest& request, Context& context);

@@ -116,8 +116,8 @@ void fields(IO& io, TiledHydroRequest& q, int& threads) {
   io(q.dem_path), io(q.out_dir), io(q.out_name);
   io(q.read.band), io(q.read.assume_crs), io(q.read.windowed);
   io(q.tile_size), io(q.memory_limit_mb), io(q.sea_level), io(q.unit), io(q.accumulation_scale), io(q.codes);
-  io(q.filled), io(q.flowdir), io(q.accumulation), io(q.streams), io(q.streams_threshold_km2);
-  for (WriteOptions* w : {&q.filled_file, &q.flowdir_file, &q.accumulation_file}) {
+  io(q.filled), io(q.flowdir), io(q.accumulation), io(q.streams), io(q.streams_threshold_km2), io(q.basins);
+  for (WriteOptions* w : {&q.filled_file, &q.flowdir_file, &q.accumulation_file, &q.basins_file}) {
     io(w->cog), io(w->overwrite), io(w->description), io(w->deflate_level);
     std::uint64_t n = w->metadata.size();
     io(n);

@@ -60,6 +60,42 @@ std::vector<Feature> polygonize(const Raster<std::uint8_t>& mask) {
   return out;
 }
 
+void label_by_descent(const Raster<std::uint8_t>& d8, Raster<std::uint32_t>& labels) {
+  std::vector<std::size_t> path;
+  for (std::size_t start = 0; start < d8.size(); ++start) {
+    if (labels[start] != 0 || d8[start] == kNoData) continue;
+    std::size_t i = start;
+    while (labels[i] == 0) {
+      path.push_back(i);
+      const std::uint8_t k = d8[i];
+      const int nc = int(i % std::size_t(d8.cols())) + (k < 8 ? dcol[k] : 0), nr = int(i / std::size_t(d8.cols())) + (k < 8 ? drow[k] : 0);
+      if (k >= 8 || !d8.inside(nc, nr) || d8(nc, nr) == kNoData)
+        throw processing_error("basins: a D8 path ends at a cell without a label");
+      i = d8.index(nc, nr);
+    }
+    for (std::size_t p : path) labels[p] = labels[i];
+    path.clear();
+  }
+}
+
+Raster<std::uint32_t> drainage_basins(const Raster<std::uint8_t>& d8) {
+  Raster<std::uint32_t> labels = d8.like<std::uint32_t>(0);
+  labels.nodata = 0;
+  std::uint64_t outlets = 0;
+  for (int r = 0; r < d8.rows(); ++r)
+    for (int c = 0; c < d8.cols(); ++c) {
+      const std::uint8_t k = d8(c, r);
+      if (k == kNoData) continue;
+      const int nc = c + (k < 8 ? dcol[k] : 0), nr = r + (k < 8 ? drow[k] : 0);
+      if (k >= 8 || !d8.inside(nc, nr) || d8(nc, nr) == kNoData) {
+        if (++outlets >= 0xFFFFFFFFu) throw bad_input("basins: more than 2^32 - 2 outlets");
+        labels(c, r) = std::uint32_t(outlets);
+      }
+    }
+  label_by_descent(d8, labels);
+  return labels;
+}
+
 Catchment delineate_catchment(const Raster<std::uint8_t>& d8, const Raster<double>& area, const CellMetrics& metrics,
                               double x, double y, double snap_radius_m, Progress& progress) {
   if (!(snap_radius_m >= 0) || !std::isfinite(snap_radius_m)) throw bad_input("--snap-radius: must be >= 0 metres");

@@ -29,6 +29,17 @@ std::vector<Feature> polygonize(const Raster<std::uint8_t>& mask);
 /// Throws bad_input when the point is off the grid or on nodata with no valid cell in the radius.
 /// The polygon comes from GDALPolygonize (8-connectedness) on the mask; fields `area_km2`,
 /// `cells`, `outlet_x`, `outlet_y`.
+/// Every valid cell labelled with its drainage basin: 1 + the rank, in row-major order, of the
+/// outlet its D8 path ends at (a cell that keeps its water, or flows off the grid or onto
+/// nodata); 0 on nodata. The `basins` output of `terrapolis hydro`; the tile engine gives the same
+/// labels. Throws bad_input beyond 2^32 - 2 outlets.
+Raster<std::uint32_t> drainage_basins(const Raster<std::uint8_t>& d8);
+
+/// Gives every valid cell of `d8` whose label is 0 the label of the first labelled cell on its D8
+/// path (the caller labels every cell where a path ends: outlets, and on tiles the cells that flow
+/// into another tile).
+void label_by_descent(const Raster<std::uint8_t>& d8, Raster<std::uint32_t>& labels);
+
 Catchment delineate_catchment(const Raster<std::uint8_t>& d8, const Raster<double>& area_m2, const CellMetrics& metrics,
                               double x, double y, double snap_radius_m, Progress& progress);
 

@@ -13,8 +13,8 @@ mkdir "$work/zion_tiles"
 for i in 0 1 2; do for j in 0 1 2; do  # 465 x 457 cells: columns 3 x 155, rows 152 + 152 + 153
   gdal_translate -q -srcwin $((i * 155)) $((j * 152)) 155 $((j == 2 ? 153 : 152)) "$zion" "$work/zion_tiles/z_${j}_${i}.tif"
 done; done
-"$bin" -q hydro "$zion" "$work/zion_whole" --outputs filled,flowdir,accumulation,streams --streams-threshold 1
-"$bin" -q hydro "$work/zion_tiles" "$work/zion_tiled" --tile-size 100 --streams-threshold 1
+"$bin" -q hydro "$zion" "$work/zion_whole" --outputs filled,flowdir,accumulation,streams,basins --streams-threshold 1
+"$bin" -q hydro "$work/zion_tiles" "$work/zion_tiled" --tile-size 100 --streams-threshold 1 --outputs filled,flowdir,accumulation,streams,basins
 # The same reaches (ids, orders, links, cells); areas and lengths to 1e-9, the folder's VRT having
 # a geotransform a few ulps off the file's (the MPI case compares the file's streams byte for byte).
 /usr/bin/python3 - "$work/zion_whole/streams.geojson" "$work/zion_tiled/streams.geojson" <<'PY' || fail "zion: tiled streams differ"
@@ -26,11 +26,24 @@ sys.exit(0 if len(a) == len(b) > 100 and all(
     all(math.isclose(u, v, abs_tol=1e-9) for p, q in zip(f["geometry"]["coordinates"], g["geometry"]["coordinates"]) for u, v in zip(p, q)) and
     len(f["geometry"]["coordinates"]) == len(g["geometry"]["coordinates"]) for f, g in zip(a, b)) else 1)
 PY
-for o in "${outputs[@]}"; do
+for o in "${outputs[@]}" basins; do
   same_cells "$work/zion_whole/$o.tif" "$work/zion_tiled/$o.vrt" || fail "zion: tiled $o differs"
   [[ $(ls "$work/zion_tiled/$o"/tile_*.tif | wc -l) -eq 25 ]] || fail "zion: expected 25 $o tiles"
 done
 gdalinfo "$work/zion_tiled/flowdir/tile_0002_0003.tif" | grep -q "D8_CODES=esri" || fail "tile without its metadata"
+# Basins stitched: the largest basin spreads over at least 9 of the 25 tiles, under one label; the
+# labels are the outlets numbered 1..N, each outlet cell in its own basin's label.
+/usr/bin/python3 - "$work/zion_tiled/basins.vrt" <<'PY' || fail "zion: basins not stitched across tiles"
+import sys
+import numpy as np
+from osgeo import gdal
+b = gdal.Open(sys.argv[1]).ReadAsArray()
+labels, counts = np.unique(b[b > 0], return_counts=True)
+big = labels[np.argmax(counts)]
+rows, cols = np.nonzero(b == big)
+tiles = {(r * 5 // b.shape[0], c * 5 // b.shape[1]) for r, c in zip(rows, cols)}
+sys.exit(0 if len(tiles) >= 9 and labels[0] == 1 and labels[-1] == len(labels) else 1)
+PY
 gdalinfo "$work/zion_tiled/filled.vrt" | grep -q 'ID\["EPSG",4326\]' || fail "VRT without the CRS"
 
 # Corsica (sea level, coast) through a VRT with km2 and TauDEM codes, on one thread.

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -18,6 +19,7 @@
 #include "core/error.hpp"
 #include "core/geodesy.hpp"
 #include "hydro/accumulation.hpp"
+#include "hydro/catchment.hpp"
 #include "hydro/depressions.hpp"
 #include "hydro/flow_directions.hpp"
 #include "hydro/grid.hpp"
@@ -30,6 +32,7 @@ struct Whole {
   Dem filled;
   Raster<std::uint8_t> d8;
   Raster<double> accumulation;
+  Raster<std::uint32_t> basins;
 };
 
 Whole whole_grid(const Dem& dem, std::optional<double> sea, AccumulationUnit unit) {
@@ -42,13 +45,14 @@ Whole whole_grid(const Dem& dem, std::optional<double> sea, AccumulationUnit uni
   AccumulationOptions a;
   a.unit = unit;
   w.accumulation = accumulate(w.filled, router, m, a, quiet);
+  w.basins = drainage_basins(w.d8);
   return w;
 }
 
 /// The tiled run's outputs put back together on the whole grid.
 Whole tiled(const Dem& dem, int tile_size, int concurrent, std::optional<double> sea, AccumulationUnit unit,
             TiledReport* report = nullptr) {
-  Whole w{dem.like<float>(-1.0f), dem.like<std::uint8_t>(77), dem.like<double>(-1.0)};
+  Whole w{dem.like<float>(-1.0f), dem.like<std::uint8_t>(77), dem.like<double>(-1.0), dem.like<std::uint32_t>(0xDEADu)};
   const TileGrid grid(dem.cols(), dem.rows(), tile_size);
   std::mutex m;
   auto place = [&](auto& whole, int t, const auto& tile) {
@@ -66,6 +70,7 @@ Whole tiled(const Dem& dem, int tile_size, int concurrent, std::optional<double>
   sinks.filled = [&](int t, const Dem& z) { place(w.filled, t, z); };
   sinks.d8 = [&](int t, const Raster<std::uint8_t>& d) { place(w.d8, t, d); };
   sinks.accumulation = [&](int t, const Raster<double>& a) { place(w.accumulation, t, a); };
+  sinks.basins = [&](int t, const Raster<std::uint32_t>& b) { place(w.basins, t, b); };
   TiledOptions o;
   o.tile_size = tile_size;
   o.concurrent_tiles = concurrent;
@@ -108,6 +113,7 @@ void expect_same(const Whole& a, const Whole& b, const std::string& what) {
   EXPECT_TRUE(same_bits(a.d8, b.d8)) << what << ": d8, " << differences(a.d8, b.d8) << " cells differ";
   EXPECT_TRUE(same_bits(a.accumulation, b.accumulation))
       << what << ": accumulation, " << differences(a.accumulation, b.accumulation) << " cells differ";
+  EXPECT_TRUE(same_bits(a.basins, b.basins)) << what << ": basins, " << differences(a.basins, b.basins) << " cells differ";
 }
 
 Georef geographic(double lon, double lat, double step) {
@@ -162,6 +168,18 @@ TEST(TileGrid, CoversTheMosaicWithNearEqualTiles) {
   for (int s : seen) EXPECT_EQ(s, 1);
 }
 
+TEST(DrainageBasins, OutletsNumberedInRowMajorOrder) {
+  // D8 codes (0 E, 2 S, 3 SW, 4 W, 5 NW, 6 N): (0,0) and (3,0) flow off the grid, (2,0) onto
+  // nodata, (2,1) keeps its water: the outlets 1, 2, 3, 4 in row-major order.
+  Raster<std::uint8_t> d8(4, 2, {}, 0);
+  const std::uint8_t codes[8] = {4, 4, 3, 0, 6, kNoData, kTerminal, 4};
+  std::copy_n(codes, 8, d8.data());
+  const Raster<std::uint32_t> b = drainage_basins(d8);
+  const std::uint32_t expected[8] = {1, 1, 2, 3, 1, 0, 4, 4};
+  for (int i = 0; i < 8; ++i) EXPECT_EQ(b[std::size_t(i)], expected[i]) << "cell " << i;
+  EXPECT_EQ(b.nodata, 0.0);
+}
+
 TEST(TiledHydro, LandscapeOnThreeByThreeTilesEqualsTheWholeGrid) {
   const Dem dem = landscape();
   const Whole whole = whole_grid(dem, std::nullopt, AccumulationUnit::area_m2);
@@ -188,6 +206,12 @@ TEST(TiledHydro, LandscapeOnThreeByThreeTilesEqualsTheWholeGrid) {
   }
   EXPECT_EQ(r, 0) << "the river reaches the north edge";
   EXPECT_GE(crossings, 3);
+  // Its basin (labelled by its outlet on the north edge) covers cells of at least three tiles.
+  std::set<int> basin_tiles;
+  for (int row = 0; row < 96; ++row)
+    for (int col = 0; col < 96; ++col)
+      if (whole.basins(col, row) == whole.basins(c, r)) basin_tiles.insert(grid.tile_of(col, row));
+  EXPECT_GE(basin_tiles.size(), 3u);
   TiledReport report;
   expect_same(whole, tiled(dem, 32, 2, std::nullopt, AccumulationUnit::area_m2, &report), "tiles of 32");
   EXPECT_EQ(report.tiles, 9);

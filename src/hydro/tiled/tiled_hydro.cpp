@@ -21,6 +21,7 @@
 
 #include "core/error.hpp"
 #include "core/geodesy.hpp"
+#include "hydro/catchment.hpp"
 #include "hydro/depressions.hpp"
 #include "hydro/exact_accumulation.hpp"
 #include "hydro/flood_queue.hpp"
@@ -586,7 +587,37 @@ TiledReport run_tiled_hydro(int cols, int rows, const Georef& georef, const Read
     frame_cell(nc, nr, z, label);
     return label == kVoid ? -1 : std::int64_t(nr) * cols + nc;
   };
+  // Where the D8 paths of tile t end, in row-major order: its outlets (a cell that keeps its water,
+  // or flows off the mosaic or onto nodata: drainage_basins' outlets) and the cells that flow into
+  // another tile (its links, with their targets).
+  struct PathEnds {
+    std::vector<std::uint32_t> outlets, exits;
+    std::vector<std::int64_t> targets;
+  };
+  auto path_ends = [&](int t, const TileRect& r, const Raster<std::uint8_t>& d8) {
+    PathEnds ends;
+    for (int row = 0; row < r.rows; ++row)
+      for (int c = 0; c < r.cols; ++c) {
+        const std::uint8_t k = d8(c, row);
+        if (k == kNoData) continue;
+        const std::uint32_t i = std::uint32_t(d8.index(c, row));
+        const int nc = c + (k < 8 ? dcol[k] : 0), nr = row + (k < 8 ? drow[k] : 0);
+        if (k < 8 && d8.inside(nc, nr)) {
+          if (d8(nc, nr) == kNoData) ends.outlets.push_back(i);
+          continue;
+        }
+        if (const std::int64_t target = crossing(t, r.col0 + c, r.row0 + row, k); target >= 0) {
+          ends.exits.push_back(i);
+          ends.targets.push_back(target);
+        } else {
+          ends.outlets.push_back(i);
+        }
+      }
+    return ends;
+  };
   std::vector<std::vector<Link>> links(static_cast<std::size_t>(tiles));
+  // Outlets of each tile by row (the basins' numbering).
+  std::vector<std::vector<std::uint32_t>> outlet_rows(static_cast<std::size_t>(tiles));
   // For each edge cell of a tile (Frame order, first ring only used), the link its flow leaves by.
   std::vector<std::vector<std::int32_t>> edge_exit(static_cast<std::size_t>(tiles));
   failure = for_tiles("accumulation of tiles", [&](int t, const TileRect& r) {
@@ -599,18 +630,23 @@ TiledReport run_tiled_hydro(int cols, int rows, const Georef& georef, const Read
     write_codes(codes_path(t), d8);
     std::vector<std::int64_t> acc = own_units(d8, r);
     accumulate_d8_units(d8, acc);
-    // Exits, then for each edge cell the exit its path reaches (-1: it ends inside or off the mosaic).
+    // Exits and outlets, then for each edge cell where its path ends: exit e >= 0, outlet j of the
+    // tile (row-major) as -3 - j, -1 on nodata.
     std::vector<std::int32_t> down(d8.size(), -2);
+    const PathEnds ends = path_ends(t, r, d8);
     auto& out = links[std::size_t(t)];
-    for (int row = 0; row < r.rows; ++row)
-      for (int c = 0; c < r.cols; ++c) {
-        if (row != 0 && c != 0 && row != r.rows - 1 && c != r.cols - 1) continue;
-        const std::size_t i = d8.index(c, row);
-        if (const std::int64_t target = crossing(t, r.col0 + c, r.row0 + row, d8[i]); target >= 0) {
-          down[i] = std::int32_t(out.size());
-          out.push_back({std::int64_t(r.row0 + row) * cols + r.col0 + c, target, acc[i]});
-        }
-      }
+    for (std::size_t e = 0; e < ends.exits.size(); ++e) {
+      const std::uint32_t i = ends.exits[e];
+      down[i] = std::int32_t(e);
+      out.push_back({std::int64_t(r.row0) * cols + r.col0 + std::int64_t(i / std::uint32_t(r.cols)) * cols + i % std::uint32_t(r.cols),
+                     ends.targets[e], acc[i]});
+    }
+    std::vector<std::uint32_t>& per_row = outlet_rows[std::size_t(t)];
+    per_row.assign(std::size_t(r.rows), 0);
+    for (std::size_t j = 0; j < ends.outlets.size(); ++j) {
+      down[ends.outlets[j]] = -3 - std::int32_t(j);
+      ++per_row[ends.outlets[j] / std::uint32_t(r.cols)];
+    }
     std::vector<std::size_t> path;
     const Frame frame(r, false);
     std::vector<std::int32_t> exits(frame.size(), -1);
@@ -641,10 +677,12 @@ TiledReport run_tiled_hydro(int cols, int rows, const Georef& georef, const Read
       [&](int t, std::vector<char>& out) {
         put(out, links[std::size_t(t)]);
         put(out, edge_exit[std::size_t(t)]);
+        put(out, outlet_rows[std::size_t(t)]);
       },
       [&](int t, Unpack& in) {
         links[std::size_t(t)] = in.take<Link>();
         edge_exit[std::size_t(t)] = in.take<std::int32_t>();
+        outlet_rows[std::size_t(t)] = in.take<std::uint32_t>();
       });
   // The link graph: each link flows into the tile of its target and leaves it by that cell's
   // exit; solved in topological order, the sums exact.
@@ -670,6 +708,43 @@ TiledReport run_tiled_hydro(int cols, int rows, const Georef& georef, const Read
       ++indegree[std::size_t(next[y])];
     }
   }
+  // Basins: outlets numbered in row-major order of the mosaic (drainage_basins), from the tiles'
+  // outlets by row; each link labelled with the basin its chain of links ends in.
+  std::vector<std::uint64_t> before_row(std::size_t(rows) + 1, 0);  // outlets of the mosaic's rows above
+  std::vector<std::vector<std::uint32_t>> outlets_above(static_cast<std::size_t>(tiles));  // a tile's, above each row
+  for (int t = 0; t < tiles; ++t) {
+    const TileRect r = grid.rect(t);
+    auto& above = outlets_above[std::size_t(t)];
+    above.assign(std::size_t(r.rows) + 1, 0);
+    for (int row = 0; row < r.rows; ++row) {
+      const std::uint32_t n = outlet_rows[std::size_t(t)][std::size_t(row)];
+      above[std::size_t(row) + 1] = above[std::size_t(row)] + n;
+      before_row[std::size_t(r.row0 + row) + 1] += n;
+    }
+  }
+  for (int row = 0; row < rows; ++row) before_row[std::size_t(row) + 1] += before_row[std::size_t(row)];
+  if (sinks.basins && before_row.back() >= 0xFFFFFFFFu) throw bad_input("basins: more than 2^32 - 2 outlets");
+  auto basin_of_outlet = [&](int u, std::uint32_t j) {  // outlet j of tile u
+    const auto& above = outlets_above[std::size_t(u)];
+    const std::size_t row = std::size_t(std::upper_bound(above.begin(), above.end(), j) - above.begin()) - 1;
+    std::uint64_t rank = before_row[std::size_t(grid.rect(u).row0) + row] + (j - above[row]);
+    for (int v = u - u % grid.across(); v < u; ++v) rank += outlet_rows[std::size_t(v)][row];  // on the row, to the west
+    return std::uint32_t(rank + 1);
+  };
+  std::vector<std::uint32_t> link_basin(sinks.basins ? link_count : 0, 0);
+  std::vector<std::uint32_t> chain;
+  for (std::uint32_t y = 0; y < link_basin.size(); ++y) {
+    chain.clear();
+    std::uint32_t z = y;
+    for (; link_basin[z] == 0 && next[z] >= 0; z = std::uint32_t(next[z])) chain.push_back(z);
+    if (link_basin[z] == 0) {
+      const int gc = int(all[z].target % cols), gr = int(all[z].target / cols);
+      const int u = grid.tile_of(gc, gr);
+      const TileRect ru = grid.rect(u);
+      link_basin[z] = basin_of_outlet(u, std::uint32_t(-3 - edge_exit[std::size_t(u)][Frame(ru, false).index(gc - ru.col0, gr - ru.row0)]));
+    }
+    for (std::uint32_t x : chain) link_basin[x] = link_basin[z];
+  }
   edge_exit = {};
   std::vector<std::int64_t> total(link_count);
   for (std::uint32_t y = 0; y < link_count; ++y) total[y] = all[y].local;
@@ -692,7 +767,7 @@ TiledReport run_tiled_hydro(int cols, int rows, const Georef& georef, const Read
     const TileRect ru = grid.rect(u);
     inflow[std::size_t(u)].push_back({std::uint32_t((gr - ru.row0) * ru.cols + (gc - ru.col0)), total[y]});
   }
-  report.global_state_bytes = std::max(report.global_state_bytes, frame_bytes + double(link_count) * 56);
+  report.global_state_bytes = std::max(report.global_state_bytes, frame_bytes + double(link_count) * 60 + double(rows) * 16);
   all = {};
   total = {};
 
@@ -701,10 +776,20 @@ TiledReport run_tiled_hydro(int cols, int rows, const Georef& georef, const Read
     throw bad_input("tiles: streams need the accumulation as an area (--area-units m2 or km2)");
   std::vector<std::vector<StreamCell>> stream_cells(static_cast<std::size_t>(tiles));
   failure = nullptr;
-  if (sinks.accumulation || sinks.streams)
+  if (sinks.accumulation || sinks.streams || sinks.basins)
     failure = for_tiles("accumulation", [&](int t, const TileRect& r) {
       Raster<std::uint8_t> d8(r.cols, r.rows, shifted(georef, r.col0, r.row0), kNoData);
       read_codes(codes_path(t), d8);
+      if (sinks.basins) {
+        Raster<std::uint32_t> basins = d8.like<std::uint32_t>(0);
+        basins.nodata = 0;
+        const PathEnds ends = path_ends(t, r, d8);
+        for (std::size_t e = 0; e < ends.exits.size(); ++e) basins[ends.exits[e]] = link_basin[link_base[std::size_t(t)] + e];
+        for (std::size_t j = 0; j < ends.outlets.size(); ++j) basins[ends.outlets[j]] = basin_of_outlet(t, std::uint32_t(j));
+        label_by_descent(d8, basins);
+        sinks.basins(t, basins);
+      }
+      if (!sinks.accumulation && !sinks.streams) return;
       std::vector<std::int64_t> acc = own_units(d8, r);
       for (const auto& [i, v] : inflow[std::size_t(t)]) acc[i] += v;
       inflow[std::size_t(t)] = {};

@@ -81,6 +81,8 @@ struct TileSinks {
   std::function<void(int tile, const Dem& filled)> filled;
   std::function<void(int tile, const Raster<std::uint8_t>& d8)> d8;  ///< flow_directions.hpp codes
   std::function<void(int tile, const Raster<double>& accumulation)> accumulation;
+  /// drainage_basins (catchment.hpp) of the whole mosaic, on the tile: labels stitched across tiles.
+  std::function<void(int tile, const Raster<std::uint32_t>& basins)> basins;
   /// The stream cells of the whole mosaic (TiledOptions::streams_threshold_m2), gathered from
   /// every tile, on rank 0 only: streams_of_cells makes the whole grid's reaches of them.
   std::function<void(StreamCells& cells)> streams;

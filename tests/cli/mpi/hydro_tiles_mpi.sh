@@ -1,13 +1,14 @@
 #!/usr/bin/env bash
 # `mpirun -np N terrapolis-mpi hydro --tile-size`: tiles dealt to 1, 2 and 4 ranks give the cells of
-# the whole grid and of the single-process tiled run, byte for byte; a depression and a flat that
+# the whole grid and of the single-process tiled run, byte for byte (basins included); a depression and a flat that
 # span four tiles each; a bad input is one error line from rank 0, exit 2, nothing left behind.
 # Usage: hydro_tiles_mpi.sh TERRAPOLIS SAMPLES SOURCE TERRAPOLIS_MPI MPIRUN (registered when MPI is found)
 # SPDX-License-Identifier: MIT
 source "$(dirname "$0")/../lib.sh" "$@"
 bin=$TP mpi_bin=$4 mpirun=${5:-mpirun} work=$WORK
 mpi() { local np=$1; shift; "$mpirun" -q --oversubscribe -np "$np" "$mpi_bin" "$@"; }  # -q: no notice of a non-zero exit
-outputs=(filled flowdir accumulation)
+outputs=(filled flowdir accumulation basins)
+all=filled,flowdir,accumulation,streams,basins
 
 # 300 x 300 cells of SRTM 1" (Zion), 3 x 3 tiles of 100: a pit 40 m deep on the corner where tiles
 # 0, 1, 3, 4 meet (filled, it is a lake flat on four tiles) and a plateau on the corner of 4, 5, 7, 8.
@@ -29,8 +30,8 @@ out.SetGeoTransform(src.GetGeoTransform())
 out.SetProjection(src.GetProjection())
 out.GetRasterBand(1).WriteArray(z)
 PY
-"$bin" -q hydro "$dem" "$work/whole" --outputs filled,flowdir,accumulation,streams --streams-threshold 0.5
-"$bin" -v hydro "$dem" "$work/tiled" --tile-size 100 --streams-threshold 0.5 2>"$work/tiled.log"
+"$bin" -q hydro "$dem" "$work/whole" --outputs $all --streams-threshold 0.5
+"$bin" -v hydro "$dem" "$work/tiled" --tile-size 100 --streams-threshold 0.5 --outputs $all 2>"$work/tiled.log"
 grep "^tiles: 9 of 100" "$work/tiled.log" | grep -Eq "; [1-9][0-9]* cells of flats across tiles" ||
   fail "expected 9 tiles and flats across tile edges: $(cat "$work/tiled.log")"
 for o in "${outputs[@]}"; do same_cells "$work/whole/$o.tif" "$work/tiled/$o.vrt" || fail "tiled $o differs from the whole grid"; done
@@ -43,8 +44,17 @@ gt = gdal.Open(sys.argv[1].replace("streams.geojson", "filled.vrt")).GetGeoTrans
 tiles = lambda line: {(int((y - gt[3]) / gt[5]) // 100, int((x - gt[0]) / gt[1]) // 100) for x, y in line}
 sys.exit(0 if max(len(tiles(f["geometry"]["coordinates"])) for f in json.load(open(sys.argv[1]))["features"]) >= 3 else 1)
 PY
+# A basin crossing tiles: the pit's lake drains on, so the basin holding the pit corner (100, 100)
+# spreads over the four tiles around it at least, under one label.
+/usr/bin/python3 - "$work/tiled/basins.vrt" <<'PY' || fail "no basin over four tiles"
+import sys
+from osgeo import gdal
+b = gdal.Open(sys.argv[1]).ReadAsArray()
+rows, cols = (b == b[100, 100]).nonzero()
+sys.exit(0 if b[100, 100] > 0 and len({(r // 100, c // 100) for r, c in zip(rows, cols)}) >= 4 else 1)
+PY
 for np in 1 2 4; do
-  mpi "$np" -v hydro "$dem" "$work/np$np" --tile-size 100 --streams-threshold 0.5 --threads 1 2>"$work/np$np.log" ||
+  mpi "$np" -v hydro "$dem" "$work/np$np" --tile-size 100 --streams-threshold 0.5 --outputs $all --threads 1 2>"$work/np$np.log" ||
     fail "np $np: $(cat "$work/np$np.log")"
   cmp -s "$work/whole/streams.geojson" "$work/np$np/streams.geojson" || fail "np $np: streams differ from the whole grid"
   grep -q "^tiles: 9 of 100.*; $np process" "$work/np$np.log" || fail "np $np: no tile report: $(cat "$work/np$np.log")"
