@@ -764,7 +764,7 @@ TargetSearch::TargetSearch(const RoadGraph& graph, Cell target) : state_(std::ma
 TargetSearch::~TargetSearch() = default;
 
 SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMethod method, std::size_t max_nodes,
-                           Progress* progress, double max_seconds, TargetSearch* shared) {
+                           Progress* progress, double max_seconds, TargetSearch* shared, const ArcDiscount* discount) {
   const auto started = std::chrono::steady_clock::now();
   std::size_t pops = 0;
   // The clock is read every 1024 pops (about a millisecond of search).
@@ -819,11 +819,20 @@ SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMet
     rel = &*state.relaxed;
     settled_before = rel->settled_cells();
   }
+  // Road reuse: a bound of the undiscounted costs times the smallest factor bounds the discounted
+  // ones (and stays consistent), so the heuristic is scaled; arcs are discounted as they are read.
+  const double h_scale = discount ? discount->floor : 1.0;
+  auto reuse = [&](Cell c, int a) {
+    if (!discount) return 1.0;
+    const RoadGraph::Arc& arc = graph.arcs()[std::size_t(a)];
+    const auto f = [&](int col, int row) { return discount->factor[t.index(col, row)]; };
+    return double(std::max({f(c.col, c.row), f(c.col + arc.dcol / 2, c.row + arc.drow / 2), f(c.col + arc.dcol, c.row + arc.drow)}));
+  };
   auto potential = [&](Cell v) {
     if (!use_h) return 0.0;
-    if (relaxed) return std::max(graph.lower_bound(v, to), rel->bound(v));
-    if (!bidir) return graph.lower_bound(v, to);
-    return 0.5 * (graph.lower_bound(v, to) - graph.lower_bound(v, from));
+    if (relaxed) return h_scale * std::max(graph.lower_bound(v, to), rel->bound(v));
+    if (!bidir) return h_scale * graph.lower_bound(v, to);
+    return h_scale * 0.5 * (graph.lower_bound(v, to) - graph.lower_bound(v, from));
   };
   auto ring_offset = [&](int r) {
     const RoadGraph::Ring& ring = graph.rings()[std::size_t(r)];
@@ -869,7 +878,7 @@ SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMet
       if (turn == kInfinity) continue;  // long arcs: the lists do not depend on the orientation
       double e;
       if (slot == 0) {
-        e = cache.get(c, costs, a);
+        e = cache.get(c, costs, a) * reuse(c, a);
       } else if (costs) {
         if (std::isnan(costs[i])) costs[i] = float(long_cost(c, a));
         e = costs[i];
@@ -896,7 +905,7 @@ SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMet
       const RoadGraph::Arc& arc = arcs[std::size_t(a)];
       const Cell p{c.col - arc.dcol, c.row - arc.drow};
       if (!t.inside(p.col, p.row)) continue;
-      const double e = slot == 0 ? cache.get(p, t.index(p.col, p.row), a) : long_cost(p, a);
+      const double e = slot == 0 ? cache.get(p, t.index(p.col, p.row), a) * reuse(p, a) : long_cost(p, a);
       if (e == kInfinity) continue;
       const double hp = potential(p);
       for (int po = 0; po < graph.orientations(); ++po) {
@@ -923,7 +932,7 @@ SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMet
     if (relaxed && q.ring < 0 && !rel->settled(c)) {
       // Queued with a bound of the relaxed distance: settle it, and queue the node again if its
       // key grew (keys only grow to admissible values, so the search stays exact).
-      const double f = q.g + std::max(graph.lower_bound(c, to), rel->exact(c));
+      const double f = q.g + h_scale * std::max(graph.lower_bound(c, to), rel->exact(c));
       if (f > q.f) {
         if (f < kInfinity) me.push({f, q.key, q.node, -1, q.g});
         return true;
