@@ -282,8 +282,10 @@ void roads_run(RunState& s, Progress& progress, const Log& log) {
           "one road per link with class, router, length, cost, grades, structures and its sections", Style::roads);
   s.write("roads", "sections.geojson", roads::network_sections_layer(terrain, r.layout),
           "the network drawn once: each section with the roads using it and their highest class", Style::sections);
-  s.write("roads", "junctions.geojson", roads::junctions_layer(terrain, r.layout), "where three or more sections meet, with their classes",
-          Style::junctions);
+  // An empty point layer has no geometry type QGIS can style: no junctions, no file.
+  if (!r.layout.junctions.empty())
+    s.write("roads", "junctions.geojson", roads::junctions_layer(terrain, r.layout), "where three or more sections meet, with their classes",
+            Style::junctions);
   s.write("roads", "road_sections.geojson", roads::sections_layer(terrain, r.roads), "road, bridge, tunnel and ferry sections",
           Style::road_sections);
   std::map<std::string, double> km;
