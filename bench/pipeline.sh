@@ -28,24 +28,8 @@ for dem in "${dems[@]}"; do
   stages=""
   for k in 1 2 3 4 5 6; do stages+=" $(cut -d' ' -f$k "$tmp/stages" | median)"; done
   printf '%-44s %8s %8s  %s\n' "$(basename "$dem")" "$(median < "$tmp/wall")" "$(median < "$tmp/mem")" "$stages"
-  # Network quality of the last run: circuity (road length over the geodesic distance of its ends;
-  # real regional networks: about 1.2-1.4, Ballou, Rahardja & Sakai 2002, Transp. Res. A) per link
-  # and for links of 10 km or more, and roads whose steepest step passes the 15 deg (26.8 %) threshold.
-  /usr/bin/python3 - "$tmp/run/roads.geojson" <<'PY' || true
-import json, math, sys
-def geod(a, b):  # haversine on the mean Earth radius (the ends are lon/lat on the SRTM and GEBCO tiles)
-    p1, p2 = math.radians(a[1]), math.radians(b[1]); dl = math.radians(b[0] - a[0])
-    h = math.sin((p2 - p1) / 2) ** 2 + math.cos(p1) * math.cos(p2) * math.sin(dl / 2) ** 2
-    return 2 * 6371008.8 * math.asin(math.sqrt(h))
-f = [x for x in json.load(open(sys.argv[1]))['features'] if x['properties']['router'] == 'galin']
-c = sorted(x['properties']['length_m'] / d for x in f if (d := geod(x['geometry']['coordinates'][0], x['geometry']['coordinates'][-1])) > 0)
-c10 = sorted(x['properties']['length_m'] / d for x in f if (d := geod(x['geometry']['coordinates'][0], x['geometry']['coordinates'][-1])) >= 1e4)
-q = lambda v, p: v[min(len(v) - 1, int(p * len(v)))] if v else float('nan')
-km = sum(x['properties']['length_m'] for x in f) / 1000
-steep = sum(1 for x in f if x['properties']['max_grade_pct'] > 26.8 + 0.05)
-print('  network: %.0f km, circuity median %.2f p90 %.2f (links >= 10 km: %d, median %.2f p90 %.2f), roads over 26.8 %%: %d' %
-      (km, q(c, .5), q(c, .9), len(c10), q(c10, .5), q(c10, .9), steep))
-PY
+  # Network quality of the last run (bench/network_quality.py: km, junctions, circuity, grades, water).
+  /usr/bin/python3 bench/network_quality.py "$tmp/run" || true
   # The last run's roads: count, links not routed within roads.max_seconds, lakes the DEM flattens.
-  /usr/bin/python3 -c "import json; r = json.load(open('$tmp/run/run.json'))['summary'].get('roads', {}); print('  roads:', {k: r.get(k) for k in ('roads', 'failed', 'not_routed_budget', 'flat_lakes', 'flat_lake_km2', 'length_km')})"
+  /usr/bin/python3 -c "import json; r = json.load(open('$tmp/run/run.json'))['summary'].get('roads', {}); print('  roads:', {k: r.get(k) for k in ('roads', 'failed', 'not_routed_budget', 'redundant', 'junctions', 'flat_lakes', 'flat_lake_km2', 'length_km')})"
 done

@@ -30,7 +30,7 @@ class RoadsCommand final : public Command {
   void setup(CLI::App& app) override {
     dem_.add_to(app);
     file_kind(app.add_option("NETWORK", network_, "network.geojson from the network stage (LineStrings: from, to, kept)")->required(), FileKind::vector_in);
-    file_kind(app.add_option("OUTDIR", outdir_, "Folder for roads.geojson and road_sections.geojson (its parent must exist)")->required(), FileKind::folder_out);
+    file_kind(app.add_option("OUTDIR", outdir_, "Folder for roads.geojson, road_sections.geojson, sections.geojson and junctions.geojson (its parent must exist)")->required(), FileKind::folder_out);
     file_kind(app.add_option("--cities", cities_, "Cities (Points: id, class); default: cities.geojson beside NETWORK when present"), FileKind::vector_in);
     app.add_flag("--corridor", corridor_,
                  "Also write corridors.geojson (per section: carriageway and earthworks zone) and add land take, cut, fill and "
@@ -75,7 +75,7 @@ class RoadsCommand final : public Command {
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     for (const std::string& f : result.failed) context.log.warn("no road under the cost model for edge " + f + " (left out)");
     for (const std::string& f : result.over_budget) context.log.warn("not routed: budget (--max-seconds) for edge " + f);
-    VectorLayer roads_layer = roads::roads_layer(terrain, result.roads);
+    VectorLayer roads_layer = roads::roads_layer(terrain, result.roads, &result.layout);
     roads::Corridors corridors;
     double corridor_seconds = 0;
     if (corridor_) {
@@ -88,6 +88,8 @@ class RoadsCommand final : public Command {
     }
     write_vector((dir / "roads.geojson").string(), roads_layer);
     write_vector((dir / "road_sections.geojson").string(), roads::sections_layer(terrain, result.roads));
+    write_vector((dir / "sections.geojson").string(), roads::network_sections_layer(terrain, result.layout));
+    write_vector((dir / "junctions.geojson").string(), roads::junctions_layer(terrain, result.layout));
     options_.write_earthworks(earthworks_path, dem, terrain, result.roads, corridor);
     outputs.commit();
     std::size_t ferries = 0;
@@ -97,8 +99,9 @@ class RoadsCommand final : public Command {
       km += r.stats.length_m / 1000;
     }
     char line[256];
-    std::snprintf(line, sizeof line, "%zu roads (%zu maritime links, %zu failed, %zu not routed: budget), %.1f km, %.2f s",
-                  result.roads.size(), ferries, result.failed.size(), result.over_budget.size(), km, seconds);
+    std::snprintf(line, sizeof line, "%zu roads (%zu maritime links, %zu failed, %zu not routed: budget, %zu redundant), %zu sections, %zu junctions, %.1f km, %.2f s",
+                  result.roads.size(), ferries, result.failed.size(), result.over_budget.size(), result.redundant.size(),
+                  result.layout.sections.size(), result.layout.junctions.size(), km, seconds);
     context.log.info(line);
     if (corridor_) context.log.info("corridors: " + roads::corridor_summary(corridors, corridor_seconds));
   }

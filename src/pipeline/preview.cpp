@@ -181,7 +181,13 @@ void write_preview(const RunState& state, const std::string& path, int width) {
     return "";
   };
   const double unit = std::max(1.0, width / 600.0);  // line widths grow with the image
-  for (Style pass : {Style::city_extents, Style::streams, Style::network, Style::road_sections, Style::roads, Style::cities}) {
+  // The network's sections draw each shared stretch once, in its highest class: when present they
+  // replace the per-link roads, which overlap along trunks.
+  bool has_sections = false;
+  for (const auto& v : state.vectors) has_sections = has_sections || v.first == Style::sections;
+  for (Style pass : {Style::city_extents, Style::streams, Style::network, Style::road_sections, Style::roads, Style::sections,
+                     Style::junctions, Style::cities}) {
+    if (pass == Style::roads && has_sections) continue;
     for (const auto& [style, layer] : state.vectors) {
       if (style != pass) continue;
       for (const auto& f : layer.features) {
@@ -193,12 +199,17 @@ void write_preview(const RunState& state, const std::string& path, int width) {
           canvas.disc(p[0], p[1], unit * std::max(1.0, 4.0 - cls), hex(0xcb181d));
           continue;
         }
+        if (style == Style::junctions) {
+          const auto p = to_px(layer, {f.parts[0][0]})[0];
+          canvas.disc(p[0], p[1], unit * 1.6, hex(0x252525));
+          continue;
+        }
         Rgb color = hex(0x2171b5);
         double w = unit;
         bool dashed = false;
         if (style == Style::streams) { w = unit * (0.5 + 0.3 * std::atoi(field(layer, f, "strahler").c_str())); }
         else if (style == Style::network) { if (field(layer, f, "kept") != "1") continue; color = hex(0x636363); w = unit * 0.6; dashed = true; }
-        else if (style == Style::roads) {
+        else if (style == Style::roads || style == Style::sections) {
           const auto& s = roads::style_of(roads::road_class_named(field(layer, f, "class")).value_or(roads::RoadClass::departmental));
           color = hex(unsigned(std::stoul(std::string(s.colour.substr(1)), nullptr, 16)));
           w = unit * (0.6 + 1.3 * s.width_mm);  // the QGIS widths, scaled to the image
@@ -216,7 +227,8 @@ void write_preview(const RunState& state, const std::string& path, int width) {
       }
       if (pass == Style::streams) legend.push_back({hex(0x2171b5), "streams", true});
       if (pass == Style::network) legend.push_back({hex(0x636363), "network", true});
-      if (pass == Style::roads) legend.push_back({hex(0xe31a1c), "roads", true});
+      if (pass == Style::roads || pass == Style::sections) legend.push_back({hex(0xe31a1c), "roads", true});
+      if (pass == Style::junctions) legend.push_back({hex(0x252525), "junctions", false});
       if (pass == Style::road_sections) legend.push_back({hex(0x08519c), "bridges", true});
       if (pass == Style::cities) legend.push_back({hex(0xcb181d), "cities", false});
     }

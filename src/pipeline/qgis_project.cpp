@@ -145,7 +145,9 @@ int draw_rank(Style s) {
     case Style::network: return 7;
     case Style::road_sections: return 8;
     case Style::roads: return 9;
-    case Style::cities: return 10;
+    case Style::sections: return 10;
+    case Style::junctions: return 11;
+    case Style::cities: return 12;
   }
   return 5;
 }
@@ -217,7 +219,8 @@ std::string qgis_style_body(const OutputFile& o, const RunState& state) {
     case Style::city_extents: return single(fill("0", "239,59,44,60", "165,15,21,255"));
     case Style::network:
       return categorized("kept", {{"1", "kept link", line("0", "#252525", 0.5)}, {"0", "removed candidate", line("1", "#bdbdbd", 0.2, "dash")}});
-    case Style::roads: {
+    case Style::roads:
+    case Style::sections: {
       std::vector<Category> cats;
       for (const roads::RoadClassStyle& s : roads::kRoadClasses)
         cats.push_back({std::string(s.name), std::string(s.label),
@@ -229,6 +232,7 @@ std::string qgis_style_body(const OutputFile& o, const RunState& state) {
                                        {"bridge", "bridge", line("1", "#1f78b4", 1.4)},
                                        {"tunnel", "tunnel", line("2", "#8c510a", 1.0, "dash")},
                                        {"ferry", "ferry", line("3", "#a6cee3", 0.6, "dot")}});
+    case Style::junctions: return single(marker("0", "#252525", 1.6));
   }
   return "";
 }

@@ -188,6 +188,13 @@ RoadsSettings roads_settings(const Scenario& scenario) {
   s.routing.bezier.tries = r["bezier_tries"].get<int>();
   s.vegetation = scenario.path("/roads/vegetation");
   s.routing.max_seconds = r["max_seconds"].get<double>();
+  for (std::size_t c = 0; c < s.routing.reuse_discount.size(); ++c) {
+    const std::string name(roads::name_of(roads::RoadClass(c)));
+    s.routing.reuse_discount[c] = r["reuse_discount"][name].get<double>();
+    s.routing.max_grade_pct[c] = r["max_grade_pct"][name].get<double>();
+    s.routing.min_radius_m[c] = r["min_radius_m"][name].get<double>();
+  }
+  s.routing.redundant_share = r["redundant_share"].get<double>();
   return s;
 }
 

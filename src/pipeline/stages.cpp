@@ -279,22 +279,35 @@ void roads_run(RunState& s, Progress& progress, const Log& log) {
   const roads::NetworkResult r = roads::route_network(terrain, graph, network::road_links(*s.network, &*s.cities), settings.routing, progress);
   for (const auto& f : r.failed) log.warn("no road: " + f);
   for (const auto& f : r.over_budget) log.warn("not routed: budget (roads.max_seconds): " + f);
-  s.write("roads", "roads.geojson", roads::roads_layer(terrain, r.roads), "roads with class, router, length, cost, grades, structures",
-          Style::roads);
+  for (const auto& f : r.redundant) log.info("redundant link dropped (roads.redundant_share): " + f);
+  s.write("roads", "roads.geojson", roads::roads_layer(terrain, r.roads, &r.layout),
+          "one road per link with class, router, length, cost, grades, structures and its sections", Style::roads);
+  s.write("roads", "sections.geojson", roads::network_sections_layer(terrain, r.layout),
+          "the network drawn once: each section with the roads using it and their highest class", Style::sections);
+  // An empty point layer has no geometry type QGIS can style: no junctions, no file.
+  if (!r.layout.junctions.empty())
+    s.write("roads", "junctions.geojson", roads::junctions_layer(terrain, r.layout), "where three or more sections meet, with their classes",
+            Style::junctions);
   s.write("roads", "road_sections.geojson", roads::sections_layer(terrain, r.roads), "road, bridge, tunnel and ferry sections",
           Style::road_sections);
   std::map<std::string, double> km;
-  double bridge_m = 0, tunnel_m = 0;
+  double bridge_m = 0, tunnel_m = 0, over_limit_m = 0, water_m = 0, network_km = 0;
   for (const auto& road : r.roads) {
     km[std::string(roads::name_of(road.road_class))] += road.stats.length_m / 1000;
     bridge_m += road.stats.bridge_m;
     tunnel_m += road.stats.tunnel_m;
+    over_limit_m += road.stats.over_limit_m;
+    water_m += road.stats.water_m;
   }
+  for (const auto& section : r.layout.sections) network_km += section.length_m / 1000;
   json per_class = json::object();
   for (const roads::RoadClassStyle& c : roads::kRoadClasses) per_class[std::string(c.name)] = round_to(km[std::string(c.name)], 0.01);
   s.summary["roads"] = {{"roads", r.roads.size()}, {"failed", r.failed.size()}, {"not_routed_budget", r.over_budget.size()},
+                        {"redundant", r.redundant.size()}, {"sections", r.layout.sections.size()}, {"junctions", r.layout.junctions.size()},
                         {"length_km", per_class},
-                        {"bridge_m", round_to(bridge_m, 0.1)}, {"tunnel_m", round_to(tunnel_m, 0.1)}};
+                        {"bridge_m", round_to(bridge_m, 0.1)}, {"tunnel_m", round_to(tunnel_m, 0.1)},
+                        {"network_km", round_to(network_km, 0.01)}, {"over_grade_limit_m", round_to(over_limit_m, 0.1)},
+                        {"on_water_m", round_to(water_m, 0.1)}};
 }
 
 void roads_load(RunState&) {}  // nothing downstream

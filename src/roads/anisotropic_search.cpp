@@ -155,6 +155,15 @@ class LongArcCache {
   std::vector<float> values_;
 };
 
+/// The factor of a surface arc along roads already built (ArcDiscount): the largest of its start,
+/// middle and end cells' (the weakest discount); 1 without reuse.
+double reuse_factor(const RoadGraph& graph, const ArcDiscount* discount, Cell c, int a) {
+  if (!discount) return 1.0;
+  const RoadGraph::Arc& arc = graph.arcs()[std::size_t(a)];
+  const auto f = [&](int col, int row) { return discount->factor[graph.terrain().index(col, row)]; };
+  return double(std::max({f(c.col, c.row), f(c.col + arc.dcol / 2, c.row + arc.drow / 2), f(c.col + arc.dcol, c.row + arc.drow)}));
+}
+
 /// Distances to the target on a relaxed 2-D graph: nodes are cells (the orientation dropped, so no
 /// turn is priced), arcs are every surface arc at its exact cost and every sampled bridge or tunnel
 /// arc at a lower bound of its cost (its deck slope term exact, the height or depth, water and
@@ -165,10 +174,14 @@ class LongArcCache {
 /// source and resumed on demand (Reverse Resumable A*, Silver 2005): `exact(v)` settles v; `bound(v)`
 /// never searches and returns the exact distance when v is settled, else the A* bound
 /// F - lower_bound(v, source) (F the smallest key still queued), which only grows.
+/// With road reuse (ArcDiscount) the surface arcs cost their discounted price, so the distances
+/// bound the discounted costs themselves, and the straight-line guide is scaled by the smallest
+/// factor to stay consistent: the forward search keeps a tight heuristic along and off the roads.
 class RelaxedDistance {
  public:
-  RelaxedDistance(const RoadGraph& graph, Cell target, Cell source, ArcCache& cache)
-      : graph_(graph), t_(graph.terrain()), source_(source), cache_(cache) {
+  RelaxedDistance(const RoadGraph& graph, Cell target, Cell source, ArcCache& cache, const ArcDiscount* discount)
+      : graph_(graph), t_(graph.terrain()), source_(source), cache_(cache), discount_(discount),
+        guide_scale_(discount ? discount->floor : 1.0) {
     if (scratch_in_use_) own_.emplace();  // a nested search on this thread gets its own arrays
     else scratch_in_use_ = true;
     Scratch& s = scratch();
@@ -231,7 +244,7 @@ class RelaxedDistance {
     Scratch& s = scratch();
     if (s.closed[i]) return s.g[i];
     if (heap_.empty()) return kInfinity;
-    return std::max(0.0, heap_.front().f - graph_.lower_bound(v, source_));
+    return std::max(0.0, heap_.front().f - guide(v));
   }
   bool settled(Cell v) { return scratch().closed[t_.index(v.col, v.row)] != 0; }
   std::size_t settled_cells() const { return settled_; }
@@ -243,7 +256,7 @@ class RelaxedDistance {
     source_ = source;
     for (Entry& e : heap_) {
       const Cell c{int(e.cell % std::size_t(t_.cols())), int(e.cell / std::size_t(t_.cols()))};
-      e.f = e.g + graph_.lower_bound(c, source_) + (e.ring >= 0 ? ring_offset_[std::size_t(e.ring)] : 0.0);
+      e.f = e.g + guide(c) + (e.ring >= 0 ? ring_offset_[std::size_t(e.ring)] : 0.0);
     }
     std::make_heap(heap_.begin(), heap_.end());
   }
@@ -273,7 +286,7 @@ class RelaxedDistance {
     if (s.g[i] == kInfinity) s.touched.push_back(i);
     s.g[i] = g;
     const Cell c{int(i % std::size_t(t_.cols())), int(i / std::size_t(t_.cols()))};
-    push({g + graph_.lower_bound(c, source_), g, i, -1});
+    push({g + guide(c), g, i, -1});
   }
   void push(const Entry& e) {
     heap_.push_back(e);
@@ -292,6 +305,9 @@ class RelaxedDistance {
     }
     return margin == kInfinity ? 0.0 : std::max(0.0, margin);
   }
+  /// The A* guide towards the source (scaled with road reuse; a smaller guide only widens the
+  /// ring margins, so the ring offsets stay valid).
+  double guide(Cell c) const { return guide_scale_ * graph_.lower_bound(c, source_); }
   /// Settles the next cell; false when the queue is empty.
   bool settle_next() {
     Scratch& s = scratch();
@@ -321,16 +337,17 @@ class RelaxedDistance {
       const std::size_t ui = t_.index(u.col, u.row);
       if (scratch().closed[ui]) continue;
       // The cheap bound first: most arcs into v cannot improve u, and need no integral.
-      const double lb = graph_.surface_arc_bound(u, int(a));
+      const double factor = reuse_factor(graph_, discount_, u, int(a));
+      const double lb = graph_.surface_arc_bound(u, int(a)) * factor;
       if (lb == kInfinity || d + lb >= scratch().g[ui]) continue;
-      const double e = cache_.get(u, ui, int(a));
+      const double e = cache_.get(u, ui, int(a)) * factor;
       if (e < kInfinity) relax(ui, d + e);
     }
     // Long arcs join two land cells. They wait in the queue, one entry per ring, keyed by f(v) plus
     // a lower bound of what an arc of the ring adds to its source's key (ring_margin), as the
     // forward search's rings do: most are never relaxed, the search ending first.
     if (graph_.rings().empty() || t_.water(v.col, v.row)) return;
-    const double f = d + graph_.lower_bound(v, source_);
+    const double f = d + guide(v);
     for (Structure st : {Structure::bridge, Structure::tunnel}) {
       const int r = graph_.first_ring(st);
       if (r >= 0) push({f + ring_offset_[std::size_t(r)], d, i, r});
@@ -364,7 +381,7 @@ class RelaxedDistance {
     if (ring.next >= 0) {
       Entry next = e;
       next.ring = ring.next;
-      next.f = d + graph_.lower_bound(v, source_) + ring_offset_[std::size_t(ring.next)];
+      next.f = d + guide(v) + ring_offset_[std::size_t(ring.next)];
       push(next);
     }
   }
@@ -373,6 +390,8 @@ class RelaxedDistance {
   const TerrainField& t_;
   Cell source_;
   ArcCache& cache_;
+  const ArcDiscount* discount_;  ///< road reuse, or nullptr
+  const double guide_scale_;     ///< the smallest discount factor, 1 without reuse
   std::optional<Scratch> own_;
   std::vector<Entry> heap_;
   double fixed_[3] = {0, 0, 0};
@@ -403,8 +422,9 @@ namespace {
 class PathSearch {
  public:
   PathSearch(const RoadGraph& graph, Cell from, Cell to, SearchMethod method, std::size_t max_nodes, Progress* progress,
-             double max_seconds, TargetSearch::State& state)
-      : graph_(graph), t_(graph.terrain()), arcs_(graph.arcs()), from_(from), to_(to), max_nodes_(max_nodes),
+             double max_seconds, TargetSearch::State& state, const ArcDiscount* discount)
+      : graph_(graph), t_(graph.terrain()), arcs_(graph.arcs()), discount_(discount),
+        h_scale_(discount ? discount->floor : 1.0), from_(from), to_(to), max_nodes_(max_nodes),
         max_seconds_(max_seconds), O_(std::uint64_t(graph.orientations())), use_h_(method != SearchMethod::dijkstra),
         bidir_(method == SearchMethod::bidirectional), relaxed_(method == SearchMethod::astar),
         goal_index_(t_.index(to.col, to.row)), cache_(state.arcs), long_cache_(state.long_arcs), fw_(t_.size(), O_),
@@ -412,8 +432,10 @@ class PathSearch {
     if (progress) step_.emplace(*progress, "route");
     h0_ = best_h_ = graph.lower_bound(from, to);
     if (relaxed_) {
-      if (state.relaxed) state.relaxed->set_source(from);
-      else state.relaxed.emplace(graph, to, from, cache_);
+      // With road reuse the roads built since the last search changed the discounted costs: the
+      // relaxed search starts again (its arc caches, of undiscounted costs, stay shared).
+      if (state.relaxed && !discount) state.relaxed->set_source(from);
+      else state.relaxed.reset(), state.relaxed.emplace(graph, to, from, cache_, discount);
       rel_ = &*state.relaxed;
       settled_before_ = rel_->settled_cells();
     }
@@ -444,18 +466,25 @@ class PathSearch {
   // reduced arc costs l(u,v) - p(u) + p(v) are >= 0 in both directions and the search may stop as
   // soon as top_f + top_b >= mu, the best meeting cost (the bidirectional Dijkstra rule on the
   // reduced costs).
+  // Road reuse (ArcDiscount): the straight-line bounds hold for the undiscounted costs, so times the
+  // smallest factor they bound the discounted ones and stay consistent; the relaxed distance is
+  // computed on the discounted costs (RelaxedDistance).
   double potential(Cell v) {
     if (!use_h_) return 0.0;
-    if (relaxed_) return std::max(graph_.lower_bound(v, to_), rel_->bound(v));
-    if (!bidir_) return graph_.lower_bound(v, to_);
-    return 0.5 * (graph_.lower_bound(v, to_) - graph_.lower_bound(v, from_));
+    if (relaxed_) return std::max(h_scale_ * graph_.lower_bound(v, to_), rel_->bound(v));
+    if (!bidir_) return h_scale_ * graph_.lower_bound(v, to_);
+    return h_scale_ * 0.5 * (graph_.lower_bound(v, to_) - graph_.lower_bound(v, from_));
   }
   double ring_offset(int r) const {
     const RoadGraph::Ring& ring = graph_.rings()[std::size_t(r)];
     // The relaxed distance is consistent but leaves no margin to add (its long arcs are already
-    // bounded by their structure's floor), so a ring waits only behind its node.
-    return relaxed_ ? 0.0 : use_h_ ? ring.with_heuristic : ring.without_heuristic;
+    // bounded by their structure's floor), so a ring waits only behind its node. With a scaled
+    // heuristic s h: arc + s dh >= s (arc + dh) + (1 - s) arc, so the bound mixes the two.
+    if (relaxed_) return 0.0;
+    if (!use_h_) return ring.without_heuristic;
+    return h_scale_ * ring.with_heuristic + (1 - h_scale_) * ring.without_heuristic;
   }
+  double reuse(Cell c, int a) const { return reuse_factor(graph_, discount_, c, a); }
   // Long arcs are priced as floats in both directions, cached or not, so every search sees the same costs.
   double long_cost(Cell from_cell, int a) const { return double(float(graph_.arc_cost(from_cell, a))); }
   void check_memory() const {
@@ -488,7 +517,7 @@ class PathSearch {
       if (turn == kInfinity) continue;  // long arcs: the lists do not depend on the orientation
       double e;
       if (slot == 0) {
-        e = cache_.get(c, costs, a);
+        e = cache_.get(c, costs, a) * reuse(c, a);
       } else if (costs) {
         if (std::isnan(costs[i])) costs[i] = float(long_cost(c, a));
         e = costs[i];
@@ -515,7 +544,7 @@ class PathSearch {
       const RoadGraph::Arc& arc = arcs_[std::size_t(a)];
       const Cell p{c.col - arc.dcol, c.row - arc.drow};
       if (!t_.inside(p.col, p.row)) continue;
-      const double e = slot == 0 ? cache_.get(p, t_.index(p.col, p.row), a) : long_cost(p, a);
+      const double e = slot == 0 ? cache_.get(p, t_.index(p.col, p.row), a) * reuse(p, a) : long_cost(p, a);
       if (e == kInfinity) continue;
       const double hp = potential(p);
       for (int po = 0; po < graph_.orientations(); ++po) {
@@ -541,7 +570,7 @@ class PathSearch {
     if (relaxed_ && q.ring < 0 && !rel_->settled(c)) {
       // Queued with a bound of the relaxed distance: settle it, and queue the node again if its
       // key grew (keys only grow to admissible values, so the search stays exact).
-      const double f = q.g + std::max(graph_.lower_bound(c, to_), rel_->exact(c));
+      const double f = q.g + std::max(h_scale_ * graph_.lower_bound(c, to_), rel_->exact(c));
       if (f > q.f) {
         if (f < kInfinity) me.push({f, q.key, q.node, -1, q.g});
         return true;
@@ -634,6 +663,8 @@ class PathSearch {
   const RoadGraph& graph_;
   const TerrainField& t_;
   const std::vector<RoadGraph::Arc>& arcs_;
+  const ArcDiscount* discount_;  ///< road reuse, or nullptr
+  const double h_scale_;         ///< the heuristic's factor: the smallest discount factor, 1 without reuse
   const Cell from_, to_;
   const std::size_t max_nodes_;
   const double max_seconds_;
@@ -656,7 +687,7 @@ class PathSearch {
 }  // namespace
 
 SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMethod method, std::size_t max_nodes,
-                           Progress* progress, double max_seconds, TargetSearch* shared) {
+                           Progress* progress, double max_seconds, TargetSearch* shared, const ArcDiscount* discount) {
   const TerrainField& t = graph.terrain();
   if (!t.inside(from.col, from.row) || !t.inside(to.col, to.row)) throw bad_input("path: an end point lies outside the DEM");
   if (from == to) {
@@ -669,7 +700,7 @@ SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMet
   if (shared && !(shared->state().target == to)) throw processing_error("path: a shared target search used for another target");
   std::optional<TargetSearch> own;
   TargetSearch::State& state = (shared ? *shared : own.emplace(graph, to)).state();
-  return PathSearch(graph, from, to, method, max_nodes, progress, max_seconds, state).run();
+  return PathSearch(graph, from, to, method, max_nodes, progress, max_seconds, state, discount).run();
 }
 
 }  // namespace terrapolis::roads

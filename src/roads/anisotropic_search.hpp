@@ -3,6 +3,7 @@
 #pragma once
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "core/progress.hpp"
@@ -47,6 +48,16 @@ class TargetSearch {
   std::unique_ptr<State> state_;
 };
 
+/// Cheaper surface arcs along roads already built (Galin et al. 2011: the next roads reuse them).
+/// `factor[cell]` in (0, 1] multiplies a surface arc whose start, middle and end cells carry a road
+/// (the largest of the three: the weakest discount); 1 off roads. Bridges and tunnels keep their
+/// cost. `floor` is the smallest factor: the heuristic is scaled by it, so it stays a lower bound
+/// of the discounted costs and the search stays exact.
+struct ArcDiscount {
+  std::span<const float> factor;
+  double floor = 1;
+};
+
 /// Shortest path from `from` to `to` (any final orientation). Nodes are stored per touched cell so
 /// memory grows with the explored region only. Long arcs are priced lazily: expanding a node queues
 /// one entry per ring keyed by a lower bound of what its arcs could reach, and the ring is priced only
@@ -55,8 +66,10 @@ class TargetSearch {
 /// stored. Returns found = false when no finite-cost path exists.
 /// `max_seconds` > 0: give up after that long (wall clock) and return over_budget = true.
 /// `shared`: the state of earlier searches to the same `to` (see TargetSearch), or nullptr.
+/// `discount`: road reuse (see ArcDiscount), or nullptr; the caches in `shared` stay valid across
+/// discounts (they hold undiscounted costs).
 SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMethod method,
                            std::size_t max_nodes = 60'000'000, Progress* progress = nullptr, double max_seconds = 0,
-                           TargetSearch* shared = nullptr);
+                           TargetSearch* shared = nullptr, const ArcDiscount* discount = nullptr);
 
 }  // namespace terrapolis::roads

@@ -55,6 +55,9 @@ struct CostModel {
   double structure_min_m = 5;           ///< h_B / h_T of the segmentation (Peytavie §4.4.2), m
   double road_radius_m = 10;            ///< road half-width + margin: water is looked for within it (m)
   double smoothing_tolerance_cells = 1; ///< max deviation of the smoothed road from the grid path (cells)
+  /// Smallest curve radius of the smoothing (m; 0 = none): a corner's curve may leave the tolerance
+  /// to reach it (its grade still checked). Set per road class (roads.min_radius_m), not in the file.
+  double min_curve_radius_m = 0;
 
   /// Cheapest cost per metre of any enabled structure (A* heuristic factor, Peytavie §4.1.2.4).
   double cheapest_per_metre() const;

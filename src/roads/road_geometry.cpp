@@ -133,8 +133,11 @@ std::vector<GridPoint> smooth_run(const TerrainField& terrain, const CostModel& 
     // Clothoid pair: tangent length u, apex u * apex/tangent from the vertex, within the tolerance.
     std::vector<GridPoint> curve;
     const ClothoidShape shape = clothoid_shape(theta);
+    // Radius at the apex of a clothoid pair: spiral length / turn; the class's smallest radius
+    // needs a tangent of at least u_radius, and may push the curve past the corridor's tolerance.
+    const double u_radius = model.min_curve_radius_m * theta * shape.tangent_per_m;
     double u = std::min(0.5 * la, 0.5 * lb);
-    if (shape.apex_per_m > 1e-12) u = std::min(u, tol_m * shape.tangent_per_m / shape.apex_per_m);
+    if (shape.apex_per_m > 1e-12) u = std::min(u, std::max(u_radius, tol_m * shape.tangent_per_m / shape.apex_per_m));
     // A curve must keep under the slope threshold and, since it cuts across the slope, must not be
     // more than 1 degree steeper than the corner of the grid path it replaces.
     auto grade_ok = [&](const std::vector<GridPoint>& c, double cut_m) {
@@ -152,6 +155,7 @@ std::vector<GridPoint> smooth_run(const TerrainField& terrain, const CostModel& 
       curve.clear();
     }
     if (!curve.empty()) ++counts.clothoid_corners;
+    if (!curve.empty() && u < u_radius * (1 - 1e-9)) ++counts.tight_corners;
     if (curve.empty()) {
       // G1 fallback: a quadratic Bézier whose apex lies 0.5 u sin(theta/2) from the vertex.
       double uq = std::min({0.5 * la, 0.5 * lb, tol_m / (0.5 * std::sin(0.5 * theta))});
@@ -162,9 +166,11 @@ std::vector<GridPoint> smooth_run(const TerrainField& terrain, const CostModel& 
         curve.clear();
       }
       if (!curve.empty()) ++counts.g1_corners;
+      if (!curve.empty() && u_radius > 0) ++counts.tight_corners;  // a quadratic's apex curvature is not checked
     }
     if (curve.empty()) {
       ++counts.sharp_corners;
+      if (u_radius > 0) ++counts.tight_corners;
       densify(out, terrain, cursor, v, step);
       cursor = v;
       continue;
@@ -252,9 +258,11 @@ RoadGeometry surface_geometry(const TerrainField& terrain, const CostModel& mode
   return road;
 }
 
-RoadStats road_stats(const TerrainField& terrain, const RoadGeometry& road) {
+RoadStats road_stats(const TerrainField& terrain, const CostModel& model, const RoadGeometry& road) {
   RoadStats s;
-  double weighted = 0;
+  const double threshold = model.road.slope_deg.threshold;
+  s.grade_limit_pct = threshold < 90 ? 100.0 * std::tan(threshold / kDeg) : kInfinity;
+  double weighted = 0, run = 0;
   for (std::size_t i = 0; i + 1 < road.points.size(); ++i) {
     const double l = terrain.length_m(road.points[i], road.points[i + 1]);
     if (l <= 0) continue;
@@ -264,6 +272,20 @@ RoadStats road_stats(const TerrainField& terrain, const RoadGeometry& road) {
     s.max_grade_pct = std::max(s.max_grade_pct, grade);
     if (road.segments[i] == Structure::bridge) s.bridge_m += l;
     if (road.segments[i] == Structure::tunnel) s.tunnel_m += l;
+    if (road.segments[i] != Structure::road) {
+      run = 0;
+      continue;
+    }
+    const GridPoint m = lerp(road.points[i], road.points[i + 1], 0.5);
+    if (terrain.depth_at(m.col, m.row) > 0) s.water_m += l;
+    // 1e-6: the grades the search and the smoothing checked, up to rounding.
+    if (grade > s.grade_limit_pct * (1 + 1e-6)) {
+      s.over_limit_m += l;
+      run += l;
+      s.longest_over_limit_m = std::max(s.longest_over_limit_m, run);
+    } else {
+      run = 0;
+    }
   }
   s.mean_grade_pct = s.length_m > 0 ? weighted / s.length_m : 0;
   return s;

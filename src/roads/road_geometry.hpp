@@ -18,6 +18,9 @@ struct RoadGeometry {
   std::vector<Structure> segments;
   /// How the corners of the surface runs were rounded: clothoid pairs, G1 fallback, left sharp.
   int clothoid_corners = 0, g1_corners = 0, sharp_corners = 0;
+  /// Corners whose curve is tighter than model.min_curve_radius_m (short legs or a steep slope
+  /// left no room), sharp corners included.
+  int tight_corners = 0;
   /// Surface runs left as the grid path because their smoothed curve broke the slope threshold.
   int unsmoothed_runs = 0;
 };
@@ -64,8 +67,13 @@ struct RoadStats {
   double max_grade_pct = 0;   ///< steepest grade over the segments, %
   double mean_grade_pct = 0;  ///< length-weighted mean absolute grade, %
   double bridge_m = 0, tunnel_m = 0;
+  double grade_limit_pct = 0;        ///< the model's road slope threshold as a grade (the class's design limit)
+  double over_limit_m = 0;           ///< surface length steeper than grade_limit_pct
+  double longest_over_limit_m = 0;   ///< the longest run of such surface segments
+  double water_m = 0;                ///< surface length on water (no bridge)
 };
-RoadStats road_stats(const TerrainField& terrain, const RoadGeometry& road);
+/// Statistics of a road; the grade limit is `model`'s road slope threshold.
+RoadStats road_stats(const TerrainField& terrain, const CostModel& model, const RoadGeometry& road);
 
 /// Consecutive segments of one structure.
 struct RoadSection {

@@ -49,6 +49,7 @@ class RoadGraph {
   int start_orientation() const { return orientations_ - 1; }
   const TerrainField& terrain() const { return terrain_; }
   const CostModel& model() const { return model_; }
+  const GraphOptions& options() const { return options_; }
   std::size_t surface_arcs() const { return surface_arcs_; }
 
   /// Cost of the straight arc from `from` through arc `arc` (no turn), infinity when forbidden.

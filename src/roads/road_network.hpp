@@ -1,6 +1,7 @@
 // Routing single roads and whole networks, and their GeoJSON layers (roads, sections).
 // SPDX-License-Identifier: MIT
 #pragma once
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -10,6 +11,7 @@
 #include "io/vector_io.hpp"
 #include "roads/anisotropic_search.hpp"
 #include "roads/bezier_router.hpp"
+#include "roads/network_sections.hpp"
 #include "roads/road_class.hpp"
 #include "roads/road_geometry.hpp"
 
@@ -25,7 +27,22 @@ struct RoutingOptions {
   std::size_t max_nodes = 60'000'000;
   int snap_cells = 3;  ///< an end on water moves to the nearest land cell within this many cells
   double max_seconds = 0;  ///< per-road search budget (wall clock; 0 = none): past it the link is not routed
+  /// Road reuse (Galin et al. 2011), per class of the road already on a cell (motorway, national,
+  /// departmental, local): the share of a surface arc's cost taken off along it (0 = roads ignore
+  /// each other; below 1).
+  std::array<double, 4> reuse_discount{0.6, 0.5, 0.4, 0.3};
+  /// Redundancy: a link whose route runs on earlier roads for at least this share of its length,
+  /// between two ends the network already joins, is dropped (> 1 keeps every link).
+  double redundant_share = 0.8;
+  /// Design standards per class (motorway, national, departmental, local; docs/roads.md): the
+  /// steepest grade (%) of a road, bridge deck or tunnel of the class (the cost model's slope
+  /// thresholds are lowered to it), and the smallest curve radius (m) of its smoothing.
+  std::array<double, 4> max_grade_pct{6, 7, 10, 12};
+  std::array<double, 4> min_radius_m{400, 120, 60, 30};
 };
+
+/// The cost model of a road class: every slope threshold at most the class's grade, its curve radius.
+CostModel class_model(CostModel model, double max_grade_pct, double min_radius_m);
 
 /// One routed road with everything the outputs need.
 struct Road {
@@ -41,14 +58,16 @@ struct Road {
   bool ferry = false;
   bool over_budget = false;  ///< the search ran out of max_seconds: no geometry, not written
   std::vector<GridPoint> ferry_line;  ///< for maritime links: the straight crossing
+  CellChain chain;  ///< the route cell by cell (empty for a ferry): reuse, sections, junctions
 };
 
 /// Routes one road between two cells. Ends on water are moved to land (snap_cells); ends on two
 /// different land masses give a maritime link. Returns nullopt when no road exists (e.g. the slope
 /// threshold closes every way) and no maritime link applies.
 /// `shared`: the target search of earlier roads ending at the same (snapped) `to`, or nullptr.
+/// `discount`: cheaper arcs along earlier roads (road reuse), or nullptr.
 std::optional<Road> route_road(const TerrainField& terrain, const RoadGraph& graph, Cell from, Cell to, const RoutingOptions& options,
-                               Progress* progress = nullptr, TargetSearch* shared = nullptr);
+                               Progress* progress = nullptr, TargetSearch* shared = nullptr, const ArcDiscount* discount = nullptr);
 
 /// A network link to route: its two settlements (ids), their centres in the DEM's CRS, its class.
 struct Link {
@@ -57,18 +76,24 @@ struct Link {
   RoadClass road_class = RoadClass::departmental;
 };
 
-/// Roads of the links. Roads are routed in parallel (oneTBB) into a vector indexed by link, so the
-/// output does not depend on the threads. Links with no road are reported in `failed` and left out.
+/// Roads of the links, as a network (Galin et al. 2011): links are routed by importance (class,
+/// then the longer first), each on the costs discounted along the roads before it, so roads merge
+/// into trunks; a link whose route is mostly on earlier roads is dropped (redundant_share).
+/// Links are routed one after the other in that order, so the output does not depend on the threads.
+/// Links with no road are reported in `failed` and left out. Roads are listed in link order.
 struct NetworkResult {
   std::vector<Road> roads;
   std::vector<std::string> failed;
   std::vector<std::string> over_budget;  ///< links not routed within roads.max_seconds ("from-to")
+  std::vector<std::string> redundant;    ///< links dropped: their route ran on earlier roads ("from-to")
+  RoadNetworkLayout layout;              ///< the roads' shared sections and junctions
 };
 NetworkResult route_network(const TerrainField& terrain, const RoadGraph& graph, const std::vector<Link>& links,
                             const RoutingOptions& options, Progress& progress);
 
 /// The roads layer (one LineString per road, in the DEM's CRS) and the sections layer.
-VectorLayer roads_layer(const TerrainField& terrain, const std::vector<Road>& roads);
+/// With `layout`, each road lists its sections' ids (field `sections`).
+VectorLayer roads_layer(const TerrainField& terrain, const std::vector<Road>& roads, const RoadNetworkLayout* layout = nullptr);
 VectorLayer sections_layer(const TerrainField& terrain, const std::vector<Road>& roads);
 
 /// The nearest land cell within `radius` cells of `cell` (itself when on land), or nullopt.

@@ -10,7 +10,7 @@ for f in run1/*; do
 done
 for f in elevation.tif hillshade.tif filled.tif flowdir.tif accumulation.tif hydrometry.tif streams.geojson \
          coast.tif plateau.tif plain.tif buildable.tif density.tif cities.geojson city_extents.geojson \
-         network.geojson roads.geojson road_sections.geojson elevation.qml roads.qml project.qgs preview.png run.json; do
+         network.geojson roads.geojson road_sections.geojson sections.geojson junctions.geojson elevation.qml roads.qml project.qgs preview.png run.json; do
   [[ -s run1/$f ]] || fail "run1/$f missing"
 done
 # Every stage ran and the summary holds its figures; the kept network is connected and each kept
@@ -23,7 +23,7 @@ s = m["summary"]
 assert s["hydro"]["stream_reaches"] > 0 and s["sites"]["cities"] > 0, s
 assert sum(c["cities"] for c in s["sites"]["per_class"].values()) == s["sites"]["cities"], s["sites"]
 assert 0 < s["density"]["mean_density"] <= 1, s["density"]
-assert s["roads"]["roads"] + s["roads"]["failed"] == s["network"]["kept_edges"], (s["roads"], s["network"])
+assert s["roads"]["roads"] + s["roads"]["failed"] + s["roads"]["redundant"] == s["network"]["kept_edges"], (s["roads"], s["network"])
 assert sum(s["roads"]["length_km"].values()) > 0, s["roads"]
 PY
 gdalinfo run1/elevation.tif | grep -q "LAYOUT=COG" || fail "elevation.tif is not a COG"

@@ -126,6 +126,43 @@ TEST(AnisotropicSearch, RoadsSharingATargetSearchKeepDijkstrasCosts) {
   EXPECT_THROW(shortest_path(graph, {0, 0}, {4, 4}, SearchMethod::astar, 60'000'000, nullptr, 0, &shared), Error);
 }
 
+TEST(AnisotropicSearch, EveryHeuristicKeepsDijkstrasCostWithRoadReuse) {
+  // Random roads already built (cells at factor 0.3..1) and a shared target search reused across
+  // discounts: every search returns Dijkstra's cost for the discounted costs, never above the
+  // undiscounted optimum.
+  std::mt19937_64 rng(11);
+  int found = 0, cheaper = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    const RandomProblem problem(rng);
+    const RoadGraph& graph = problem.graph;
+    const Cell target{int(rng() % 16), int(rng() % 16)};
+    std::vector<float> factor(problem.terrain.size(), 1.0f);
+    const int row = int(rng() % 16);
+    for (int c = 0; c < 16; ++c) factor[problem.terrain.index(c, row)] = 0.3f + 0.2f * float(rng() % 3);  // a road along a row
+    for (int r = 0; r < 16; ++r) factor[problem.terrain.index(int(rng() % 16), r)] = 0.5f;                // and scattered cells
+    const ArcDiscount discount{factor, 0.3};
+    TargetSearch shared(graph, target);
+    for (int road = 0; road < 3; ++road) {
+      const Cell source{int(rng() % 16), int(rng() % 16)};
+      const SearchResult plain = shortest_path(graph, source, target, SearchMethod::dijkstra);
+      const SearchResult d = shortest_path(graph, source, target, SearchMethod::dijkstra, 60'000'000, nullptr, 0, nullptr, &discount);
+      ASSERT_EQ(d.found, plain.found) << trial;
+      if (!d.found) continue;
+      ++found;
+      EXPECT_LE(d.cost, plain.cost * (1 + 1e-12)) << trial;
+      cheaper += d.cost < 0.999 * plain.cost;
+      for (SearchMethod method : {SearchMethod::astar, SearchMethod::astar_distance, SearchMethod::bidirectional}) {
+        const SearchResult s = shortest_path(graph, source, target, method, 60'000'000, nullptr, 0,
+                                             method == SearchMethod::astar ? &shared : nullptr, &discount);
+        ASSERT_TRUE(s.found) << trial;
+        EXPECT_NEAR(s.cost, d.cost, 1e-9 * (1 + d.cost)) << trial << " method " << int(method);
+      }
+    }
+  }
+  EXPECT_GE(found, 60);
+  EXPECT_GE(cheaper, 20);  // the discount does change the costs
+}
+
 TEST(AnisotropicSearch, NoSurfaceArcSteeperThanTheThresholdAndNoInfiniteArc) {
   std::mt19937_64 rng(7);
   for (int trial = 0; trial < 10; ++trial) {

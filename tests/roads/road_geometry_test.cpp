@@ -123,7 +123,7 @@ TEST(RoadGeometry, NoRoadSteeperThanTheSlopeThresholdOnACone) {
       if (!path.found) continue;
       ++routed;
       const RoadGeometry road = build_road_geometry(terrain, model, path);
-      EXPECT_LE(road_stats(terrain, road).max_grade_pct, limit_pct + 1e-6) << a.col << "," << a.row << " structures " << structures;
+      EXPECT_LE(road_stats(terrain, model, road).max_grade_pct, limit_pct + 1e-6) << a.col << "," << a.row << " structures " << structures;
     }
     EXPECT_GE(routed, 3);
   }

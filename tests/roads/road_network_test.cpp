@@ -4,6 +4,7 @@
 #include <tbb/global_control.h>
 
 #include <cmath>
+#include <numbers>
 
 #include "roads/road_network.hpp"
 #include "roads_fixtures.hpp"
@@ -68,13 +69,15 @@ TEST(RoadNetwork, SameOutputWithOneAndTwoThreadsAndFerriesBetweenIslands) {
       RoutingOptions o;
       o.router = router;
       o.graph = {4, 8, 9};
+      o.max_grade_pct = {27, 27, 27, 27};  // the islands are steep: the default threshold's grade
       const NetworkResult r = route_network(terrain, graph, net, o, silent);
       ASSERT_EQ(r.roads.size(), 4u);
       EXPECT_TRUE(r.roads[2].ferry);  // the two islands
       EXPECT_EQ(r.roads[2].router, "ferry");
       EXPECT_FALSE(r.roads[0].ferry);
       EXPECT_EQ(r.roads[0].router, router == Router::galin ? "galin" : "bezier");
-      outputs[threads - 1] += dump(roads_layer(terrain, r.roads)) + dump(sections_layer(terrain, r.roads));
+      outputs[threads - 1] += dump(roads_layer(terrain, r.roads, &r.layout)) + dump(sections_layer(terrain, r.roads)) +
+                              dump(network_sections_layer(terrain, r.layout)) + dump(junctions_layer(terrain, r.layout));
     }
   }
   EXPECT_EQ(outputs[0], outputs[1]);
@@ -106,7 +109,9 @@ TEST(RoadNetwork, LinksKeepTheirClassAndFerriesAreMaritime) {
   net[0].road_class = RoadClass::national;
   net[1].road_class = RoadClass::motorway;
   SilentProgress silent;
-  const NetworkResult r = route_network(terrain, graph, net, RoutingOptions{}, silent);
+  RoutingOptions o;
+  o.max_grade_pct = {27, 27, 27, 27};  // the islands are steep: the default threshold's grade
+  const NetworkResult r = route_network(terrain, graph, net, o, silent);
   ASSERT_EQ(r.roads.size(), 2u);
   EXPECT_EQ(r.roads[0].road_class, RoadClass::national);
   EXPECT_EQ(r.roads[1].road_class, RoadClass::maritime);  // the two islands
@@ -171,6 +176,7 @@ TEST(RoadNetwork, ABudgetMarksLinksNotRoutedAndKeepsTheOthers) {
   SilentProgress silent;
   RoutingOptions o;
   o.graph = {3, 8, 1};
+  o.max_grade_pct = {27, 27, 27, 27};  // the islands are steep: the default threshold's grade
   o.max_seconds = 1e-9;  // every search runs out at its first check
   const NetworkResult r = route_network(terrain, graph, net, o, silent);
   EXPECT_EQ(r.over_budget.size(), 2u);  // the two land links
@@ -179,4 +185,131 @@ TEST(RoadNetwork, ABudgetMarksLinksNotRoutedAndKeepsTheOthers) {
   EXPECT_TRUE(r.failed.empty());
   o.max_seconds = 3600;
   EXPECT_TRUE(route_network(terrain, graph, net, o, silent).over_budget.empty());
+}
+
+namespace {
+
+/// A flat valley floor 100 x 40 cells of 10 m between steep sides (rows < 6 and > 34).
+Dem valley() {
+  return test::make_dem(100, 40, 10.0, [](int, int r) { return r < 6 ? 100.0 + 30 * (6 - r) : r > 34 ? 100.0 + 30 * (r - 34) : 100.0; });
+}
+
+/// Share of a road's chain cells lying on `row`.
+double share_on_row(const TerrainField& t, const Road& r, int row) {
+  std::size_t n = 0;
+  for (std::uint32_t c : r.chain.cells) n += c / std::uint32_t(t.cols()) == std::uint32_t(row);
+  return double(n) / double(r.chain.cells.size());
+}
+
+}  // namespace
+
+TEST(RoadNetwork, ASecondRoadJoinsTheFirstAlongTheValley) {
+  // A motorway along row 20, then a local road parallel to it 4 cells away (rows 24, 10 -> 90).
+  // On its own the local road runs straight along row 24 (80 cells). With a 50 % discount on the
+  // motorway's cells, going over to it (about 4 cells each way) and along it (72 cells at half
+  // price, 36) costs about 45: the local road joins the motorway and leaves it near its end.
+  const Dem dem = valley();
+  const TerrainField terrain(dem, 0.0, 10.0, 0.0);
+  CostModel model = default_cost_model();
+  model.bridge.enabled = model.tunnel.enabled = false;
+  const RoadGraph graph(terrain, model, {4, 8, 1});
+  std::vector<Link> net = network(dem, {{10, 24, 90, 24}, {5, 20, 95, 20}});
+  net[0].road_class = RoadClass::local;
+  net[1].road_class = RoadClass::motorway;  // routed first although listed second
+  SilentProgress silent;
+  RoutingOptions alone;
+  alone.graph = {4, 8, 1};
+  alone.reuse_discount = {0, 0, 0, 0};
+  const NetworkResult apart = route_network(terrain, graph, net, alone, silent);
+  ASSERT_EQ(apart.roads.size(), 2u);
+  EXPECT_GT(share_on_row(terrain, apart.roads[0], 24), 0.9);
+  EXPECT_EQ(share_on_row(terrain, apart.roads[0], 20), 0.0);
+  EXPECT_TRUE(apart.layout.junctions.empty());
+  EXPECT_EQ(apart.layout.sections.size(), 2u);
+
+  RoutingOptions reuse = alone;
+  reuse.reuse_discount = {0.5, 0.5, 0.5, 0.5};
+  const NetworkResult joined = route_network(terrain, graph, net, reuse, silent);
+  ASSERT_EQ(joined.roads.size(), 2u);  // not redundant: its ends were not on the network
+  EXPECT_TRUE(joined.redundant.empty());
+  EXPECT_GT(share_on_row(terrain, joined.roads[0], 20), 0.75);
+  EXPECT_LT(*joined.roads[0].cost, 0.7 * *apart.roads[0].cost);
+  // Trunk: west part, shared part, east part; two spurs; two junctions where the spurs meet it.
+  const RoadNetworkLayout& l = joined.layout;
+  ASSERT_EQ(l.junctions.size(), 2u);
+  for (const Junction& j : l.junctions) {
+    EXPECT_EQ(j.degree, 3);
+    EXPECT_EQ(j.roads, 2u);
+    EXPECT_EQ(j.classes, (std::vector<RoadClass>{RoadClass::motorway, RoadClass::local}));
+    EXPECT_EQ(j.cell / std::uint32_t(terrain.cols()), 20u);
+  }
+  ASSERT_EQ(l.sections.size(), 5u);
+  std::size_t shared = 0;
+  for (const NetworkSection& s : l.sections) {
+    if (s.roads.size() != 2) continue;
+    ++shared;
+    EXPECT_EQ(s.road_class, RoadClass::motorway);  // the highest class of its roads
+    EXPECT_GT(s.length_m, 600.0);
+  }
+  EXPECT_EQ(shared, 1u);
+  EXPECT_EQ(l.road_sections[0].size(), 3u);  // spur, shared trunk, spur
+  EXPECT_EQ(l.road_sections[1].size(), 3u);  // west, shared, east
+}
+
+TEST(RoadNetwork, ALinkRunningOnEarlierRoadsBetweenJoinedEndsIsDropped) {
+  // A motorway A-B along row 20, a town C two cells off it. A-C joins the motorway and branches to
+  // C (its end C is new: kept); C-B then runs on A-C's spur and the motorway only, between ends
+  // the network already joins: redundant.
+  const Dem dem = valley();
+  const TerrainField terrain(dem, 0.0, 10.0, 0.0);
+  CostModel model = default_cost_model();
+  model.bridge.enabled = model.tunnel.enabled = false;
+  const RoadGraph graph(terrain, model, {4, 8, 1});
+  std::vector<Link> net = network(dem, {{10, 20, 90, 20}, {10, 20, 52, 22}, {52, 22, 90, 20}});
+  net[0].road_class = RoadClass::motorway;
+  net[1].road_class = net[2].road_class = RoadClass::local;
+  net[2].from = 7;
+  SilentProgress silent;
+  RoutingOptions o;
+  o.graph = {4, 8, 1};
+  const NetworkResult r = route_network(terrain, graph, net, o, silent);
+  EXPECT_EQ(r.roads.size(), 2u);
+  ASSERT_EQ(r.redundant.size(), 1u);
+  EXPECT_EQ(r.redundant[0], "7-3");
+  o.redundant_share = 1.01;  // keeps every link
+  EXPECT_EQ(route_network(terrain, graph, net, o, silent).roads.size(), 3u);
+}
+
+TEST(RoadNetwork, GradesNeverExceedTheClassLimitOnACone) {
+  // A cone of 20 degree flanks (36 %) on a plain: every class climbs to a town half-way up within
+  // its design grade (slanting across the flank), its surface never steeper; tighter classes climb longer.
+  const Dem dem = test::make_dem(80, 80, 10.0, [](int c, int r) {
+    const double d = std::hypot(c - 39.5, r - 39.5) * 10.0;
+    return 20.0 + std::max(0.0, 120.0 - d * std::tan(20.0 * std::numbers::pi / 180));
+  });
+  const TerrainField terrain(dem, 0.0, 10.0, 0.0);
+  CostModel model = default_cost_model();
+  model.bridge.enabled = model.tunnel.enabled = false;
+  const RoadGraph graph(terrain, model, {5, 16, 3});
+  SilentProgress silent;
+  RoutingOptions o;
+  o.graph = {5, 16, 3};
+  o.reuse_discount = {0, 0, 0, 0};
+  o.max_grade_pct = {8, 10, 12, 16};
+  double previous = 0;
+  for (RoadClass c : {RoadClass::local, RoadClass::departmental, RoadClass::national, RoadClass::motorway}) {
+    std::vector<Link> net = network(dem, {{2, 40, 24, 40}});  // 60 m up at 16 cells from the top
+    net[0].road_class = c;
+    const NetworkResult r = route_network(terrain, graph, net, o, silent);
+    ASSERT_EQ(r.roads.size(), 1u) << name_of(c);
+    const RoadStats& s = r.roads[0].stats;
+    const double limit = o.max_grade_pct[std::size_t(c)];
+    EXPECT_NEAR(s.grade_limit_pct, limit, 1e-9);
+    EXPECT_LE(s.max_grade_pct, limit * (1 + 1e-6)) << name_of(c);
+    EXPECT_EQ(s.over_limit_m, 0.0) << name_of(c);
+    EXPECT_EQ(s.longest_over_limit_m, 0.0) << name_of(c);
+    EXPECT_EQ(s.water_m, 0.0);
+    EXPECT_GT(s.length_m, previous) << name_of(c);  // a gentler grade is a longer road
+    previous = s.length_m;
+  }
 }

@@ -1,0 +1,98 @@
+#!/usr/bin/env python3
+"""Network quality of a run folder (terrapolis run): what real road networks look like.
+
+Prints total road length (the network drawn once, sections.geojson), junctions, circuity (road
+length over the geodesic distance of its ends) per link and between city pairs 10 km or more
+apart through the network (Dijkstra on the sections; real regional networks: about 1.2-1.4,
+Ballou, Rahardja & Sakai 2002, "Selected country circuity factors for road travel distance
+estimation", Transportation Research A 36), the share of surface length above each class's grade
+limit, and the surface length on water (no bridge).
+Usage: network_quality.py RUN_FOLDER   (coordinates in lon/lat: the SRTM and GEBCO tiles)
+"""
+import heapq
+import json
+import math
+import os
+import sys
+
+
+def geod(a, b):  # haversine on the mean Earth radius
+    p1, p2 = math.radians(a[1]), math.radians(b[1])
+    dl = math.radians(b[0] - a[0])
+    h = math.sin((p2 - p1) / 2) ** 2 + math.cos(p1) * math.cos(p2) * math.sin(dl / 2) ** 2
+    return 2 * 6371008.8 * math.asin(math.sqrt(h))
+
+
+def quantile(v, p):
+    v = sorted(v)
+    return v[min(len(v) - 1, int(p * len(v)))] if v else float('nan')
+
+
+def load(folder, name):
+    path = os.path.join(folder, name)
+    return json.load(open(path))['features'] if os.path.exists(path) else []
+
+
+def main(folder):
+    roads = load(folder, 'roads.geojson')
+    sections = load(folder, 'sections.geojson')
+    junctions = load(folder, 'junctions.geojson')
+    land = [r for r in roads if r['properties']['router'] != 'ferry']
+    key = lambda p: (round(p[0], 9), round(p[1], 9))
+    # Per link.
+    link = [r['properties']['length_m'] / d for r in land
+            if (d := geod(r['geometry']['coordinates'][0], r['geometry']['coordinates'][-1])) > 0]
+    # City pairs through the network: each city at the cell its roads start or end at.
+    graph = {}
+    for s in sections:
+        c = s['geometry']['coordinates']
+        a, b, w = key(c[0]), key(c[-1]), s['properties']['length_m']
+        graph.setdefault(a, []).append((b, w))
+        graph.setdefault(b, []).append((a, w))
+    city = {}
+    for r in land:
+        c = r['geometry']['coordinates']
+        city.setdefault(r['properties']['from'], key(c[0]))
+        city.setdefault(r['properties']['to'], key(c[-1]))
+    ids = sorted(i for i in city if city[i] in graph)
+    pair, unreachable = [], 0
+    for n, i in enumerate(ids):
+        dist = {city[i]: 0.0}
+        heap = [(0.0, city[i])]
+        while heap:
+            d, u = heapq.heappop(heap)
+            if d > dist[u]:
+                continue
+            for v, w in graph[u]:
+                if d + w < dist.get(v, math.inf):
+                    dist[v] = d + w
+                    heapq.heappush(heap, (d + w, v))
+        for j in ids[n + 1:]:
+            g = geod(city[i], city[j])
+            if g < 1e4:
+                continue
+            if city[j] in dist:
+                pair.append(dist[city[j]] / g)
+            else:
+                unreachable += 1
+    # Grades and water, per class, on the surface (no bridge or tunnel).
+    by_class = {}
+    for r in land:
+        p = r['properties']
+        s = by_class.setdefault(p['class'], [0.0, 0.0, 0.0, p.get('grade_limit_pct')])
+        s[0] += p['length_m'] - p['bridge_m'] - p['tunnel_m']
+        s[1] += p.get('over_limit_m', 0)
+        s[2] = max(s[2], p.get('longest_over_limit_m', 0))
+    water_km = sum(r['properties'].get('water_m', 0) for r in land) / 1000
+    km = sum(s['properties']['length_m'] for s in sections) / 1000
+    print('  network: %.0f km (%d links, %.0f km summed per link), %d sections, %d junctions' %
+          (km, len(roads), sum(r['properties']['length_m'] for r in roads) / 1000, len(sections), len(junctions)))
+    print('  circuity per link: median %.2f p90 %.2f; city pairs >= 10 km: %d, median %.2f p90 %.2f (%d pairs not joined by road)' %
+          (quantile(link, .5), quantile(link, .9), len(pair), quantile(pair, .5), quantile(pair, .9), unreachable))
+    grades = ', '.join('%s %.1f %% over %s %% (longest %.0f m)' % (c, 100 * s[1] / s[0] if s[0] else 0, s[3], s[2])
+                       for c, s in sorted(by_class.items()))
+    print('  surface above the class grade limit: %s; on water without a structure: %.2f km' % (grades or 'no roads', water_km))
+
+
+if __name__ == '__main__':
+    main(sys.argv[1])

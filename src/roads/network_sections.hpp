@@ -1,0 +1,62 @@
+// The road network drawn once: shared sections and junctions from the roads' cell chains
+// (Galin et al. 2011: roads merge into trunks and branch at junctions).
+// SPDX-License-Identifier: MIT
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "io/vector_io.hpp"
+#include "roads/anisotropic_search.hpp"
+#include "roads/road_class.hpp"
+#include "roads/terrain_field.hpp"
+
+namespace terrapolis::roads {
+
+/// A road's route as a chain of 8-connected cells (grid indices), each arc of the search path
+/// drawn cell by cell; `structures[i]` is the structure of the step from cells[i] to cells[i + 1].
+struct CellChain {
+  std::vector<std::uint32_t> cells;
+  std::vector<Structure> structures;
+};
+/// The chain of a path of cells joined by arcs (`structures`: one per arc, or empty for surface arcs).
+CellChain cell_chain(const TerrainField& terrain, const std::vector<Cell>& path, const std::vector<Structure>& structures = {});
+
+/// One piece of the network between two breakpoints (a junction, a road's end, or where the set of
+/// roads using it or the structure changes), written once whatever the number of roads on it.
+struct NetworkSection {
+  std::vector<std::uint32_t> cells;  ///< grid indices, in order along the section
+  std::vector<std::size_t> roads;    ///< indices of the roads using it, ascending
+  RoadClass road_class = RoadClass::local;  ///< the most important class among them
+  Structure structure = Structure::road;
+  double length_m = 0;
+};
+
+/// A cell where three or more sections meet.
+struct Junction {
+  std::uint32_t cell = 0;
+  int degree = 0;                   ///< sections meeting
+  std::vector<RoadClass> classes;   ///< classes of those sections, most important first, distinct
+  std::size_t roads = 0;            ///< distinct roads through the cell
+};
+
+struct RoadNetworkLayout {
+  std::vector<NetworkSection> sections;
+  std::vector<Junction> junctions;
+  std::vector<std::vector<std::size_t>> road_sections;  ///< per road: its sections in order along it
+};
+
+/// Sections and junctions of the roads' chains (`classes[i]` the class of road i). Deterministic:
+/// sections are numbered in the order of their first edge by cell index.
+RoadNetworkLayout network_layout(const TerrainField& terrain, const std::vector<CellChain>& chains, const std::vector<RoadClass>& classes);
+
+/// The layers: sections (LineString: id, roads "i,j,...", count, class, structure, length_m) and
+/// junctions (Point: degree, classes "national,local", roads). Road ids are the features' order
+/// in roads.geojson.
+VectorLayer network_sections_layer(const TerrainField& terrain, const RoadNetworkLayout& layout);
+VectorLayer junctions_layer(const TerrainField& terrain, const RoadNetworkLayout& layout);
+
+/// "a,b,c" from a list of numbers (the ids fields).
+std::string id_list(const std::vector<std::size_t>& ids);
+
+}  // namespace terrapolis::roads
