@@ -77,6 +77,8 @@ void check_reusable(const std::filesystem::path& folder, const json& saved, cons
   for (std::size_t i = 0; i < plan.size(); ++i) {
     const StageDef& stage = stages()[i];
     if (plan[i] == Action::run) continue;
+    // A later stage the saved run never made (it stopped with --until) stays absent.
+    if (plan[i] == Action::keep && !saved["summary"].contains(stage.name)) continue;
     if (!saved["summary"].contains(stage.name))
       throw bad_input(folder.string() + ": the saved run has no " + stage.name + " stage; rerun from it");
     if (plan[i] != Action::load) continue;
@@ -167,6 +169,7 @@ json run_scenario(const Scenario& scenario, const RunOptions& options, Progress&
     for (std::size_t i = 0; i <= last; ++i) {
       const StageDef& stage = stages()[i];
       const Log stage_log = log.stage(stage.name);
+      if (plan[i] == Action::keep && !saved["summary"].contains(stage.name)) continue;  // never made
       if (plan[i] != Action::run) {
         // A saved stage: its files, figures and timing come from the saved run.
         reuse_saved(state, saved, stage.name, timings);
@@ -271,8 +274,11 @@ std::string format_summary(const json& manifest) {
   }
   if (sum.contains("roads")) {
     const json& r = sum["roads"];
-    line("  roads    %d roads (%d not routable), bridges %.0f m, tunnels %.0f m\n", r["roads"].get<int>(), r["failed"].get<int>(),
-         r["bridge_m"].get<double>(), r["tunnel_m"].get<double>());
+    line("  roads    %d roads (%d not routable, %d redundant), bridges %.0f m, tunnels %.0f m\n", r["roads"].get<int>(),
+         r["failed"].get<int>(), r.value("redundant", 0), r["bridge_m"].get<double>(), r["tunnel_m"].get<double>());
+    if (r.contains("network_km"))
+      line("           network %.1f km drawn once, %d sections, %d junctions\n", r["network_km"].get<double>(), r.value("sections", 0),
+           r.value("junctions", 0));
     for (const auto& [cls, km] : r["length_km"].items()) line("           %-13s %9.1f km\n", cls.c_str(), km.get<double>());
   }
   out += "  timings ";

@@ -279,7 +279,11 @@ void roads_run(RunState& s, Progress& progress, const Log& log) {
   const roads::NetworkResult r = roads::route_network(terrain, graph, network::road_links(*s.network, &*s.cities), settings.routing, progress);
   for (const auto& f : r.failed) log.warn("no road: " + f);
   for (const auto& f : r.over_budget) log.warn("not routed: budget (roads.max_seconds): " + f);
-  for (const auto& f : r.redundant) log.info("redundant link dropped (roads.redundant_share): " + f);
+  if (!r.redundant.empty()) {  // the summary counts them; the list only when asked (-v)
+    std::string list;
+    for (const auto& f : r.redundant) list += (list.empty() ? "" : ", ") + f;
+    log.detail(std::to_string(r.redundant.size()) + " redundant links dropped (roads.redundant_share): " + list);
+  }
   s.write("roads", "roads.geojson", roads::roads_layer(terrain, r.roads, &r.layout),
           "one road per link with class, router, length, cost, grades, structures and its sections", Style::roads);
   s.write("roads", "sections.geojson", roads::network_sections_layer(terrain, r.layout),

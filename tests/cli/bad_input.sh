@@ -14,7 +14,7 @@ expect_fail 2 "truncated.tif: (corrupt or truncated|not a raster)" "$TP" convert
 # An ESRI ASCII grid without its .prj has no CRS.
 cp "$SAMPLES/gebco2022_15s_north_corsica_capcorse.asc" "$WORK/nocrs.asc"
 expect_fail 2 "nocrs.asc: has no CRS.*--assume-crs" "$TP" info "$WORK/nocrs.asc"
-"$TP" info "$WORK/nocrs.asc" --assume-crs EPSG:4326 | grep -q "EPSG:4326" || fail "--assume-crs not applied"
+grep -q "EPSG:4326" <("$TP" info "$WORK/nocrs.asc" --assume-crs EPSG:4326) || fail "--assume-crs not applied"
 
 # A three-band colour image is not a DEM unless a band is chosen.
 gdal_translate -q -b 1 -b 1 -b 1 -ot Byte -scale -co PHOTOMETRIC=RGB "$good" "$WORK/rgb.tif"

@@ -19,10 +19,10 @@ for f in coast plateau plain buildable density; do [[ -f $tmp/corsica/$f.tif ]] 
 for f in coast plateau plain density; do in_unit "$tmp/corsica/$f.tif"; done
 read -r lo hi < <(minmax "$tmp/corsica/coast.tif")
 [[ $hi == 1.000 ]] || fail "corsica: coast maximum is $hi, expected 1"
-gdalinfo "$tmp/corsica/density.tif" | grep -q 'Size is 175, 175' || fail "corsica: grid changed"
-gdalinfo "$tmp/corsica/density.tif" | grep -q 'ID\["EPSG",4326\]' || fail "corsica: CRS lost"
-gdalinfo "$tmp/corsica/density.tif" | grep -q 'Description = Human population density' || fail "corsica: no description"
-gdalinfo "$tmp/corsica/coast.tif" | grep -q 'WEIGHTS_COAST_HYDROMETRY_PLATEAU_PLAIN=1,0,1.5,0' || fail "corsica: no provenance"
+grep -q 'Size is 175, 175' <(gdalinfo "$tmp/corsica/density.tif") || fail "corsica: grid changed"
+grep -q 'ID\["EPSG",4326\]' <(gdalinfo "$tmp/corsica/density.tif") || fail "corsica: CRS lost"
+grep -q 'Description = Human population density' <(gdalinfo "$tmp/corsica/density.tif") || fail "corsica: no description"
+grep -q 'WEIGHTS_COAST_HYDROMETRY_PLATEAU_PLAIN=1,0,1.5,0' <(gdalinfo "$tmp/corsica/coast.tif") || fail "corsica: no provenance"
 grep -q 'buildable:' "$tmp/report.txt" || fail "report: no buildable share"
 [[ $(grep -c '^    \[' "$tmp/report.txt") == 10 ]] || fail "report: histogram should have 10 lines"
 # Deterministic whatever the thread count.
@@ -41,8 +41,8 @@ gdal_translate -q -ot Byte -scale 212 1233 0 2 "$dem" "$tmp/exclude.tif"       #
 for f in coast plateau plain hydrometry density; do in_unit "$tmp/vermont/$f.tif"; done
 read -r lo hi < <(minmax "$tmp/vermont/coast.tif")
 [[ $hi == 0.000 ]] || fail "vermont: inland but coast reaches $hi"
-gdalinfo "$tmp/vermont/density.tif" | grep -q 'LAYOUT=COG' || fail "vermont: not a COG"
-gdalinfo "$tmp/vermont/density.tif" | grep -q 'ID\["EPSG",26918\]' || fail "vermont: CRS lost"
+grep -q 'LAYOUT=COG' <(gdalinfo "$tmp/vermont/density.tif") || fail "vermont: not a COG"
+grep -q 'ID\["EPSG",26918\]' <(gdalinfo "$tmp/vermont/density.tif") || fail "vermont: CRS lost"
 
 # 3. New Zealand (projected, no EPSG code): sea is NaN nodata; with --nodata-is-sea it is water
 #    (83 % of the grid), without it unknown: only land cells at 0 m are water.
@@ -53,7 +53,7 @@ in_unit "$tmp/nz/density.tif"
 grep -q 'cells: *1616750 (1616750 with data or water, 13[0-9]\{5\} water)' "$tmp/nz.txt" || fail "nz: sea not counted as water: $(grep cells: "$tmp/nz.txt")"
 "$bin" --quiet density "$samples/spDataLarge_nz_elev.tif" "$tmp/nz2" --weights 1,0,1,0 --r-min 1000 --r-max 8000 --report > "$tmp/nz2.txt"
 grep -q 'cells: *1616750 (2[0-9]\{5\} with data or water' "$tmp/nz2.txt" || fail "nz: nodata counted as known: $(grep cells: "$tmp/nz2.txt")"
-gdalinfo -mm "$tmp/nz2/density.tif" | grep -q 'NoData Value=nan' || fail "nz: density lost its nodata"
+grep -q 'NoData Value=nan' <(gdalinfo -mm "$tmp/nz2/density.tif") || fail "nz: density lost its nodata"
 
 # 4. Olinda (UTM, sea near 0 m, no nodata) and Luxembourg (nodata border).
 "$bin" --quiet density "$samples/stars_olinda_dem_utm25s.tif" "$tmp/olinda" --weights 1,0,0,1
@@ -61,7 +61,7 @@ read -r lo hi < <(minmax "$tmp/olinda/coast.tif")
 [[ $hi == 1.000 ]] || fail "olinda: coast maximum is $hi"
 "$bin" --quiet density "$samples/terra_elev_luxembourg.tif" "$tmp/lux" --weights 0,0,1,1 --r-min 1500 --r-max 10000
 in_unit "$tmp/lux/density.tif"
-gdalinfo "$tmp/lux/buildable.tif" | grep -q 'NoData Value=255' || fail "luxembourg: buildable has no nodata"
+grep -q 'NoData Value=255' <(gdalinfo "$tmp/lux/buildable.tif") || fail "luxembourg: buildable has no nodata"
 
 # 5. --overwrite replaces; the water mask makes the coast appear inland.
 gdal_translate -q -ot Byte -scale 212 1233 0 1.6 "$dem" "$tmp/lake.tif"   # 0 below ~850 m, 1 above: a "lake"

@@ -30,7 +30,7 @@ for o in "${outputs[@]}" basins; do
   same_cells "$work/zion_whole/$o.tif" "$work/zion_tiled/$o.vrt" || fail "zion: tiled $o differs"
   [[ $(ls "$work/zion_tiled/$o"/tile_*.tif | wc -l) -eq 25 ]] || fail "zion: expected 25 $o tiles"
 done
-gdalinfo "$work/zion_tiled/flowdir/tile_0002_0003.tif" | grep -q "D8_CODES=esri" || fail "tile without its metadata"
+grep -q "D8_CODES=esri" <(gdalinfo "$work/zion_tiled/flowdir/tile_0002_0003.tif") || fail "tile without its metadata"
 # Basins stitched: the largest basin spreads over at least 9 of the 25 tiles, under one label; the
 # labels are the outlets numbered 1..N, each outlet cell in its own basin's label.
 /usr/bin/python3 - "$work/zion_tiled/basins.vrt" <<'PY' || fail "zion: basins not stitched across tiles"
@@ -44,7 +44,7 @@ rows, cols = np.nonzero(b == big)
 tiles = {(r * 5 // b.shape[0], c * 5 // b.shape[1]) for r, c in zip(rows, cols)}
 sys.exit(0 if len(tiles) >= 9 and labels[0] == 1 and labels[-1] == len(labels) else 1)
 PY
-gdalinfo "$work/zion_tiled/filled.vrt" | grep -q 'ID\["EPSG",4326\]' || fail "VRT without the CRS"
+grep -q 'ID\["EPSG",4326\]' <(gdalinfo "$work/zion_tiled/filled.vrt") || fail "VRT without the CRS"
 
 # Corsica (sea level, coast) through a VRT with km2 and TauDEM codes, on one thread.
 gdalbuildvrt -q "$work/corsica.vrt" "$samples/gebco2022_15s_north_corsica_capcorse.asc"

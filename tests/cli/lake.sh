@@ -15,8 +15,8 @@ dam="LINESTRING (-113.168 37.2261, -113.1537 37.2189)"
 for f in depth.tif shoreline.geojson lake.json; do [[ -s $work/reservoir/$f ]] || fail "missing $f"; done
 # CRS and grid kept; depth 0 < d <= 10 m + the lake floor's relief; NaN where dry.
 [[ "$(gdalsrsinfo -o wkt1 "$zion")" == "$(gdalsrsinfo -o wkt1 "$work/reservoir/depth.tif")" ]] || fail "CRS not kept"
-gdalinfo "$work/reservoir/depth.tif" | grep -q "Size is 465, 457" || fail "grid not kept"
-gdalinfo "$work/reservoir/depth.tif" | grep -q "LEVEL_M=1167.000" || fail "no LEVEL_M"
+grep -q "Size is 465, 457" <(gdalinfo "$work/reservoir/depth.tif") || fail "grid not kept"
+grep -q "LEVEL_M=1167.000" <(gdalinfo "$work/reservoir/depth.tif") || fail "no LEVEL_M"
 # The report's area and volume are the depth raster's: cells times their geodesic areas (checked
 # independently with pyproj's geodesic areas of each row's cell).
 /usr/bin/python3 - "$work/reservoir" <<'EOF'

@@ -9,6 +9,9 @@ trap 'rm -rf "$WORK"' EXIT
 
 fail() { echo "FAIL: $*" >&2; exit 1; }
 
+# Match a command's output with `grep -q PATTERN <(CMD)`, never `CMD | grep -q PATTERN`: under
+# pipefail, grep -q exits at its first match and CMD, still writing past one buffer, dies of SIGPIPE.
+
 # expect_fail CODE PATTERN CMD...: the command exits with CODE and its stderr matches PATTERN (grep -E).
 expect_fail() {
   local code=$1 pattern=$2; shift 2

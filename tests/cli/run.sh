@@ -26,8 +26,8 @@ assert 0 < s["density"]["mean_density"] <= 1, s["density"]
 assert s["roads"]["roads"] + s["roads"]["failed"] + s["roads"]["redundant"] == s["network"]["kept_edges"], (s["roads"], s["network"])
 assert sum(s["roads"]["length_km"].values()) > 0, s["roads"]
 PY
-gdalinfo run1/elevation.tif | grep -q "LAYOUT=COG" || fail "elevation.tif is not a COG"
-gdalinfo run1/elevation.tif | grep -q "TERRAPOLIS_INPUT_SHA256=" || fail "no provenance in elevation.tif"
+grep -q "LAYOUT=COG" <(gdalinfo run1/elevation.tif) || fail "elevation.tif is not a COG"
+grep -q "TERRAPOLIS_INPUT_SHA256=" <(gdalinfo run1/elevation.tif) || fail "no provenance in elevation.tif"
 /usr/bin/python3 -c "import json,sys; m=json.load(open('run1/run.json')); assert m['input']['sha256'] and m['timings'], m" || fail "run.json"
 
 # Existing folder refused; invalid scenarios fail with the pointer and leave nothing.
@@ -38,7 +38,7 @@ echo '{"dem": "nowhere.tif", "output": "bad2"}' > s.json
 expect_fail 2 "nowhere.tif: no such file" "$TP" run s.json
 [[ ! -e bad2 ]] || fail "a missing DEM left a folder"
 no_leftovers "$WORK"
-ls -a | grep -q "tmp-" && fail "temporary run folder left behind"
+grep -q "tmp-" <(ls -a) && fail "temporary run folder left behind"
 
 # The real client: QGIS opens project.qgs headless, every layer valid and styled, and renders it.
 if /usr/bin/python3 -c "import qgis.core" 2>/dev/null; then
@@ -78,6 +78,11 @@ cp -r run1 grass
 "$TP" --quiet run -o grass --only hydro --set hydro.d8_codes=grass
 grep -q 'value="8" color="#e41a1c" alpha="255" label="E"' grass/flowdir.qml || fail "flowdir.qml does not use the GRASS codes"
 expect_fail 2 "other 'density' parameters" "$TP" run -o rerun --only hydro roads --set density.r_max_m=6000
+# A run that stopped early (--until) can rerun its last stage: the stages it never made stay absent.
+"$TP" --quiet run -o short --until sites
+"$TP" --quiet run -o short --only sites --set sites.influence_factor=2
+/usr/bin/python3 -c "import json; m=json.load(open('short/run.json')); assert m['rerun']['stale']==[] and 'network' not in m['summary'], m['rerun']" || fail "--only sites after --until sites"
+[[ ! -e short/network.geojson ]] || fail "--only sites made a network"
 expect_fail 2 "dunes" "$TP" run -o rerun --from dunes
 expect_fail 2 "nosuch: not a run folder" "$TP" run -o nosuch --from roads
 no_leftovers "$WORK"

@@ -76,7 +76,7 @@ gdal_translate -q mydem.tif theirs.tif
 expect_fail 2 "theirs.tif: was not written by terrapolis" "$TP" convert mydem.tif theirs.tif --overwrite
 "$TP" -q convert mydem.tif ours.tif
 "$TP" -q convert mydem.tif ours.tif --overwrite --cog
-gdalinfo ours.tif | grep -q "LAYOUT=COG" || fail "convert --overwrite did not replace its own file"
+grep -q "LAYOUT=COG" <(gdalinfo ours.tif) || fail "convert --overwrite did not replace its own file"
 echo keep > report.txt
 expect_fail 2 "report.txt: was not written by terrapolis" "$TP" compare r1 r2 --save report.txt --overwrite
 [[ $(cat report.txt) == keep ]] || fail "compare --save replaced a user's file"

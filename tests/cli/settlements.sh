@@ -29,7 +29,7 @@ PY
 "$TP" --quiet run -o thesis_run --until sites --set density.preset='"belhadj2007"' --set sites.quotas='"belhadj2007"' \
   --set sites.reference="\"$REF\""
 [[ $(sha256sum < thesis_run/cities.geojson | cut -d' ' -f1) == "$PINNED" ]] || fail "run: the thesis's cities changed"
-"$TP" compare run thesis_run | grep -q "realism.count.generated" || fail "compare does not show the realism figures"
+grep -q "realism.count.generated" <("$TP" compare run thesis_run) || fail "compare does not show the realism figures"
 expect_fail 2 "nowhere.geojson: no such file" "$TP" run -o bad --until sites --set sites.reference='"nowhere.geojson"'
 
 # Calibration on the tile: a fragment a scenario takes, a report with the figures.

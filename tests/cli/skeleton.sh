@@ -13,7 +13,7 @@ for f in ridges.geojson valleys.geojson ridges.qml valleys.qml skeleton.tif form
   [[ -s $work/zion/$f ]] || fail "missing $f"
 done
 [[ "$(gdalsrsinfo -o wkt1 "$zion")" == "$(gdalsrsinfo -o wkt1 "$work/zion/skeleton.tif")" ]] || fail "CRS not kept"
-gdalinfo "$work/zion/skeleton.tif" | grep -q "Size is 465, 457" || fail "grid not kept"
+grep -q "Size is 465, 457" <(gdalinfo "$work/zion/skeleton.tif") || fail "grid not kept"
 
 # Every vertex lies on a kept cell holding the DEM's height; lengths are geodesic (pyproj on WGS 84)
 # and reliefs are the spread of the DEM's heights along the line; the report counts what was written.

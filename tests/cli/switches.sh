@@ -9,8 +9,8 @@ expect_fail 2 "seed" "$TP" run --seed -1 --print-scenario
 expect_fail 2 "seed" "$TP" run --seed -7 --print-scenario
 expect_fail 2 "seed" "$TP" run --seed 9007199254740992 --print-scenario
 expect_fail 2 "/seed" "$TP" run --set seed=-1 --print-scenario
-"$TP" run --seed 5 --print-scenario | grep -q '"seed": 5' || fail "--seed 5 not honoured"
-"$TP" run --seed 0 --print-scenario | grep -q '"seed": 0' || fail "--seed 0 not honoured"
+grep -q '"seed": 5' <("$TP" run --seed 5 --print-scenario) || fail "--seed 5 not honoured"
+grep -q '"seed": 0' <("$TP" run --seed 0 --print-scenario) || fail "--seed 0 not honoured"
 expect_fail 2 "seed" "$TP" sites "$SAMPLES/gebco2022_15s_north_corsica_capcorse.asc" out --seed -1
 
 # count_structures FILE: "bridge tunnel" section counts of a road_sections.geojson.
