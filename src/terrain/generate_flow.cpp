@@ -45,7 +45,14 @@ bool discrete_line(Cell a, Cell b, const std::function<bool(Cell, Cell)>& visit)
   }
 }
 
-Cell floor_cell(double x, double y) { return {int(std::floor(x)), int(std::floor(y))}; }
+/// The cell holding (x, y). A particle thrown far off the grid (a large velocity) is clamped to
+/// 2^24 cells away: it leaves the grid at the first cell outside anyway, and converting a double
+/// beyond int's range (or NaN) to int is undefined.
+Cell floor_cell(double x, double y) {
+  static constexpr double kFar = 1 << 24;
+  const auto cell = [](double v) { return int(std::floor(std::isnan(v) ? -kFar : std::clamp(v, -kFar, kFar))); };
+  return {cell(x), cell(y)};
+}
 
 // ---- Ridges and basins (§2.2.1) -------------------------------------------------------------
 
