@@ -3,6 +3,7 @@
 // SPDX-License-Identifier: MIT
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -28,20 +29,19 @@ namespace terrapolis::cli {
 namespace {
 
 using json = nlohmann::ordered_json;
-constexpr std::size_t kTerms = 8;
-constexpr std::array<const char*, kTerms> kTermNames = {"coast", "hydrometry", "plateau", "plain", "altitude", "slope", "coast_near", "river_near"};
+constexpr std::size_t kTerms = density::kTermCount;
 
 /// One region: its presences and background sample (terms), and every land cell for the AUC.
 struct Region {
   std::string name;
-  std::vector<std::array<double, kTerms>> presence, background, land;
+  std::vector<density::Terms> presence, background, land;
   std::vector<double> population;
   int dropped = 0;
   density::Skill baselines;  // baselines only (the density field is not used)
   std::vector<double> sizes;  // populations of min_population or more
 };
 
-double score(const std::vector<double>& beta, const std::array<double, kTerms>& x) {
+double score(const std::vector<double>& beta, const density::Terms& x) {
   double s = 0;
   for (std::size_t j = 0; j < kTerms; ++j) s += beta[j + 1] * x[j];
   return s;
@@ -60,11 +60,16 @@ std::pair<double, double> region_auc(const std::vector<double>& beta, const Regi
   return {density::auc(pres, {}, bg), density::auc(pres, w, bg)};
 }
 
-/// Pooled fit: each training region's presences weigh 1 in all, its background 1 in all, so
-/// regions count equally whatever their number of places. Presences in `held_out` of region
-/// `fold_region` are left out.
-std::vector<double> fit(const std::vector<Region>& regions, const std::vector<bool>& train, double ridge, int fold_region = -1,
-                        const std::vector<std::size_t>& held_out = {}) {
+/// Pooled fit of the terms in `fitted` (the others weigh 0): each training region's presences
+/// weigh 1 in all, its background 1 in all, so regions count equally whatever their number of
+/// places. Presences in `held_out` of region `fold_region` are left out. Returns {b0, b...} over every term.
+std::vector<double> fit(const std::vector<Region>& regions, const std::vector<std::size_t>& fitted, const std::vector<bool>& train, double ridge,
+                        int fold_region = -1, const std::vector<std::size_t>& held_out = {}) {
+  auto columns = [&](const density::Terms& t) {
+    std::vector<double> v;
+    for (std::size_t j : fitted) v.push_back(t[j]);
+    return v;
+  };
   std::vector<std::vector<double>> x;
   std::vector<double> y, w;
   for (std::size_t g = 0; g < regions.size(); ++g) {
@@ -77,11 +82,15 @@ std::vector<double> fit(const std::vector<Region>& regions, const std::vector<bo
     for (std::size_t k = 0; k < r.presence.size(); ++k) kept += !skip[k];
     if (kept == 0) continue;
     for (std::size_t k = 0; k < r.presence.size(); ++k)
-      if (!skip[k]) x.emplace_back(r.presence[k].begin(), r.presence[k].end()), y.push_back(1), w.push_back(1.0 / double(kept));
-    for (const auto& b : r.background) x.emplace_back(b.begin(), b.end()), y.push_back(0), w.push_back(1.0 / double(r.background.size()));
+      if (!skip[k]) x.push_back(columns(r.presence[k])), y.push_back(1), w.push_back(1.0 / double(kept));
+    for (const auto& b : r.background) x.push_back(columns(b)), y.push_back(0), w.push_back(1.0 / double(r.background.size()));
   }
   if (x.empty()) throw bad_input("calibrate: no places to fit on");
-  return density::fit_logistic(x, y, w, ridge);
+  const std::vector<double> b = density::fit_logistic(x, y, w, ridge);
+  std::vector<double> beta(kTerms + 1, 0.0);
+  beta[0] = b[0];
+  for (std::size_t j = 0; j < fitted.size(); ++j) beta[fitted[j] + 1] = b[j + 1];
+  return beta;
 }
 
 json auc_pair(std::pair<double, double> a) {
@@ -106,6 +115,7 @@ class CalibrateCommand final : public Command {
     app.add_option("--folds", folds_, "Folds of the cross-validation within a region (one region given)")->check(CLI::Range(2, 100))->capture_default_str();
     app.add_option("--background", background_, "Background cells sampled per region for the fit")->check(CLI::Range(100, 10000000))->capture_default_str();
     app.add_option("--ridge", ridge_, "Ridge penalty on the weights (times the total weight)")->check(CLI::NonNegativeNumber)->capture_default_str();
+    app.add_option("--terms", terms_, "Terms to fit, the others weigh 0 (default: every term: " + join(density::term_names()) + ")")->delimiter(',');
     app.add_option("--seed", seed_, "Seed of the background sample and of the folds")->capture_default_str();
     app.add_flag("--overwrite", overwrite_, "Replace existing --fragment / --report files");
   }
@@ -121,6 +131,7 @@ class CalibrateCommand final : public Command {
     const std::string report_file = report_.empty() ? "" : outputs.file(report_);
     if (scenarios_.size() > 1 && scenarios_.size() != dems_.size())
       throw bad_input("--scenario: give one scenario, or one per DEM (" + std::to_string(dems_.size()) + " DEMs)");
+    fitted_ = fitted_terms();  // refused before any work
     std::vector<Region> regions;
     for (std::size_t g = 0; g < dems_.size(); ++g) {
       const pipeline::Scenario scenario = pipeline::load_scenario(scenarios_.empty() ? "" : scenarios_[scenarios_.size() == 1 ? 0 : g]);
@@ -129,7 +140,7 @@ class CalibrateCommand final : public Command {
 
     const std::size_t n = regions.size();
     const std::vector<bool> all(n, true);
-    const std::vector<double> beta = fit(regions, all, ridge_);
+    const std::vector<double> beta = fit(regions, fitted_, all, ridge_);
     json report;
     report["regions"] = json::array();
     std::vector<double> thesis(kTerms + 1, 0.0);
@@ -143,7 +154,7 @@ class CalibrateCommand final : public Command {
       if (n > 1) {
         std::vector<bool> others(n, true);
         others[g] = false;
-        const std::vector<double> b = fit(regions, others, ridge_);
+        const std::vector<double> b = fit(regions, fitted_, others, ridge_);
         held = region_auc(b, r);
         held_weights = scaled_weights(b);
       } else {
@@ -172,6 +183,8 @@ class CalibrateCommand final : public Command {
     }
     const json weights = scaled_weights(beta);
     report["weights"] = weights;
+    report["terms"] = json::array();
+    for (std::size_t j : fitted_) report["terms"].push_back(density::term_names()[j]);
     report["method"] = n > 1 ? "logistic presence/background, regions weighted equally; held out: leave one region out"
                              : "logistic presence/background; held out: " + std::to_string(folds_) + "-fold cross-validation on the places";
     std::printf("weights:");
@@ -228,7 +241,7 @@ class CalibrateCommand final : public Command {
       std::vector<std::size_t> held;
       for (std::size_t k = std::size_t(f); k < order.size(); k += std::size_t(folds_)) held.push_back(order[k]);
       if (held.empty()) continue;
-      const std::vector<double> beta = fit(regions, {true}, ridge_, 0, held);
+      const std::vector<double> beta = fit(regions, fitted_, {true}, ridge_, 0, held);
       // Scores of different folds are not on one scale: each fold's AUC, weighted by its size.
       const auto a = region_auc(beta, r, held);
       double wp = 0;
@@ -241,16 +254,37 @@ class CalibrateCommand final : public Command {
     return {s / n, nw > 0 ? sw / nw : NAN};
   }
 
+  /// Indices of the --terms (every term when none is given).
+  std::vector<std::size_t> fitted_terms() const {
+    const auto names = density::term_names();
+    std::vector<std::size_t> fitted;
+    for (const std::string& t : terms_) {
+      const auto at = std::find(names.begin(), names.end(), t);
+      if (at == names.end()) throw bad_input("--terms: unknown term '" + t + "' (terms: " + join(names) + ")");
+      if (std::find(fitted.begin(), fitted.end(), std::size_t(at - names.begin())) == fitted.end()) fitted.push_back(std::size_t(at - names.begin()));
+    }
+    if (terms_.empty())
+      for (std::size_t j = 0; j < names.size(); ++j) fitted.push_back(j);
+    return fitted;
+  }
+
+  static std::string join(const std::array<const char*, kTerms>& names) {
+    std::string s;
+    for (const char* name : names) s += (s.empty() ? "" : ",") + std::string(name);
+    return s;
+  }
+
   /// Weights scaled so the largest is 1 in magnitude: the density ranks cells as the linear predictor does.
   static json scaled_weights(const std::vector<double>& beta) {
     double largest = 0;
     for (std::size_t j = 1; j < beta.size(); ++j) largest = std::max(largest, std::abs(beta[j]));
     json weights = json::object();
-    for (std::size_t j = 0; j < kTerms; ++j) weights[kTermNames[j]] = largest > 0 ? std::round(beta[j + 1] / largest * 1e4) / 1e4 : 0.0;
+    for (std::size_t j = 0; j < kTerms; ++j) weights[density::term_names()[j]] = largest > 0 ? std::round(beta[j + 1] / largest * 1e4) / 1e4 : 0.0;
     return weights;
   }
 
-  std::vector<std::string> dems_, places_, scenarios_;
+  std::vector<std::string> dems_, places_, scenarios_, terms_;
+  std::vector<std::size_t> fitted_;
   std::string fragment_, report_;
   int folds_ = 5;
   std::size_t background_ = 20000;

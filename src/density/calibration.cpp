@@ -11,9 +11,10 @@
 namespace terrapolis::density {
 
 std::vector<std::uint8_t> land_cells(const DensityResult& model) {
-  if (model.altitude.size() == 0) throw processing_error("density: the terrain terms were not computed");
-  std::vector<std::uint8_t> land(model.altitude.size());
-  for (std::size_t i = 0; i < land.size(); ++i) land[i] = std::isnan(model.altitude[i]) ? 0 : 1;
+  const Raster<float>& altitude = model.term(TerrainTerm::altitude);
+  if (altitude.size() == 0) throw processing_error("density: the terrain terms were not computed");
+  std::vector<std::uint8_t> land(altitude.size());
+  for (std::size_t i = 0; i < land.size(); ++i) land[i] = std::isnan(altitude[i]) ? 0 : 1;
   return land;
 }
 
@@ -82,11 +83,21 @@ std::vector<double> fit_logistic(const std::vector<std::vector<double>>& x, cons
   return b;
 }
 
-std::array<double, 8> terms_at(const DensityResult& m, std::size_t i) {
-  return {m.coast[i], m.hydrometry[i], m.plateau[i], m.plain[i], m.altitude[i], m.slope[i], m.coast_near[i], m.river_near[i]};
+std::array<const char*, kTermCount> term_names() {
+  std::array<const char*, kTermCount> names = {"coast", "hydrometry", "plateau", "plain"};
+  std::copy(kTerrainTerms.begin(), kTerrainTerms.end(), names.begin() + 4);
+  return names;
 }
 
-std::array<double, 3> baselines_at(const DensityResult& m, std::size_t i) { return {-m.altitude[i], -m.slope[i], m.coast_near[i]}; }
+Terms terms_at(const DensityResult& m, std::size_t i) {
+  Terms t = {m.coast[i], m.hydrometry[i], m.plateau[i], m.plain[i]};
+  for (std::size_t k = 0; k < kTerrainCount; ++k) t[4 + k] = m.terrain[k][i];
+  return t;
+}
+
+std::array<double, 3> baselines_at(const DensityResult& m, std::size_t i) {
+  return {-m.term(TerrainTerm::altitude)[i], -m.term(TerrainTerm::slope)[i], m.term(TerrainTerm::coast_near)[i]};
+}
 
 double Skill::best_baseline() const { return *std::max_element(baseline_auc.begin(), baseline_auc.end()); }
 

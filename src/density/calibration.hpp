@@ -31,9 +31,13 @@ double auc(const std::vector<double>& presence, const std::vector<double>& weigh
 std::vector<double> fit_logistic(const std::vector<std::vector<double>>& x, const std::vector<double>& y,
                                  const std::vector<double>& w, double ridge);
 
-/// The model's terms at cell i, in weight order: coast, hydrometry, plateau, plain, then the
-/// terrain terms (altitude, slope, coast_near, river_near).
-std::array<double, 8> terms_at(const DensityResult& model, std::size_t i);
+/// Every term of the model, in weight order: the four characteristics, then the terrain terms.
+inline constexpr std::size_t kTermCount = 4 + kTerrainCount;
+using Terms = std::array<double, kTermCount>;
+std::array<const char*, kTermCount> term_names();
+
+/// The model's terms at cell i, in weight order.
+Terms terms_at(const DensityResult& model, std::size_t i);
 
 /// Single-factor baselines scored at cell i: minus the elevation, minus the slope, nearness to water.
 std::array<double, 3> baselines_at(const DensityResult& model, std::size_t i);

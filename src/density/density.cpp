@@ -280,6 +280,13 @@ Grid describe_grid(const Dem& dem, const DensityOptions& options) {
   return g;
 }
 
+/// The largest distance between the centres of two 4-neighbours, metres.
+double largest_cell_step(const Grid& g) {
+  double step = 0;
+  for (std::size_t r = 0; r < std::size_t(g.rows); ++r) step = std::max({step, g.metrics.width_m[r], g.metrics.height_m[r], g.metrics.height_m[r + 1]});
+  return step;
+}
+
 /// The masks (§4.2.2.2, the thresholds): uninhabitable are water, cells too high, excluded,
 /// river beds and cells too steep; the hydrometry clamped to [0,1], 0 on water.
 void mark_buildable(const Dem& dem, const Grid& g, const Raster<float>& hydrometry, const DensityOptions& options, DensityResult& result,
@@ -439,8 +446,36 @@ bool terrain_used(const DensityOptions& options) {
   return std::any_of(options.terrain_weights.begin(), options.terrain_weights.end(), [](double w) { return w != 0; });
 }
 
-/// The terrain terms the thesis does not have (fitted by `terrapolis calibrate`): ranks of the
-/// altitude and the slope among the land cells, nearness to water and to rivers.
+/// Topographic position (Weiss 2001; Guisan et al. 1999): each land cell's altitude minus the mean
+/// altitude of the land cells within `radius_m` (the disc of DiscPlan), NaN off land.
+Raster<float> topographic_position(const Dem& dem, const Grid& g, double radius_m, int max_bands) {
+  Raster<float> out = dem.like<float>(nan_f);
+  const DiscPlan plan(g.metrics, g.rows, radius_m, max_bands);
+  const Window win = disc_window(g, plan, plan);
+  const std::vector<std::uint8_t>& kind = g.kind;
+  const double mid = g.land_min <= g.land_max ? 0.5 * (double(g.land_min) + double(g.land_max)) : 0.0;
+  const SummedArea<std::uint32_t> count(win, g.cols, [&](std::size_t i) { return std::uint32_t(kind[i] == land); });
+  const SummedArea<double> sum(win, g.cols, [&](std::size_t i) { return kind[i] == land ? double(dem[i]) - mid : 0.0; });
+  tbb::parallel_for(tbb::blocked_range<int>(0, g.rows, 4), [&](const tbb::blocked_range<int>& range) {
+    std::vector<std::uint32_t> a(static_cast<std::size_t>(g.cols));
+    std::vector<double> b(static_cast<std::size_t>(g.cols));
+    for (int r = range.begin(); r < range.end(); ++r) {
+      const int x0 = g.span_lo[std::size_t(r)], x1 = g.span_hi[std::size_t(r)];
+      if (x0 >= x1) continue;
+      std::fill(a.begin() + x0, a.begin() + x1, 0u);
+      std::fill(b.begin() + x0, b.begin() + x1, 0.0);
+      add_disc_row(count, plan, r, +1, a.data(), x0, x1);
+      add_disc_row(sum, plan, r, +1, b.data(), x0, x1);
+      for (int x = x0; x < x1; ++x) {
+        const std::size_t i = dem.index(x, r);
+        if (kind[i] == land) out[i] = float(double(dem[i]) - mid - b[std::size_t(x)] / std::max(1u, a[std::size_t(x)]));
+      }
+    }
+  });
+  return out;
+}
+
+/// The terrain terms the thesis does not have (TerrainTerm, fitted by `terrapolis calibrate`).
 void terrain_terms(const Dem& dem, const Grid& g, const DensityOptions& options, DensityResult& result, Progress& progress) {
   ProgressStep step(progress, "density: terrain terms");
   const std::size_t n = dem.size();
@@ -451,26 +486,29 @@ void terrain_terms(const Dem& dem, const Grid& g, const DensityOptions& options,
   if (rivers_known)
     for (std::size_t i = 0; i < n; ++i) river[i] = options.rivers[i] != 0 && options.rivers[i] != options.rivers.nodata;
   const std::vector<float> to_water = g.any_water ? distance_to_m(wet, g.metrics, g.cols, g.rows) : std::vector<float>();
-  step.update(0.4);
   const std::vector<float> to_river = rivers_known ? distance_to_m(river, g.metrics, g.cols, g.rows) : std::vector<float>();
+  step.update(0.3);
+  // Radii of at least two cells, so the disc holds the neighbours on coarse grids.
+  const double largest_step = largest_cell_step(g);
+  auto term = [&](TerrainTerm t) -> Raster<float>& { return result.terrain[std::size_t(t)]; };
+  term(TerrainTerm::position_1km) = topographic_position(dem, g, std::max(1000.0, 2 * largest_step), options.ring_bands);
+  step.update(0.5);
+  term(TerrainTerm::position_5km) = topographic_position(dem, g, std::max(5000.0, 2 * largest_step), options.ring_bands);
   step.update(0.8);
-  result.altitude = dem.like<float>(nan_f);
-  result.slope = dem.like<float>(nan_f);
-  result.coast_near = dem.like<float>(nan_f);
-  result.river_near = dem.like<float>(nan_f);
+  for (TerrainTerm t : {TerrainTerm::altitude, TerrainTerm::slope, TerrainTerm::coast_near, TerrainTerm::river_near})
+    term(t) = dem.like<float>(nan_f);
   tbb::parallel_for(tbb::blocked_range<int>(0, g.rows, 8), [&](const tbb::blocked_range<int>& range) {
     for (int r = range.begin(); r < range.end(); ++r)
       for (int x = 0; x < g.cols; ++x) {
         const std::size_t i = dem.index(x, r);
         if (g.kind[i] != land) continue;
-        result.altitude[i] = dem[i];
-        result.slope[i] = slope_deg(dem, g.metrics, x, r);
-        result.coast_near[i] = g.any_water ? float(std::exp(-double(to_water[i]) / 10000.0)) : 0.0f;
-        result.river_near[i] = rivers_known ? float(std::exp(-double(to_river[i]) / 2000.0)) : 0.0f;
+        term(TerrainTerm::altitude)[i] = dem[i];
+        term(TerrainTerm::slope)[i] = slope_deg(dem, g.metrics, x, r);
+        term(TerrainTerm::coast_near)[i] = g.any_water ? float(std::exp(-double(to_water[i]) / 10000.0)) : 0.0f;
+        term(TerrainTerm::river_near)[i] = rivers_known ? float(std::exp(-double(to_river[i]) / 2000.0)) : 0.0f;
       }
   });
-  to_land_rank(result.altitude);
-  to_land_rank(result.slope);
+  for (TerrainTerm t : {TerrainTerm::altitude, TerrainTerm::slope, TerrainTerm::position_1km, TerrainTerm::position_5km}) to_land_rank(term(t));
 }
 
 /// The density (§4.2.1, Fig. 4.3): the weighted combination of the characteristics, the user's
@@ -483,7 +521,6 @@ void combine_terms(const Dem& dem, const Grid& g, const DensityOptions& options,
   const std::size_t first_factor = 4, first_terrain = first_factor + options.factors.size();
   // The terrain terms come last, and only when used: the thesis's model sums exactly what it always did.
   const bool with_terrain = terrain_used(options);
-  const Raster<float>* terrain[4] = {&result.altitude, &result.slope, &result.coast_near, &result.river_near};
   if (with_terrain) weights.insert(weights.end(), options.terrain_weights.begin(), options.terrain_weights.end());
   for_rows(g.rows, step, [&](int r0, int r1) {
     std::vector<double> values(weights.size()), cell_weights(weights);
@@ -506,7 +543,7 @@ void combine_terms(const Dem& dem, const Grid& g, const DensityOptions& options,
           cell_weights[first_factor + f] = std::isnan(v) ? 0.0 : weights[first_factor + f];
         }
         if (with_terrain)
-          for (std::size_t t = 0; t < 4; ++t) values[first_terrain + t] = (*terrain[t])[i];
+          for (std::size_t t = 0; t < kTerrainCount; ++t) values[first_terrain + t] = result.terrain[t][i];
         const bool any = std::any_of(cell_weights.begin(), cell_weights.end(), [](double w) { return w != 0; });
         result.density[i] = any ? float(combine(cell_weights.data(), values.data(), cell_weights.size())) : 0.0f;
       }
@@ -558,10 +595,7 @@ DensityResult compute_density(const Dem& dem, const Raster<float>& hydrometry, c
   mark_buildable(dem, grid, hydrometry, options, result, progress);
 
   // The plain disc must hold at least the 4-neighbours: raise r_min to the largest cell step.
-  double largest_step = 0;
-  for (std::size_t r = 0; r < std::size_t(grid.rows); ++r)
-    largest_step = std::max({largest_step, grid.metrics.width_m[r], grid.metrics.height_m[r], grid.metrics.height_m[r + 1]});
-  const double r_min = std::max(options.r_min_m, largest_step * (1 + 1e-9));
+  const double r_min = std::max(options.r_min_m, largest_cell_step(grid) * (1 + 1e-9));
   if (!(options.r_max_m > r_min))
     throw bad_input("--r-max: must be larger than r_min (" + std::to_string(r_min) + " m once raised to the cell size)");
   const DiscPlan inner(grid.metrics, grid.rows, r_min, options.ring_bands);

@@ -16,6 +16,17 @@
 
 namespace terrapolis::density {
 
+/// The terrain terms the thesis does not have (fitted by `terrapolis calibrate`), in [0,1] on land:
+/// - altitude, slope: ranks among the region's land cells (share lower, ties half): scale-free;
+/// - coast_near: exp(-d / 10 km), d the distance to the nearest water cell (0 with no water);
+/// - river_near: exp(-d / 2 km), d the distance to the nearest river cell (0 with no rivers);
+/// - position_1km, position_5km: rank of the topographic position, the altitude minus the mean
+///   altitude of the land within 1 and 5 km (Weiss 2001; Guisan et al. 1999): valley floors low,
+///   ridges high.
+enum class TerrainTerm : std::size_t { altitude, slope, coast_near, river_near, position_1km, position_5km };
+inline constexpr std::array<const char*, 6> kTerrainTerms = {"altitude", "slope", "coast_near", "river_near", "position_1km", "position_5km"};
+inline constexpr std::size_t kTerrainCount = kTerrainTerms.size();
+
 /// Everything the density model needs besides the DEM and its hydrometry. Defaults are the
 /// thesis's (Belhadj 2007, §4.2.1 and §4.2.2.2, Corsica example) unless said otherwise.
 struct DensityOptions {
@@ -56,9 +67,9 @@ struct DensityOptions {
   // ---- combination ---------------------------------------------------------------------------
   /// Weights of (coast, hydrometry, plateau, plain): negative repulsive, 0 neutral, positive attractive.
   std::array<double, 4> weights{1, 1, 1.5, 0};
-  /// Weights of the terrain terms (altitude, slope, coast_near, river_near), combined with the
-  /// four characteristics: 0 leaves them out (the thesis's model).
-  std::array<double, 4> terrain_weights{0, 0, 0, 0};
+  /// Weights of the terrain terms (kTerrainTerms, in that order), combined with the four
+  /// characteristics: 0 leaves them out (the thesis's model).
+  std::array<double, kTerrainCount> terrain_weights{};
   /// Computes the terrain terms even when their weights are 0 (calibration, realism figures).
   bool terrain_terms = false;
   /// Cells of the river network on the DEM's grid (non-zero = river), for river_near; empty: no
@@ -103,11 +114,10 @@ struct DensityResult {
   Raster<float> hydrometry;  ///< the hydrometry used (input), 0 on water
   Raster<float> density;     ///< the weighted combination, 0 where uninhabitable
   Raster<std::uint8_t> buildable;  ///< 1 habitable, 0 uninhabitable (water, too high, too steep...), 255 nodata
-  // Terrain terms, computed when a terrain weight is not 0 or options.terrain_terms; NaN off land.
-  Raster<float> altitude;    ///< rank of the altitude among the land cells (share lower, ties half), [0,1]
-  Raster<float> slope;       ///< rank of the slope among the land cells, [0,1]
-  Raster<float> coast_near;  ///< exp(-d / 10 km), d the distance to the nearest water cell (0 with no water)
-  Raster<float> river_near;  ///< exp(-d / 2 km), d the distance to the nearest river cell (0 with no rivers)
+  /// Terrain terms in kTerrainTerms order, computed when a terrain weight is not 0 or
+  /// options.terrain_terms (empty rasters otherwise); in [0,1] on land, NaN off land.
+  std::array<Raster<float>, kTerrainCount> terrain;
+  const Raster<float>& term(TerrainTerm t) const { return terrain[std::size_t(t)]; }
   DensityStats stats;
 };
 
@@ -128,8 +138,6 @@ DensityResult compute_density(const Dem& dem, const Raster<float>& hydrometry, c
 /// otherwise rescaled linearly from its [min, max] over the grid; NaN (no data) reads as 0.
 void to_unit_range(Raster<float>& layer);
 
-/// Names of the terrain terms, in the order of DensityOptions::terrain_weights.
-inline constexpr std::array<const char*, 4> kTerrainTerms = {"altitude", "slope", "coast_near", "river_near"};
 
 /// Distance in metres from each cell's centre to the nearest cell where `feature` is non-zero
 /// (infinity when there is none): an exact Euclidean transform (Felzenszwalb & Huttenlocher
