@@ -59,6 +59,8 @@ for name, layer in layers.items():
         if layer.featureCount() != out["features"]:
             sys.exit("vector %s has %d features, run.json says %d" % (name, layer.featureCount(), out["features"]))
         renderer = layer.renderer()
+        if out["features"] == 0 and renderer is None:
+            continue  # an empty GeoJSON carries no geometry type: QGIS has nothing to style or draw
         if renderer.type() not in ("categorizedSymbol", "singleSymbol", "graduatedSymbol"):
             sys.exit("vector %s is not styled" % name)
         if renderer.type() == "categorizedSymbol":
@@ -89,10 +91,11 @@ for name, layer in layers.items():
             if not inside.contains(p):
                 sys.exit("city %s lies at %s in the project CRS, outside the DEM's %s" % (feature["id"], p.toString(), dem_extent.toString()))
         continue
+    if isinstance(layer, QgsVectorLayer) and layer.featureCount() == 0:
+        continue  # an empty layer has no extent
     extent = to_project.transformBoundingBox(layer.extent())
-    if layer.featureCount() if isinstance(layer, QgsVectorLayer) else True:
-        if not dem_extent.buffered(max(dem_extent.width(), dem_extent.height()) * 0.1).contains(extent):
-            sys.exit("layer %s lies at %s in the project CRS, outside the DEM's %s" % (name, extent.toString(), dem_extent.toString()))
+    if not dem_extent.buffered(max(dem_extent.width(), dem_extent.height()) * 0.1).contains(extent):
+        sys.exit("layer %s lies at %s in the project CRS, outside the DEM's %s" % (name, extent.toString(), dem_extent.toString()))
 
 settings = QgsMapSettings()
 settings.setLayers([l for l in project.layerTreeRoot().layerOrder() if l.isValid()])
