@@ -1,4 +1,4 @@
-// Single roads, network routing in parallel, maritime links and the output layers.
+// Single roads, the network routed link after link by importance (reuse, redundancy), maritime links and the output layers.
 // SPDX-License-Identifier: MIT
 #include "roads/road_network.hpp"
 
