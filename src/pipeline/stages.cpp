@@ -276,7 +276,10 @@ void roads_run(RunState& s, Progress& progress, const Log& log) {
     terrain.set_vegetation(read_resampled(settings.vegetation, s.dem.georef(), s.dem.cols(), s.dem.rows(), Resampling::bilinear));
   plugin::add_to_terrain(plugin::road_terms(s.plugins, s.dem, progress, log), terrain);
   const roads::RoadGraph graph(terrain, settings.model, settings.routing.graph);
-  const roads::NetworkResult r = roads::route_network(terrain, graph, network::road_links(*s.network, &*s.cities), settings.routing, progress);
+  const std::vector<roads::Link> links = network::road_links(*s.network, &*s.cities);
+  const roads::NetworkResult r = roads::route_network(terrain, graph, links, settings.routing, progress);
+  // Links routed ahead in parallel are routed again when the roads before them change what they saw.
+  log.detail(std::to_string(links.size()) + " links, " + std::to_string(r.searches) + " searches");
   for (const auto& f : r.failed) log.warn("no road: " + f);
   for (const auto& f : r.over_budget) log.warn("not routed: budget (roads.max_seconds): " + f);
   if (!r.redundant.empty()) {  // the summary counts them; the list only when asked (-v)

@@ -1,10 +1,14 @@
-// Single roads, the network routed link after link by importance (reuse, redundancy), maritime links and the output layers.
+// Single roads, the network routed by importance (reuse, redundancy; links routed ahead in parallel), maritime links and the output layers.
 // SPDX-License-Identifier: MIT
 #include "roads/road_network.hpp"
 
-#include <cmath>
-#include <numbers>
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
+#include <cmath>
+#include <exception>
+#include <numbers>
 
 #include "core/error.hpp"
 #include "core/random.hpp"
@@ -116,6 +120,10 @@ class BuiltRoads {
     view_.factor = factor_;  // floor 1: no road yet
   }
   const ArcDiscount* discount() const { return view_.floor < 1 ? &view_ : nullptr; }
+  double floor() const { return view_.floor; }
+  /// The cells whose factor changed, in the order the roads were added (a search routed when the
+  /// log held n cells saw every change before n).
+  const std::vector<std::uint32_t>& changes() const { return changes_; }
   bool on_road(std::uint32_t cell) const { return class_[cell] != kNone; }
   bool joined(std::uint32_t a, std::uint32_t b) { return find(a) == find(b); }
   /// Share of the chain's length (m) on cells already carrying a road at both ends of a step.
@@ -136,7 +144,9 @@ class BuiltRoads {
       for (std::uint32_t cell : {chain.cells[i], chain.cells[i + 1]}) {
         if (class_[cell] <= std::uint8_t(c)) continue;
         class_[cell] = std::uint8_t(c);
-        factor_[cell] = float(1.0 - discount_[std::size_t(c)]);
+        const float f = float(1.0 - discount_[std::size_t(c)]);
+        if (f != factor_[cell]) changes_.push_back(cell);
+        factor_[cell] = f;
         view_.floor = std::min(view_.floor, double(factor_[cell]));  // the smallest factor on the grid
       }
     }
@@ -158,6 +168,7 @@ class BuiltRoads {
   std::vector<float> factor_;
   std::vector<std::uint8_t> class_;
   std::vector<std::uint32_t> parent_;
+  std::vector<std::uint32_t> changes_;
   ArcDiscount view_;
 };
 
@@ -170,16 +181,32 @@ CostModel class_model(CostModel model, double max_grade_pct, double min_radius_m
   return model;
 }
 
+namespace {
+
+/// One routing of a link and what it saw of the roads before it: how many factor changes of
+/// BuiltRoads' log it was routed after, the floor, and the tiles of the cells whose factors it read.
+struct Attempt {
+  bool routed = false;
+  std::optional<Road> road;
+  std::exception_ptr error;  ///< rethrown only if the attempt is the one kept
+  std::size_t version = 0;
+  double floor = 1;
+  std::vector<std::uint8_t> tiles;
+};
+
+}  // namespace
+
 NetworkResult route_network(const TerrainField& t, const RoadGraph& base, const std::vector<Link>& links, const RoutingOptions& options,
                             Progress& progress) {
-  // One graph per road class, under the class's design standards (built when first needed).
+  // One graph per road class, under the class's design standards, built before routing (the
+  // searches share them read-only).
   std::array<std::optional<RoadGraph>, 4> graphs;
-  auto graph_of = [&](RoadClass c) -> const RoadGraph& {
-    const std::size_t k = std::size_t(c);
-    if (k >= graphs.size()) return base;
-    if (!graphs[k]) graphs[k].emplace(t, class_model(base.model(), options.max_grade_pct[k], options.min_radius_m[k]), base.options());
-    return *graphs[k];
-  };
+  for (const Link& l : links) {
+    const std::size_t k = std::size_t(l.road_class);
+    if (k < graphs.size() && !graphs[k])
+      graphs[k].emplace(t, class_model(base.model(), options.max_grade_pct[k], options.min_radius_m[k]), base.options());
+  }
+  auto graph_of = [&](RoadClass c) -> const RoadGraph& { return std::size_t(c) < graphs.size() ? *graphs[std::size_t(c)] : base; };
   struct Edge {
     Cell a, b;
   };
@@ -206,42 +233,96 @@ NetworkResult route_network(const TerrainField& t, const RoadGraph& base, const 
   std::vector<std::optional<Road>> out(edges.size());
   std::vector<bool> redundant(edges.size(), false);
   ProgressStep step(progress, "roads");
-  // One link after the other: each sees every road before it, so the order alone fixes the output
-  // (no parallelism across links: any two may share cells). Consecutive links to one end share its
-  // target search (the caches hold undiscounted costs, valid whatever the roads built since).
-  std::optional<TargetSearch> shared;
-  std::size_t shared_end = SIZE_MAX;
-  RoadClass shared_class = RoadClass::maritime;
-  for (std::size_t k = 0; k < order.size(); ++k) {
+  // Each link is routed on the roads of every link before it (the sequential definition), but the
+  // next links are routed ahead, in parallel, on the roads built so far, and an attempt is kept
+  // only if no road added since changed a factor it read (nor the floor): its search would then
+  // have run exactly the same, so the roads are those of routing one link after the other, whatever
+  // the threads or the look-ahead (docs/roads.md, "How routing is scheduled").
+  const int shift = ArcDiscount::kReadTileShift;
+  const std::size_t tile_cols = (std::size_t(t.cols()) >> shift) + 1, tile_rows = (std::size_t(t.rows()) >> shift) + 1;
+  int reach = 0;  // cells a surface arc's factors lie from the cell the search marks
+  for (std::size_t a = 0; a < base.surface_arcs(); ++a) reach = std::max({reach, std::abs(base.arcs()[a].dcol), std::abs(base.arcs()[a].drow)});
+  std::vector<Attempt> attempts(order.size());
+  auto cell_index = [&](Cell c) { return std::uint32_t(t.index(c.col, c.row)); };
+  auto still_valid = [&](const Attempt& at) {
+    if (at.floor != built.floor()) return false;
+    const auto& changes = built.changes();
+    if (at.tiles.empty()) return at.version == changes.size();  // routed without reuse
+    for (std::size_t j = at.version; j < changes.size(); ++j) {
+      const int col = int(changes[j] % std::uint32_t(t.cols())), row = int(changes[j] / std::uint32_t(t.cols()));
+      const int c0 = std::max(0, col - reach) >> shift, c1 = std::min(t.cols() - 1, col + reach) >> shift;
+      const int r0 = std::max(0, row - reach) >> shift, r1 = std::min(t.rows() - 1, row + reach) >> shift;
+      for (int r = r0; r <= r1; ++r)
+        for (int c = c0; c <= c1; ++c)
+          if (at.tiles[std::size_t(r) * tile_cols + std::size_t(c)]) return false;
+    }
+    return true;
+  };
+  auto route = [&](std::size_t k) {
+    Attempt& at = attempts[k];
+    at = Attempt{};
+    at.routed = true;
+    at.version = built.changes().size();
+    at.floor = built.floor();
     const std::size_t i = order[k];
-    const Edge& e = edges[i];
-    if (e.a == e.b) continue;
+    if (edges[i].a == edges[i].b) return;
+    std::optional<ArcDiscount> seen;
+    if (const ArcDiscount* d = built.discount()) {
+      at.tiles.assign(tile_cols * tile_rows, 0);
+      seen = *d;
+      seen->read_tiles = at.tiles.data();
+      seen->read_tile_cols = tile_cols;
+    }
     RoutingOptions o = options;
     o.bezier.seed = splitmix64(options.bezier.seed ^ splitmix64(i));
-    const RoadGraph& graph = graph_of(links[i].road_class);
-    const auto end = snap_to_land(t, e.b, options.snap_cells);
-    if (end && (t.index(end->col, end->row) != shared_end || links[i].road_class != shared_class)) {
-      shared.reset();
-      shared.emplace(graph, *end);
-      shared_end = t.index(end->col, end->row);
-      shared_class = links[i].road_class;
+    try {
+      at.road = route_road(t, graph_of(links[i].road_class), edges[i].a, edges[i].b, o, nullptr, nullptr, seen ? &*seen : nullptr);
+    } catch (...) {
+      at.error = std::current_exception();
     }
+  };
+  auto commit = [&](std::size_t k) {
+    Attempt& at = attempts[k];
+    if (at.error) std::rethrow_exception(at.error);
+    const std::size_t i = order[k];
     std::optional<Road>& r = out[i];
-    r = route_road(t, graph, e.a, e.b, o, nullptr, end ? &*shared : nullptr, built.discount());
+    r = std::move(at.road);
+    at = Attempt{};
     step.update(double(k + 1) / double(edges.size()), std::to_string(k + 1) + " of " + std::to_string(edges.size()) + " roads");
-    if (!r) continue;
+    if (!r) return;
     r->from = links[i].from;
     r->to = links[i].to;
     r->road_class = r->ferry ? RoadClass::maritime : links[i].road_class;
-    if (r->over_budget || r->chain.cells.empty()) continue;
+    if (r->over_budget || r->chain.cells.empty()) return;
     if (built.shared_share(r->chain) >= options.redundant_share && built.joined(r->chain.cells.front(), r->chain.cells.back())) {
       redundant[i] = true;
-      continue;
+      return;
     }
     built.add(r->chain, r->road_class);
+  };
+  const std::size_t lookahead =
+      options.lookahead > 0 ? options.lookahead : std::max<std::size_t>(1, tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+  NetworkResult result;
+  for (std::size_t head = 0; head < order.size();) {
+    // The head link (routed on the current roads, so always kept) and up to lookahead - 1 next ones
+    // not yet routed or whose attempt the roads added since made stale, routed at once; then every
+    // valid attempt in order.
+    // A link sharing an end with an earlier uncommitted link is left for later: that link's road
+    // will reach the end, where the search starts or ends, and make the attempt stale.
+    std::vector<std::size_t> todo{head};
+    std::vector<std::uint32_t> ends{cell_index(edges[order[head]].a), cell_index(edges[order[head]].b)};
+    for (std::size_t k = head + 1; k < std::min(order.size(), head + 4 * lookahead) && todo.size() < lookahead; ++k) {
+      const Edge& e = edges[order[k]];
+      const std::uint32_t a = cell_index(e.a), b = cell_index(e.b);
+      const bool after_an_end = std::find(ends.begin(), ends.end(), a) != ends.end() || std::find(ends.begin(), ends.end(), b) != ends.end();
+      ends.push_back(a), ends.push_back(b);
+      if (!after_an_end && (!attempts[k].routed || !still_valid(attempts[k]))) todo.push_back(k);
+    }
+    result.searches += todo.size();
+    tbb::parallel_for(std::size_t(0), todo.size(), [&](std::size_t j) { route(todo[j]); });
+    while (head < order.size() && attempts[head].routed && still_valid(attempts[head])) commit(head++);
   }
   step.update(1.0);
-  NetworkResult result;
   for (std::size_t i = 0; i < edges.size(); ++i) {
     const std::string name = std::to_string(links[i].from) + "-" + std::to_string(links[i].to);
     if (!out[i]) {

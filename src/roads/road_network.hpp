@@ -39,6 +39,9 @@ struct RoutingOptions {
   /// thresholds are lowered to it), and the smallest curve radius (m) of its smoothing.
   std::array<double, 4> max_grade_pct{6, 7, 10, 12};
   std::array<double, 4> min_radius_m{400, 120, 60, 30};
+  /// Links routed at once ahead of the roads they depend on (0: the worker threads). The roads never
+  /// depend on it (route_network); not a scenario option, tests set it.
+  std::size_t lookahead = 0;
 };
 
 /// The cost model of a road class: every slope threshold at most the class's grade, its curve radius.
@@ -79,7 +82,9 @@ struct Link {
 /// Roads of the links, as a network (Galin et al. 2011): links are routed by importance (class,
 /// then the longer first), each on the costs discounted along the roads before it, so roads merge
 /// into trunks; a link whose route is mostly on earlier roads is dropped (redundant_share).
-/// Links are routed one after the other in that order, so the output does not depend on the threads.
+/// The roads are those of routing the links one after the other in that order: the next links are
+/// routed ahead in parallel and kept only when the roads added meanwhile change nothing their search
+/// read, else routed again; so the output depends neither on the threads nor on the look-ahead.
 /// Links with no road are reported in `failed` and left out. Roads are listed in link order.
 struct NetworkResult {
   std::vector<Road> roads;
@@ -87,6 +92,7 @@ struct NetworkResult {
   std::vector<std::string> over_budget;  ///< links not routed within roads.max_seconds ("from-to")
   std::vector<std::string> redundant;    ///< links dropped: their route ran on earlier roads ("from-to")
   RoadNetworkLayout layout;              ///< the roads' shared sections and junctions
+  std::size_t searches = 0;              ///< links routed, attempts routed again included (depends on the threads)
 };
 NetworkResult route_network(const TerrainField& terrain, const RoadGraph& graph, const std::vector<Link>& links,
                             const RoutingOptions& options, Progress& progress);

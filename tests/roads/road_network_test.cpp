@@ -3,8 +3,10 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <random>
 
 #include "roads/road_network.hpp"
 #include "roads_fixtures.hpp"
@@ -312,4 +314,107 @@ TEST(RoadNetwork, GradesNeverExceedTheClassLimitOnACone) {
     EXPECT_GT(s.length_m, previous) << name_of(c);  // a gentler grade is a longer road
     previous = s.length_m;
   }
+}
+
+namespace {
+
+/// Random hills (a few Gaussian bumps above a plain at 50 m) on n x n cells of 10 m, with towns at
+/// random cells each linked to its two nearest neighbours, in random classes.
+struct RandomNetwork {
+  Dem dem;
+  std::vector<Link> links;
+};
+RandomNetwork random_network(std::mt19937_64& rng, int n, int towns) {
+  std::uniform_real_distribution<double> u(0, 1);
+  struct Bump { double c, r, h, s; };
+  std::vector<Bump> bumps;
+  for (int i = 0; i < 8; ++i) bumps.push_back({u(rng) * n, u(rng) * n, 10 + 40 * u(rng), 3 + 6 * u(rng)});
+  RandomNetwork net{test::make_dem(n, n, 10.0, [&](int c, int r) {
+    double z = 50;
+    for (const auto& b : bumps) z += b.h * std::exp(-((c - b.c) * (c - b.c) + (r - b.r) * (r - b.r)) / (2 * b.s * b.s));
+    return z;
+  }), {}};
+  std::vector<std::array<int, 2>> at;
+  for (int i = 0; i < towns; ++i) at.push_back({2 + int(u(rng) * (n - 4)), 2 + int(u(rng) * (n - 4))});
+  for (int i = 0; i < towns; ++i) {
+    std::vector<int> near;
+    for (int j = 0; j < towns; ++j)
+      if (j != i) near.push_back(j);
+    auto d2 = [&](int j) { return std::hypot(at[j][0] - at[i][0], at[j][1] - at[i][1]); };
+    std::sort(near.begin(), near.end(), [&](int x, int y) { return d2(x) < d2(y); });
+    for (int k = 0; k < 2; ++k) {
+      const int j = near[std::size_t(k)];
+      if (j < i) continue;  // each pair once
+      net.links.push_back({i, j, net.dem.georef().cell_centre(at[i][0], at[i][1]), net.dem.georef().cell_centre(at[j][0], at[j][1]),
+                           RoadClass(int(u(rng) * 4))});
+    }
+  }
+  return net;
+}
+
+}  // namespace
+
+TEST(RoadNetwork, RoutingAheadGivesTheRoadsOfOneLinkAfterTheOther) {
+  // Differential: links routed ahead in parallel (kept only when the roads added meanwhile change
+  // nothing they read) against one link after the other, on random networks that reuse each
+  // other's roads; the same layers byte for byte whatever the look-ahead and the threads.
+  std::mt19937_64 rng(2026);
+  std::size_t rerouted = 0;
+  for (int trial = 0; trial < 4; ++trial) {
+    const RandomNetwork net = random_network(rng, 48, 9);
+    const TerrainField terrain(net.dem, 0.0, 10.0, 0.0);
+    CostModel model = default_cost_model();
+    model.bridge.enabled = model.tunnel.enabled = false;
+    const RoadGraph graph(terrain, model, {4, 8, 1});
+    SilentProgress silent;
+    RoutingOptions o;
+    o.graph = {4, 8, 1};
+    o.max_grade_pct = {30, 30, 30, 30};
+    auto layers = [&](const NetworkResult& r) {
+      return dump(roads_layer(terrain, r.roads, &r.layout)) + dump(network_sections_layer(terrain, r.layout)) +
+             dump(junctions_layer(terrain, r.layout));
+    };
+    o.lookahead = 1;  // one link after the other: each routed once
+    NetworkResult sequential;
+    {
+      tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+      sequential = route_network(terrain, graph, net.links, o, silent);
+    }
+    EXPECT_EQ(sequential.searches, net.links.size());
+    ASSERT_GE(sequential.roads.size(), 3u);
+    EXPECT_FALSE(sequential.layout.junctions.empty()) << "the roads should share cells, trial " << trial;
+    const std::string expected = layers(sequential);
+    for (std::size_t lookahead : {2, 3, 16})
+      for (int threads : {1, 2}) {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
+        o.lookahead = lookahead;
+        const NetworkResult r = route_network(terrain, graph, net.links, o, silent);
+        EXPECT_EQ(layers(r), expected) << "trial " << trial << ", look-ahead " << lookahead << ", " << threads << " threads";
+        EXPECT_EQ(r.redundant, sequential.redundant);
+        EXPECT_GE(r.searches, net.links.size());
+        rerouted += r.searches - net.links.size();
+      }
+  }
+  EXPECT_GT(rerouted, 0u);  // some attempts were stale and routed again
+}
+
+TEST(RoadNetwork, ALinkRoutedAheadFarFromTheRoadsBeforeItIsKept) {
+  // Two links at the two ends of a long valley: the second one's search never reads a cell of the
+  // first road, so routed ahead it is kept (two searches); with the second link crossing the first
+  // road's end it is routed again (three).
+  const Dem dem = test::make_dem(220, 40, 10.0, [](int, int r) { return r < 6 ? 100.0 + 30 * (6 - r) : r > 34 ? 100.0 + 30 * (r - 34) : 100.0; });
+  const TerrainField terrain(dem, 0.0, 10.0, 0.0);
+  CostModel model = default_cost_model();
+  model.bridge.enabled = model.tunnel.enabled = false;
+  const RoadGraph graph(terrain, model, {4, 8, 1});
+  SilentProgress silent;
+  RoutingOptions o;
+  o.graph = {4, 8, 1};
+  o.lookahead = 2;
+  const NetworkResult apart = route_network(terrain, graph, network(dem, {{5, 20, 90, 20}, {150, 20, 210, 22}}), o, silent);
+  EXPECT_EQ(apart.roads.size(), 2u);
+  EXPECT_EQ(apart.searches, 2u);
+  const NetworkResult crossing = route_network(terrain, graph, network(dem, {{5, 20, 90, 20}, {60, 30, 130, 10}}), o, silent);
+  EXPECT_EQ(crossing.roads.size(), 2u);
+  EXPECT_EQ(crossing.searches, 3u);
 }
