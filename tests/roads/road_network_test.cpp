@@ -399,9 +399,10 @@ TEST(RoadNetwork, RoutingAheadGivesTheRoadsOfOneLinkAfterTheOther) {
 }
 
 TEST(RoadNetwork, ALinkRoutedAheadFarFromTheRoadsBeforeItIsKept) {
-  // Two links at the two ends of a long valley: the second one's search never reads a cell of the
-  // first road, so routed ahead it is kept (two searches); with the second link crossing the first
-  // road's end it is routed again (three).
+  // The first road changes the smallest factor, so the link routed ahead of it is routed again
+  // (searches 1 and 2, then 2 again). The third link, at the other end of a long valley, is routed
+  // ahead of the second: its search never reads a cell of the second road, so it is kept (4
+  // searches); crossing the second road instead, it is routed again (5).
   const Dem dem = test::make_dem(220, 40, 10.0, [](int, int r) { return r < 6 ? 100.0 + 30 * (6 - r) : r > 34 ? 100.0 + 30 * (r - 34) : 100.0; });
   const TerrainField terrain(dem, 0.0, 10.0, 0.0);
   CostModel model = default_cost_model();
@@ -411,10 +412,10 @@ TEST(RoadNetwork, ALinkRoutedAheadFarFromTheRoadsBeforeItIsKept) {
   RoutingOptions o;
   o.graph = {4, 8, 1};
   o.lookahead = 2;
-  const NetworkResult apart = route_network(terrain, graph, network(dem, {{5, 20, 90, 20}, {150, 20, 210, 22}}), o, silent);
-  EXPECT_EQ(apart.roads.size(), 2u);
-  EXPECT_EQ(apart.searches, 2u);
-  const NetworkResult crossing = route_network(terrain, graph, network(dem, {{5, 20, 90, 20}, {60, 30, 130, 10}}), o, silent);
-  EXPECT_EQ(crossing.roads.size(), 2u);
-  EXPECT_EQ(crossing.searches, 3u);
+  const NetworkResult apart = route_network(terrain, graph, network(dem, {{5, 20, 100, 20}, {10, 28, 90, 30}, {150, 20, 210, 22}}), o, silent);
+  EXPECT_EQ(apart.roads.size() + apart.redundant.size(), 3u);
+  EXPECT_EQ(apart.searches, 4u);
+  const NetworkResult crossing = route_network(terrain, graph, network(dem, {{5, 20, 100, 20}, {10, 28, 90, 30}, {60, 30, 130, 10}}), o, silent);
+  EXPECT_EQ(crossing.roads.size() + crossing.redundant.size(), 3u);
+  EXPECT_EQ(crossing.searches, 5u);
 }
