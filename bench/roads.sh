@@ -40,19 +40,24 @@ if command -v grass >/dev/null; then
   " >"$out/grass.log" 2>&1 || { echo "GRASS failed:"; grep -i error "$out/grass.log" | head -5; exit 1; }
   read -r secs user kb <"$out/time"
   echo "grass r.walk+r.drain: wall ${secs} s, CPU ${user} s (GRASS session included), peak ${kb} kB"
-  # Paired: the default road (A*, bridges and tunnels) and GRASS in turn, 3 times each; medians and
-  # their ratio (the machine is shared: wall times drift, pairs see the same load).
-  ours=(); peer=()
+  # Paired: the default road (A*, bridges and tunnels) and GRASS in turn, 3 times each; medians of
+  # wall and CPU (user) seconds and their ratios (the machine is shared: wall times drift with the
+  # load, pairs see the same load; CPU seconds drift less).
+  ours=(); peer=(); ours_cpu=(); peer_cpu=()
   for i in 1 2 3; do
-    /usr/bin/time -f "%e" -o "$out/t_ours" "$bin" --progress none path "$dem" --from $from --to $to "$out/paired.geojson" --overwrite 2>/dev/null
-    /usr/bin/time -f "%e" -o "$out/t_peer" grass "$out/loc/PERMANENT" --exec bash -c "
+    /usr/bin/time -f "%e %U" -o "$out/t_ours" "$bin" --progress none path "$dem" --from $from --to $to "$out/paired.geojson" --overwrite 2>/dev/null
+    /usr/bin/time -f "%e %U" -o "$out/t_peer" grass "$out/loc/PERMANENT" --exec bash -c "
       r.walk -k --quiet --overwrite elevation=dem friction=friction output=cost outdir=dir start_coordinates=$from stop_coordinates=$to
       r.drain -d --quiet --overwrite input=cost direction=dir output=drain drain=drain_line start_coordinates=$to" >/dev/null 2>&1
-    ours+=("$(cat "$out/t_ours")"); peer+=("$(cat "$out/t_peer")")
+    read -r w u <"$out/t_ours"; ours+=("$w"); ours_cpu+=("$u")
+    read -r w u <"$out/t_peer"; peer+=("$w"); peer_cpu+=("$u")
   done
   median() { printf '%s\n' "$@" | sort -g | sed -n 2p; }
-  mo=$(median "${ours[@]}"); mp=$(median "${peer[@]}")
-  echo "paired x3, wall: terrapolis ${ours[*]} s (median $mo), grass ${peer[*]} s (median $mp), ratio $(awk -v a="$mo" -v b="$mp" 'BEGIN {printf "%.2f", a / b}')"
+  ratio() { awk -v a="$1" -v b="$2" 'BEGIN {printf "%.2f", a / b}'; }
+  mo=$(median "${ours[@]}"); mp=$(median "${peer[@]}"); co=$(median "${ours_cpu[@]}"); cp=$(median "${peer_cpu[@]}")
+  echo "paired x3, wall: terrapolis ${ours[*]} s (median $mo), grass ${peer[*]} s (median $mp), ratio $(ratio "$mo" "$mp")"
+  echo "paired x3, CPU: terrapolis ${ours_cpu[*]} s (median $co), grass ${peer_cpu[*]} s (median $cp), ratio $(ratio "$co" "$cp")"
+  echo "load average: $(cut -d' ' -f1-3 /proc/loadavg)"
   # Both paths priced by our model, walked cell by cell (8-neighbour steps, curvature with m = 8);
   # then without the slope and water thresholds, so that a path breaking them still gets a number.
   echo '{"road": {"slope_deg": {"threshold": null}, "water_depth_m": {"threshold": null}}}' >"$out/open.json"

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "roads/radix_heap.hpp"
 
 namespace terrapolis::roads {
 namespace {
@@ -182,7 +183,7 @@ double reuse_factor(const RoadGraph& graph, const ArcDiscount* discount, Cell c,
 /// factor to stay consistent: the forward search keeps a tight heuristic along and off the roads.
 class RelaxedDistance {
  public:
-  RelaxedDistance(const RoadGraph& graph, Cell target, Cell source, ArcCache& cache, const ArcDiscount* discount)
+  RelaxedDistance(const RoadGraph& graph, Cell target, Cell source, ArcCache* cache, const ArcDiscount* discount)
       : graph_(graph), t_(graph.terrain()), source_(source), cache_(cache), discount_(discount),
         guide_scale_(discount ? discount->floor : 1.0) {
     if (scratch_in_use_) own_.emplace();  // a nested search on this thread gets its own arrays
@@ -247,7 +248,7 @@ class RelaxedDistance {
     Scratch& s = scratch();
     if (s.closed[i]) return s.g[i];
     if (heap_.empty()) return kInfinity;
-    return std::max(0.0, heap_.front().f - guide(v));
+    return std::max(0.0, heap_.floor() - guide(v));
   }
   bool settled(Cell v) { return scratch().closed[t_.index(v.col, v.row)] != 0; }
   std::size_t settled_cells() const { return settled_; }
@@ -257,11 +258,10 @@ class RelaxedDistance {
   void set_source(Cell source) {
     if (source == source_) return;
     source_ = source;
-    for (Entry& e : heap_) {
+    heap_.rekey([&](Entry& e) {
       const Cell c{int(e.cell % std::size_t(t_.cols())), int(e.cell / std::size_t(t_.cols()))};
       e.f = e.g + guide(c) + (e.ring >= 0 ? ring_offset_[std::size_t(e.ring)] : 0.0);
-    }
-    std::make_heap(heap_.begin(), heap_.end());
+    });
   }
 
  private:
@@ -269,10 +269,6 @@ class RelaxedDistance {
     double f, g;
     std::size_t cell;
     int ring;  ///< -1: settle the cell; r >= 0: relax the long arcs of ring r into the (settled) cell
-    bool operator<(const Entry& o) const {  // min-heap, fixed ties
-      if (f != o.f) return f > o.f;
-      return cell != o.cell ? cell > o.cell : ring > o.ring;
-    }
   };
   struct Scratch {
     std::vector<double> g;
@@ -291,10 +287,7 @@ class RelaxedDistance {
     const Cell c{int(i % std::size_t(t_.cols())), int(i / std::size_t(t_.cols()))};
     push({g + guide(c), g, i, -1});
   }
-  void push(const Entry& e) {
-    heap_.push_back(e);
-    std::push_heap(heap_.begin(), heap_.end());
-  }
+  void push(const Entry& e) { heap_.push(e); }
   /// The least of (relaxed long-arc cost - lower_bound across the arc) per metre for structure st,
   /// >= 0: an arc of length L into v gives its source w a key at least f(v) + L x margin, since
   /// lower_bound(v, w) <= L envelope(grade) (the envelope is convex and non-decreasing). Each grade
@@ -315,9 +308,7 @@ class RelaxedDistance {
   bool settle_next() {
     Scratch& s = scratch();
     while (!heap_.empty()) {
-      std::pop_heap(heap_.begin(), heap_.end());
-      const Entry e = heap_.back();
-      heap_.pop_back();
+      const Entry e = heap_.pop();
       if (e.ring >= 0) {
         relax_ring(e);
         continue;
@@ -343,7 +334,7 @@ class RelaxedDistance {
       const double factor = reuse_factor(graph_, discount_, u, int(a));
       const double lb = graph_.surface_arc_bound(u, int(a)) * factor;
       if (lb == kInfinity || d + lb >= scratch().g[ui]) continue;
-      const double e = cache_.get(u, ui, int(a)) * factor;
+      const double e = (cache_ ? cache_->get(u, ui, int(a)) : double(float(graph_.arc_cost(u, int(a))))) * factor;
       if (e < kInfinity) relax(ui, d + e);
     }
     // Long arcs join two land cells. They wait in the queue, one entry per ring, keyed by f(v) plus
@@ -392,11 +383,12 @@ class RelaxedDistance {
   const RoadGraph& graph_;
   const TerrainField& t_;
   Cell source_;
-  ArcCache& cache_;
+  ArcCache* cache_;              ///< shared with later searches to the target, or nullptr (the arcs
+                                 ///< it prices are each priced once: caching them costs more)
   const ArcDiscount* discount_;  ///< road reuse, or nullptr
   const double guide_scale_;     ///< the smallest discount factor, 1 without reuse
   std::optional<Scratch> own_;
-  std::vector<Entry> heap_;
+  RadixHeap<Entry> heap_;  ///< keys only grow: the guide is consistent
   double fixed_[3] = {0, 0, 0};
   std::vector<double> slope_floor_[3];  ///< per structure: lower bounds of the deck slope cost by grade step
   double grade_step_[3] = {1, 1, 1}, tan_max_[3] = {kInfinity, kInfinity, kInfinity};
@@ -425,7 +417,7 @@ namespace {
 class PathSearch {
  public:
   PathSearch(const RoadGraph& graph, Cell from, Cell to, SearchMethod method, std::size_t max_nodes, Progress* progress,
-             double max_seconds, TargetSearch::State& state, const ArcDiscount* discount)
+             double max_seconds, TargetSearch::State& state, bool state_shared, const ArcDiscount* discount)
       : graph_(graph), t_(graph.terrain()), arcs_(graph.arcs()), discount_(discount),
         h_scale_(discount ? discount->floor : 1.0), from_(from), to_(to), max_nodes_(max_nodes),
         max_seconds_(max_seconds), O_(std::uint64_t(graph.orientations())), use_h_(method != SearchMethod::dijkstra),
@@ -438,7 +430,7 @@ class PathSearch {
       // With road reuse the roads built since the last search changed the discounted costs: the
       // relaxed search starts again (its arc caches, of undiscounted costs, stay shared).
       if (state.relaxed && !discount) state.relaxed->set_source(from);
-      else state.relaxed.reset(), state.relaxed.emplace(graph, to, from, cache_, discount);
+      else state.relaxed.reset(), state.relaxed.emplace(graph, to, from, state_shared ? &cache_ : nullptr, discount);
       rel_ = &*state.relaxed;
       settled_before_ = rel_->settled_cells();
     }
@@ -703,7 +695,7 @@ SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMet
   if (shared && !(shared->state().target == to)) throw processing_error("path: a shared target search used for another target");
   std::optional<TargetSearch> own;
   TargetSearch::State& state = (shared ? *shared : own.emplace(graph, to)).state();
-  return PathSearch(graph, from, to, method, max_nodes, progress, max_seconds, state, discount).run();
+  return PathSearch(graph, from, to, method, max_nodes, progress, max_seconds, state, shared != nullptr, discount).run();
 }
 
 }  // namespace terrapolis::roads

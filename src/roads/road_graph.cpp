@@ -40,6 +40,12 @@ RoadGraph::RoadGraph(const TerrainField& terrain, const CostModel& model, const 
   orientations_ = blocks * m + 1;
   for (const MaskArc& a : segment_mask(options_.k)) arcs_.push_back({a.dcol, a.drow, Structure::road, block[0] * m + sector_of(a.angle_rad, m), a.angle_rad});
   surface_arcs_ = arcs_.size();
+  if (surface_arcs_ * std::size_t(terrain_.rows()) <= kMaxLengthTable) {
+    surface_length_.resize(surface_arcs_ * std::size_t(terrain_.rows()));
+    for (int r = 0; r < terrain_.rows(); ++r)
+      for (std::size_t a = 0; a < surface_arcs_; ++a)
+        surface_length_[std::size_t(r) * surface_arcs_ + a] = terrain_.length_m({0, double(r)}, {double(arcs_[a].dcol), double(r + arcs_[a].drow)});
+  }
   const double cell = terrain_.typical_cell_m();
   for (Structure s : {Structure::bridge, Structure::tunnel}) {
     const StructureCosts& sc = s == Structure::bridge ? model_.bridge : model_.tunnel;
@@ -297,11 +303,17 @@ double RoadGraph::road_slope_cost(double grade) const {
   return slope_lut_[i] + f * (slope_lut_[i + 1] - slope_lut_[i]);
 }
 
+double RoadGraph::surface_length_m(int row, int arc) const {
+  if (!surface_length_.empty()) return surface_length_[std::size_t(row) * surface_arcs_ + std::size_t(arc)];
+  const Arc& a = arcs_[std::size_t(arc)];
+  return terrain_.length_m({0, double(row)}, {double(a.dcol), double(row + a.drow)});
+}
+
 double RoadGraph::surface_arc_bound(Cell from, int arc) const {
   const Arc& a = arcs_[std::size_t(arc)];
   const int c1 = from.col + a.dcol, r1 = from.row + a.drow;
   if (!terrain_.inside(c1, r1)) return kInfinity;
-  const double length = terrain_.length_m({double(from.col), double(from.row)}, {double(c1), double(r1)});
+  const double length = surface_length_m(from.row, arc);
   const double grade = std::fabs(double(terrain_.surface(c1, r1)) - double(terrain_.surface(from.col, from.row))) / length;
   // Some step is at least as steep as the mean (1e-9: the steps' own rounding).
   if (grade > tan_slope_max_ * (1 + 1e-9) || road_hull_t_.empty()) return kInfinity;
@@ -368,7 +380,7 @@ double RoadGraph::arc_cost(Cell from, int arc) const {
   const int c1 = from.col + a.dcol, r1 = from.row + a.drow;
   if (!terrain_.inside(c1, r1)) return kInfinity;
   const GridPoint p0{double(from.col), double(from.row)}, p1{double(c1), double(r1)};
-  const double length = terrain_.length_m(p0, p1);
+  const double length = a.structure == Structure::road ? surface_length_m(from.row, arc) : terrain_.length_m(p0, p1);
   const int n = std::max(1, int(std::ceil(length / step_m_)));
   const double dl = length / n;
   const double dc = double(a.dcol) / n, dr = double(a.drow) / n;

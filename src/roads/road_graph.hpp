@@ -109,6 +109,11 @@ class RoadGraph {
   std::uint64_t bridge_keep_ = 0, tunnel_keep_ = 0;  ///< hash thresholds of the sampling
   std::uint64_t salt_[3] = {0, 0, 0};                ///< per-structure hash salt from the seed
   std::vector<double> turn_;
+  /// Length (m) of surface arc a from row r at [r * surface_arcs_ + a], exactly as length_m gives it
+  /// (a function of the row alone: no hypot per arc); empty past kMaxLengthTable entries.
+  std::vector<double> surface_length_;
+  static constexpr std::size_t kMaxLengthTable = std::size_t(1) << 22;  // 32 MB
+  double surface_length_m(int row, int arc) const;
   std::vector<double> slope_lut_;        ///< road slope cost against the grade |dz|/dl, for speed
   double lut_step_ = 1, tan_slope_max_ = kInfinity;
   double road_slope_cost(double grade) const;

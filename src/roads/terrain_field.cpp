@@ -111,11 +111,6 @@ double bilinear(const V& v, int cols, int rows, double col, double row) {
 double TerrainField::surface_at(double col, double row) const { return bilinear(surface_, cols_, rows_, col, row); }
 double TerrainField::ground_at(double col, double row) const { return bilinear(ground_, cols_, rows_, col, row); }
 
-float TerrainField::depth_at(double col, double row) const {
-  const int c = std::clamp(int(std::lround(col)), 0, cols_ - 1), r = std::clamp(int(std::lround(row)), 0, rows_ - 1);
-  return depth_[index(c, r)];
-}
-
 void TerrainField::set_vegetation(const Raster<float>& density) {
   if (density.cols() != cols_ || density.rows() != rows_) throw bad_input("vegetation layer: not on the DEM's grid");
   vegetation_.resize(density.size());
@@ -140,18 +135,18 @@ void TerrainField::add_cost_layer(const std::string& name, const Raster<float>& 
 
 float TerrainField::vegetation_at(double col, double row) const {
   if (vegetation_.empty()) return 0.f;
-  const int c = std::clamp(int(std::lround(col)), 0, cols_ - 1), r = std::clamp(int(std::lround(row)), 0, rows_ - 1);
+  const int c = std::clamp(nearest_cell(col), 0, cols_ - 1), r = std::clamp(nearest_cell(row), 0, rows_ - 1);
   return vegetation_[index(c, r)];
 }
 
 double TerrainField::metres_x(double row) const {
-  const int r = std::clamp(int(std::lround(row)), 0, rows_ - 1);
+  const int r = std::clamp(nearest_cell(row), 0, rows_ - 1);
   return metrics_.width_m[r];
 }
 
 double TerrainField::metres_y(double row) const {
   // height_m[r] spans rows r-1..r; take the boundary nearest to the position.
-  const int r = std::clamp(int(std::lround(row + 0.5)), 0, rows_);
+  const int r = std::clamp(nearest_cell(row + 0.5), 0, rows_);
   return metrics_.height_m[r];
 }
 

@@ -14,6 +14,12 @@
 
 namespace terrapolis::roads {
 
+/// std::lround for |x| < 2^31, inlined (x - trunc(x) is exact): the nearest cell to a position.
+inline int nearest_cell(double x) {
+  const double t = std::trunc(x), f = x - t;
+  return int(t) + (f >= 0.5) - (f <= -0.5);
+}
+
 /// Positions are in cell units, (col, row) with integers at cell centres (row 0 north).
 struct GridPoint {
   double col = 0, row = 0;
@@ -46,7 +52,10 @@ class TerrainField {
   /// Bilinear terrain height (m) (sea floor under water).
   double ground_at(double col, double row) const;
   /// Water depth (m) at the nearest cell, the maximum within the road radius; 0 on land.
-  float depth_at(double col, double row) const;
+  float depth_at(double col, double row) const {
+    const int c = std::clamp(nearest_cell(col), 0, cols_ - 1), r = std::clamp(nearest_cell(row), 0, rows_ - 1);
+    return depth_[index(c, r)];
+  }
   /// Sets the vegetation / land-cover density layer (same grid as the DEM; NaN counts as 0).
   void set_vegetation(const Raster<float>& density);
   /// Vegetation density at the nearest cell (0 without a layer).
@@ -63,7 +72,7 @@ class TerrainField {
   float extra_cost_at(Structure s, double col, double row) const {
     const auto& v = extra_[int(s)];
     if (v.empty()) return 0.f;
-    const int c = std::clamp(int(std::lround(col)), 0, cols_ - 1), r = std::clamp(int(std::lround(row)), 0, rows_ - 1);
+    const int c = std::clamp(nearest_cell(col), 0, cols_ - 1), r = std::clamp(nearest_cell(row), 0, rows_ - 1);
     return v[index(c, r)];
   }
   bool water(int col, int row) const { return water_[index(col, row)] != 0; }
