@@ -25,4 +25,11 @@ double polygon_area_m2(const Crs& crs, const std::vector<std::array<double, 2>>&
   return 0.5 * std::abs(twice) * crs.linear_unit_m * crs.linear_unit_m;
 }
 
+double polygons_area_m2(const Crs& crs, const std::vector<Polygon>& polygons) {
+  double area = 0;
+  for (const Polygon& p : polygons)
+    for (std::size_t i = 0; i < p.rings.size(); ++i) area += (i == 0 ? 1 : -1) * polygon_area_m2(crs, p.rings[i]);
+  return area;
+}
+
 }  // namespace terrapolis

@@ -13,4 +13,14 @@ namespace terrapolis {
 /// the shoelace formula times the linear unit squared on projected ones.
 double polygon_area_m2(const Crs& crs, const std::vector<std::array<double, 2>>& ring);
 
+using Ring = std::vector<std::array<double, 2>>;
+
+/// A polygon: the outer ring first, then its holes (rings not closed, any orientation).
+struct Polygon {
+  std::vector<Ring> rings;
+};
+
+/// Area in m² of disjoint polygons: each outer ring's area less its holes'.
+double polygons_area_m2(const Crs& crs, const std::vector<Polygon>& polygons);
+
 }  // namespace terrapolis

@@ -14,6 +14,7 @@
 #include "core/error.hpp"
 #include "io/crs.hpp"
 #include "io/text_io.hpp"
+#include "roads/corridor.hpp"
 #include "roads/road_class.hpp"
 
 namespace terrapolis::pipeline {
@@ -143,6 +144,7 @@ int draw_rank(Style s) {
     case Style::city_extents: return 5;
     case Style::streams: return 6;
     case Style::network: return 7;
+    case Style::corridors: return 8;
     case Style::road_sections: return 8;
     case Style::roads: return 9;
     case Style::sections: return 10;
@@ -233,6 +235,7 @@ std::string qgis_style_body(const OutputFile& o, const RunState& state) {
                                        {"tunnel", "tunnel", line("2", "#8c510a", 1.0, "dash")},
                                        {"ferry", "ferry", line("3", "#a6cee3", 0.6, "dot")}});
     case Style::junctions: return single(marker("0", "#252525", 1.6));
+    case Style::corridors: return roads::corridors_renderer();
   }
   return "";
 }

@@ -202,6 +202,13 @@ CorridorSettings corridor_settings(const Scenario& scenario) {
   const json& c = scenario.resolved["roads"]["corridor"];
   CorridorSettings s;
   s.options.half_width_m = c["half_width_m"].get<double>();
+  for (std::size_t k = 0; k < s.options.widths.size(); ++k) {
+    const std::string name(roads::name_of(roads::RoadClass(k)));
+    s.options.widths[k] = {c["carriageway_m"][name].get<double>(), c["platform_m"][name].get<double>()};
+    if (s.options.widths[k].platform_m < s.options.widths[k].carriageway_m)
+      throw bad_input("/roads/corridor/platform_m/" + name + ": narrower than /roads/corridor/carriageway_m/" + name);
+  }
+  s.enabled = c["enabled"].get<bool>();
   const double angle = c["side_angle_deg"].get<double>();
   s.options.side_angle_deg = angle > 0 ? angle : roads::repose_angle_deg(c["material"].get<std::string>());
   s.options.max_height_m = c["max_height_m"].get<double>();
@@ -252,6 +259,8 @@ StageSettings prepare_stages(const Scenario& scenario) {
     s.sites = sites_options(scenario);
     s.network = network_options(scenario);
     s.roads = at("/roads/costs", [&] { return roads_settings(scenario); });
+    s.corridor = corridor_settings(scenario);
+    check_file("/roads/corridor/side_angles", s.corridor.side_angles);
     check_file("/water/water_mask", scenario.path("/water/water_mask"));
     check_file("/roads/vegetation", s.roads.vegetation);
     check_file("/sites/reference", scenario.path("/sites/reference"));

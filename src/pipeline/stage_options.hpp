@@ -59,6 +59,7 @@ RoadsSettings roads_settings(const Scenario& scenario);
 struct CorridorSettings {
   roads::CorridorOptions options;
   std::string side_angles;
+  bool enabled = false;  ///< the run's roads stage writes corridors.geojson
 };
 CorridorSettings corridor_settings(const Scenario& scenario);
 
@@ -77,6 +78,7 @@ struct StageSettings {
   sites::SitesOptions sites;
   network::NetworkOptions network;
   RoadsSettings roads;
+  CorridorSettings corridor;
 };
 /// Builds every stage's settings, loads the cost model and checks that every file the scenario
 /// names exists. Throws bad_input as "SCENARIO: /json/pointer: problem".

@@ -265,6 +265,27 @@ void network_load(RunState& s) { s.network = read_vector(saved(s, "network.geojs
 
 // ---- roads (Galin et al. 2010, Peytavie 2010 ch. 4; Belhadj 2007 Alg. 16; docs/roads.md) ----
 
+/// roads.corridor.enabled: corridors.geojson and the land take and volumes for the summary (null when off).
+json corridor_hook(RunState& s, const roads::TerrainField& terrain, const std::vector<roads::Road>& built) {
+  CorridorSettings c = s.settings.corridor;
+  if (!c.enabled) return nullptr;
+  if (!c.side_angles.empty())
+    c.options.side_angles_deg = read_resampled(c.side_angles, s.dem.georef(), s.dem.cols(), s.dem.rows(), Resampling::nearest);
+  std::vector<const roads::RoadGeometry*> geometries;
+  std::vector<roads::RoadClass> classes;
+  for (const roads::Road& r : built) {
+    geometries.push_back(&r.geometry);
+    classes.push_back(r.road_class);
+  }
+  const roads::Corridors corridors = roads::corridors(terrain, geometries, c.options, classes);
+  s.write("roads", "corridors.geojson", roads::corridors_layer(terrain, corridors),
+          "per section the carriageway and earthworks zone (cut, fill), and the land take united", Style::corridors);
+  json out = {{"land_take_ha", round_to(corridors.run.land_take_ha, 0.01)}, {"cut_m3", round_to(corridors.run.cut_m3, 1)},
+              {"fill_m3", round_to(corridors.run.fill_m3, 1)}};
+  if (corridors.vegetation) out["cleared_ha"] = round_to(corridors.run.cleared_ha, 0.01);
+  return out;
+}
+
 void roads_run(RunState& s, Progress& progress, const Log& log) {
   const RoadsSettings& settings = s.settings.roads;
   const Raster<float> water = read_resampled(saved(s, kInlandWater), s.dem.georef(), s.dem.cols(), s.dem.rows(), Resampling::nearest);
@@ -297,6 +318,7 @@ void roads_run(RunState& s, Progress& progress, const Log& log) {
             Style::junctions);
   s.write("roads", "road_sections.geojson", roads::sections_layer(terrain, r.roads), "road, bridge, tunnel and ferry sections",
           Style::road_sections);
+  const json corridor = corridor_hook(s, terrain, r.roads);
   std::map<std::string, double> km;
   double bridge_m = 0, tunnel_m = 0, over_limit_m = 0, water_m = 0, network_km = 0;
   for (const auto& road : r.roads) {
@@ -315,6 +337,7 @@ void roads_run(RunState& s, Progress& progress, const Log& log) {
                         {"bridge_m", round_to(bridge_m, 0.1)}, {"tunnel_m", round_to(tunnel_m, 0.1)},
                         {"network_km", round_to(network_km, 0.01)}, {"over_grade_limit_m", round_to(over_limit_m, 0.1)},
                         {"on_water_m", round_to(water_m, 0.1)}};
+  if (!corridor.is_null()) s.summary["roads"]["corridor"] = corridor;
 }
 
 void roads_load(RunState&) {}  // nothing downstream

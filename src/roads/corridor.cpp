@@ -8,12 +8,14 @@
 #include <numbers>
 
 #include "core/error.hpp"
-#include "core/polygon_area.hpp"
+#include "io/polygon_union.hpp"
 
 namespace terrapolis::roads {
 namespace {
 
 constexpr double kRad = std::numbers::pi / 180.0;
+
+using Point2 = std::array<double, 2>;
 
 double side_slope_of(double angle_deg) { return 1.0 / std::tan(angle_deg * kRad); }
 
@@ -98,49 +100,70 @@ Side cross_section(const TerrainField& t, const EarthworkOptions& o, GridPoint p
   return side;
 }
 
-/// Appends the offset point unless it runs back against the road's direction (the inner side of
-/// a corner tighter than the offset: skipping it keeps the ring simple).
-void push_offset(std::vector<GridPoint>& side, const TerrainField& t, GridPoint q, Direction along) {
-  if (!side.empty()) {
-    const GridPoint& last = side.back();
-    const double dx = (q.col - last.col) * t.metres_x(q.row), dy = (q.row - last.row) * t.metres_y(q.row);
-    if (dx * along.x + dy * along.y <= 0) return;
+/// The pieces a cross-section's half sweeps between two stations: the quadrilateral
+/// a (centre), b (next centre), c (next offset), d (offset), or, where it folds (the inner side of
+/// a bend tighter than the offset: the offsets cross), its two triangles about the crossing.
+/// Degenerate pieces (no area) are left out: the union needs valid polygons.
+void add_swept(std::vector<Polygon>& out, const Point2& a, const Point2& b, const Point2& c, const Point2& d) {
+  auto cross = [](const Point2& o, const Point2& p, const Point2& q) {
+    return (p[0] - o[0]) * (q[1] - o[1]) - (p[1] - o[1]) * (q[0] - o[0]);
+  };
+  // Where segments pq and uv cross properly, their crossing point.
+  auto crossing = [&](const Point2& p, const Point2& q, const Point2& u, const Point2& v) -> std::optional<Point2> {
+    const double d1 = cross(p, q, u), d2 = cross(p, q, v), d3 = cross(u, v, p), d4 = cross(u, v, q);
+    if (!((d1 > 0) != (d2 > 0) && d1 != 0 && d2 != 0 && (d3 > 0) != (d4 > 0) && d3 != 0 && d4 != 0)) return std::nullopt;
+    const double t = d3 / (d3 - d4);
+    return Point2{p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])};
+  };
+  auto piece = [&](Ring ring) {
+    double twice = 0;
+    for (std::size_t i = 0, j = ring.size() - 1; i < ring.size(); j = i++) twice += cross({0, 0}, ring[j], ring[i]);
+    const double scale = std::max(std::fabs(a[0] - d[0]) + std::fabs(a[1] - d[1]), std::fabs(b[0] - c[0]) + std::fabs(b[1] - c[1]));
+    if (std::fabs(twice) > 1e-9 * scale * scale) out.push_back(Polygon{{std::move(ring)}});
+  };
+  if (const auto x = crossing(b, c, d, a)) {
+    piece({a, b, *x});
+    piece({*x, c, d});
+  } else if (const auto y = crossing(a, b, c, d)) {
+    piece({a, *y, d});
+    piece({*y, b, c});
+  } else {
+    piece({a, b, c, d});
   }
-  side.push_back(q);
 }
 
-/// A ring from the offsets: left side forward, right side back.
-std::vector<GridPoint> ring_of(std::vector<GridPoint> left, const std::vector<GridPoint>& right) {
-  left.insert(left.end(), right.rbegin(), right.rend());
-  return left;
+/// The area a cross-section sweeps along the stations: centres[j] to left[j] and right[j], united.
+std::vector<Polygon> swept_area(const Ring& centres, const Ring& left, const Ring& right) {
+  std::vector<Polygon> pieces;
+  for (std::size_t j = 0; j + 1 < centres.size(); ++j) {
+    add_swept(pieces, centres[j], centres[j + 1], left[j + 1], left[j]);
+    add_swept(pieces, centres[j], centres[j + 1], right[j + 1], right[j]);
+  }
+  return polygon_union(pieces);
 }
 
-std::vector<std::array<double, 2>> to_crs(const TerrainField& t, const std::vector<GridPoint>& pts) {
-  std::vector<std::array<double, 2>> out;
-  out.reserve(pts.size());
-  for (const GridPoint& p : pts) out.push_back(t.georef().cell_centre(p.col, p.row));
-  return out;
-}
-
-/// The carriageway and earthworks rings of one section (points pts, decks from road point
+/// The carriageway and earthworks zone of one section (points pts, decks from road point
 /// `first`), and its cross-sections' volumes and clearing.
 void section_corridor(const TerrainField& t, const EarthworkOptions& o, const RoadGeometry& road, std::size_t first,
                       const std::vector<GridPoint>& pts, SectionCorridor& s) {
-  std::vector<GridPoint> lane_left, lane_right, zone_left, zone_right;
+  if (s.structure == "ferry") return;
+  Ring centres, lane_left, lane_right, zone_left, zone_right;
   const bool surface = s.structure == "road";
   double sum_r = 0, cover_m2 = 0, zone_m2 = 0;  // the cross-sections' cover and widths, integrated along the road
+  auto crs = [&](GridPoint p) { return t.georef().cell_centre(p.col, p.row); };
   for (std::size_t j = 0; j < pts.size(); ++j) {
     const Direction along = tangent(t, pts, j), left{along.y, -along.x}, right{-along.y, along.x};
     const double mx = t.metres_x(pts[j].row), my = t.metres_y(pts[j].row);
-    auto offset = [&](Direction n, double d) { return GridPoint{pts[j].col + n.x * d / mx, pts[j].row + n.y * d / my}; };
-    push_offset(lane_left, t, offset(left, o.half_width_m), along);
-    push_offset(lane_right, t, offset(right, o.half_width_m), along);
+    auto offset = [&](Direction n, double d) { return crs({pts[j].col + n.x * d / mx, pts[j].row + n.y * d / my}); };
+    centres.push_back(crs(pts[j]));
+    lane_left.push_back(offset(left, s.carriageway_half_width_m));
+    lane_right.push_back(offset(right, s.carriageway_half_width_m));
     if (!surface) continue;
     // The station's share of the section's length.
     const double share = 0.5 * ((j > 0 ? t.length_m(pts[j - 1], pts[j]) : 0) + (j + 1 < pts.size() ? t.length_m(pts[j], pts[j + 1]) : 0));
     for (const auto& [n, ring] : {std::pair{left, &zone_left}, std::pair{right, &zone_right}}) {
       const Side side = cross_section(t, o, pts[j], n, road.z[first + j]);
-      push_offset(*ring, t, offset(n, side.half_width_m), along);
+      ring->push_back(offset(n, side.half_width_m));
       sum_r += side.half_width_m;
       s.max_half_width_m = std::max(s.max_half_width_m, side.half_width_m);
       s.totals.cut_m3 += share * side.cut_m2;
@@ -150,13 +173,22 @@ void section_corridor(const TerrainField& t, const EarthworkOptions& o, const Ro
       if (side.walled) s.walled_m += share;
     }
   }
-  s.carriageway = ring_of(std::move(lane_left), lane_right);
+  s.carriageway = swept_area(centres, lane_left, lane_right);
   if (!surface) return;
-  s.zone = ring_of(std::move(zone_left), zone_right);
+  s.zone = swept_area(centres, zone_left, zone_right);
   s.mean_half_width_m = sum_r / double(2 * pts.size());
-  s.totals.land_take_ha = polygon_area_m2(t.georef().crs, to_crs(t, s.zone)) / 1e4;
+  s.totals.land_take_ha = polygons_area_m2(t.georef().crs, s.zone) / 1e4;
   // The zone's mean cover over its polygon's area (so a fully covered zone is cleared entirely).
   s.totals.cleared_ha = zone_m2 > 0 ? s.totals.land_take_ha * cover_m2 / zone_m2 : 0;
+}
+
+/// Sets `totals`' land take to the area of `zones` united (returned), scaling the clearing with it.
+std::vector<Polygon> unite(const Crs& crs, const std::vector<Polygon>& zones, CorridorTotals& totals) {
+  std::vector<Polygon> united = polygon_union(zones);
+  const double ha = polygons_area_m2(crs, united) / 1e4;
+  totals.cleared_ha = totals.land_take_ha > 0 ? totals.cleared_ha * ha / totals.land_take_ha : 0;
+  totals.land_take_ha = ha;
+  return united;
 }
 
 void add(CorridorTotals& to, const CorridorTotals& from) {
@@ -178,11 +210,13 @@ double repose_angle_deg(const std::string& material) {
   throw bad_input("material: '" + material + "' is none of sand, earth, stones, rock");
 }
 
-EarthworkOptions earthwork_options(const CorridorOptions& c, Raster<float>& slopes) {
-  if (!(c.half_width_m > 0) || !(c.side_angle_deg > 0 && c.side_angle_deg < 90) || !(c.max_height_m >= 0))
-    throw bad_input("corridor: the half-width must be > 0 and the side angle within 0-90 degrees");
+EarthworkOptions earthwork_options(const CorridorOptions& c, Raster<float>& slopes, RoadClass road_class) {
+  const ClassWidths& w = c.widths[std::min(std::size_t(road_class), c.widths.size() - 1)];
+  if (!(c.half_width_m >= 0) || !(w.carriageway_m > 0) || !(w.platform_m >= w.carriageway_m) || !(c.side_angle_deg > 0 && c.side_angle_deg < 90) ||
+      !(c.max_height_m >= 0))
+    throw bad_input("corridor: the widths must be > 0 (a platform no narrower than its carriageway) and the side angle within 0-90 degrees");
   EarthworkOptions o;
-  o.half_width_m = c.half_width_m;
+  o.half_width_m = c.half_width_m > 0 ? c.half_width_m : 0.5 * w.platform_m;
   o.side_slope = side_slope_of(c.side_angle_deg);
   o.max_height_m = c.max_height_m;
   if (c.side_angles_deg.size() > 0) {
@@ -196,16 +230,23 @@ EarthworkOptions earthwork_options(const CorridorOptions& c, Raster<float>& slop
   return o;
 }
 
-Corridors corridors(const TerrainField& terrain, const std::vector<const RoadGeometry*>& roads, const CorridorOptions& options) {
+Corridors corridors(const TerrainField& terrain, const std::vector<const RoadGeometry*>& roads, const CorridorOptions& options,
+                    const std::vector<RoadClass>& classes) {
+  if (!classes.empty() && classes.size() != roads.size()) throw processing_error("corridor: one class per road");
   Raster<float> slopes;
-  const EarthworkOptions o = earthwork_options(options, slopes);
+  std::array<EarthworkOptions, 4> by_class;
+  for (std::size_t c = 0; c < by_class.size(); ++c) by_class[c] = earthwork_options(options, slopes, RoadClass(c));
+  const Crs& crs = terrain.georef().crs;
   Corridors out;
   out.vegetation = terrain.has_vegetation();
-  out.half_width_m = o.half_width_m;
   out.roads.resize(roads.size());
+  std::vector<Polygon> road_zones;  // every road's zone, united road by road
   for (std::size_t ri = 0; ri < roads.size(); ++ri) {
     const RoadGeometry& road = *roads[ri];
+    const std::size_t c = classes.empty() ? std::size_t(RoadClass::departmental) : std::min(std::size_t(classes[ri]), by_class.size() - 1);
+    const EarthworkOptions& o = by_class[c];
     const auto sections = road_sections(terrain, road);
+    std::vector<Polygon> zones;
     std::size_t first = 0;  // the section's first point in the road
     for (std::size_t si = 0; si < sections.size(); ++si) {
       SectionCorridor s;
@@ -213,13 +254,19 @@ Corridors corridors(const TerrainField& terrain, const std::vector<const RoadGeo
       s.section = si;
       s.structure = sections[si].structure;
       s.length_m = sections[si].length_m;
+      s.half_width_m = o.half_width_m;
+      s.carriageway_half_width_m = options.half_width_m > 0 ? options.half_width_m : 0.5 * options.widths[c].carriageway_m;
       section_corridor(terrain, o, road, first, sections[si].points, s);
       add(out.roads[ri], s.totals);
+      zones.insert(zones.end(), s.zone.begin(), s.zone.end());
       first += sections[si].points.size() - 1;
       out.sections.push_back(std::move(s));
     }
+    const std::vector<Polygon> united = unite(crs, zones, out.roads[ri]);
+    road_zones.insert(road_zones.end(), united.begin(), united.end());
     add(out.run, out.roads[ri]);
   }
+  out.land_take = unite(crs, road_zones, out.run);
   return out;
 }
 
@@ -233,23 +280,23 @@ VectorLayer corridors_layer(const TerrainField& terrain, const Corridors& corrid
                   {"half_width_m", FieldType::real},    {"max_half_width_m", FieldType::real}, {"cut_m3", FieldType::real},
                   {"fill_m3", FieldType::real},         {"cleared_ha", FieldType::real},       {"walled_m", FieldType::real}};
   const FieldValue none;
+  auto feature = [&](const Polygon& polygon, std::vector<FieldValue> values) {
+    values.insert(values.begin() + 5, round_to(polygons_area_m2(layer.crs, {polygon}) / 1e4, 1e-4));  // area_ha
+    layer.features.push_back({polygon.rings, std::move(values)});
+  };
   for (const SectionCorridor& s : corridors.sections) {
-    auto feature = [&](const std::vector<GridPoint>& ring, const std::string& part) {
-      Feature f;
-      f.parts.push_back(to_crs(terrain, ring));
-      const bool zone = part == "earthworks";
-      const double area_ha = zone ? s.totals.land_take_ha : polygon_area_m2(layer.crs, f.parts[0]) / 1e4;
-      const double mean_r = zone ? s.mean_half_width_m : corridors.half_width_m, max_r = zone ? s.max_half_width_m : corridors.half_width_m;
-      f.values = {std::int64_t(s.road), std::int64_t(s.section), s.structure, part, round_to(s.length_m, 0.01), round_to(area_ha, 1e-4),
-                  round_to(mean_r, 0.01), round_to(max_r, 0.01),
-                  zone ? FieldValue(round_to(s.totals.cut_m3, 0.1)) : none, zone ? FieldValue(round_to(s.totals.fill_m3, 0.1)) : none,
-                  zone && corridors.vegetation ? FieldValue(round_to(s.totals.cleared_ha, 1e-4)) : none,
-                  zone ? FieldValue(round_to(s.walled_m, 0.01)) : none};
-      layer.features.push_back(std::move(f));
-    };
-    if (!s.zone.empty()) feature(s.zone, "earthworks");
-    if (s.carriageway.size() >= 3) feature(s.carriageway, "carriageway");
+    // A part united into several polygons (rare: slivers) carries the section's figures on its first.
+    for (std::size_t k = 0; k < s.zone.size(); ++k)
+      feature(s.zone[k], {std::int64_t(s.road), std::int64_t(s.section), s.structure, "earthworks", round_to(s.length_m, 0.01),
+                          round_to(s.mean_half_width_m, 0.01), round_to(s.max_half_width_m, 0.01),
+                          k == 0 ? FieldValue(round_to(s.totals.cut_m3, 0.1)) : none, k == 0 ? FieldValue(round_to(s.totals.fill_m3, 0.1)) : none,
+                          k == 0 && corridors.vegetation ? FieldValue(round_to(s.totals.cleared_ha, 1e-4)) : none,
+                          k == 0 ? FieldValue(round_to(s.walled_m, 0.01)) : none});
+    for (const Polygon& p : s.carriageway)
+      feature(p, {std::int64_t(s.road), std::int64_t(s.section), s.structure, "carriageway", round_to(s.length_m, 0.01),
+                  round_to(s.carriageway_half_width_m, 0.01), round_to(s.carriageway_half_width_m, 0.01), none, none, none, none});
   }
+  for (const Polygon& p : corridors.land_take) feature(p, {none, none, none, "land_take", none, none, none, none, none, none, none});
   return layer;
 }
 
@@ -267,14 +314,15 @@ void add_corridor_fields(VectorLayer& layer, const Corridors& corridors) {
   }
 }
 
-std::string corridors_qml() {
+std::string corridors_renderer() {
   struct Category { const char* value; const char* label; const char* fill; const char* outline; const char* style; };
-  const Category categories[] = {{"earthworks", "earthworks zone (cut and fill sides)", "217,179,120,170", "140,100,50,255", "solid"},
+  const Category categories[] = {{"land_take", "land take (the zones united)", "0,0,0,0", "165,15,21,255", "dash"},
+                                 {"earthworks", "earthworks zone (cut and fill sides)", "217,179,120,170", "140,100,50,255", "solid"},
                                  {"road", "carriageway", "82,82,82,255", "40,40,40,255", "solid"},
                                  {"bridge", "bridge deck", "8,81,156,255", "8,48,107,255", "solid"},
                                  {"tunnel", "tunnel (underground)", "150,150,150,90", "60,60,60,255", "dash"}};
   std::string list, symbols;
-  for (int k = 0; k < 4; ++k) {
+  for (std::size_t k = 0; k < std::size(categories); ++k) {
     const Category& c = categories[k];
     const std::string id = std::to_string(k);
     list += std::string("<category render=\"true\" symbol=\"") + id + "\" value=\"" + c.value + "\" label=\"" + c.label + "\"/>";
@@ -285,11 +333,15 @@ std::string corridors_qml() {
                "<Option type=\"QString\" name=\"outline_width\" value=\"0.2\"/><Option type=\"QString\" name=\"outline_width_unit\" value=\"MM\"/>"
                "</Option></layer></symbol>";
   }
-  // Zones first, carriageways on top: ordered by part, descending ("earthworks" after "carriageway").
-  return "<!DOCTYPE qgis PUBLIC 'http://mrcc.com/qgis.dtd' 'SYSTEM'>\n<qgis version=\"3.22.16\" styleCategories=\"AllStyleCategories\">"
-         "<renderer-v2 type=\"categorizedSymbol\" attr=\"CASE WHEN &quot;part&quot; = 'earthworks' THEN 'earthworks' ELSE &quot;structure&quot; END\" "
+  // The land take's outline first, then the zones, carriageways on top: ordered by part, descending.
+  return "<renderer-v2 type=\"categorizedSymbol\" attr=\"CASE WHEN &quot;part&quot; = 'carriageway' THEN &quot;structure&quot; ELSE &quot;part&quot; END\" "
          "enableorderby=\"1\" forceraster=\"0\" symbollevels=\"0\"><categories>" + list + "</categories><symbols>" + symbols +
-         "</symbols><orderby><orderByClause asc=\"0\" nullsFirst=\"0\">\"part\"</orderByClause></orderby></renderer-v2></qgis>\n";
+         "</symbols><orderby><orderByClause asc=\"0\" nullsFirst=\"0\">\"part\"</orderByClause></orderby></renderer-v2>";
+}
+
+std::string corridors_qml() {
+  return "<!DOCTYPE qgis PUBLIC 'http://mrcc.com/qgis.dtd' 'SYSTEM'>\n<qgis version=\"3.22.16\" styleCategories=\"AllStyleCategories\">" +
+         corridors_renderer() + "</qgis>\n";
 }
 
 std::string corridor_summary(const Corridors& c, double seconds) {

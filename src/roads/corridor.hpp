@@ -2,13 +2,16 @@
 // (Peytavie 2010 §4.4.3 for the road model, §2.3.4 for the angles of repose).
 // SPDX-License-Identifier: MIT
 #pragma once
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "core/polygon_area.hpp"
 #include "core/raster.hpp"
 #include "io/vector_io.hpp"
 #include "roads/earthworks.hpp"
+#include "roads/road_class.hpp"
 
 namespace terrapolis::roads {
 
@@ -19,32 +22,49 @@ namespace terrapolis::roads {
 /// Throws bad_input for another name.
 double repose_angle_deg(const std::string& material);
 
+/// A road class's cross-section (full widths, m): the carriageway (the paved lanes and, on a
+/// motorway, the central reserve) and the platform (carriageway and shoulders), levelled to the
+/// deck; the side slopes start at its edge.
+struct ClassWidths {
+  double carriageway_m = 6, platform_m = 9;
+};
+
 struct CorridorOptions {
-  double half_width_m = 4;    ///< r: half the carriageway (m)
+  /// Per class (motorway, national, departmental, local; a ferry link has no corridor). Orders of
+  /// magnitude of the French profiles (ICTAAL 2000 for motorways: 2 x 2 lanes of 3.5 m, central
+  /// reserve, shoulders; ARP 1994 for 2-lane roads: 7 m or 6 m of lanes and shoulders), not their tables.
+  std::array<ClassWidths, 4> widths = {{{17, 25}, {7, 12}, {6, 9}, {5, 7}}};
+  /// > 0: r for every road, the carriageway's and the platform's half-width (overrides `widths`), m.
+  double half_width_m = 0;
   double side_angle_deg = 25;  ///< angle of the cut and fill sides where no map says otherwise (deg, 0-90 exclusive)
   /// Optional map of side angles (deg) on the DEM's grid, e.g. from a geology map; NaN or <= 0: side_angle_deg.
   Raster<float> side_angles_deg;
   double max_height_m = 50;   ///< deepest cut / highest fill (bounds the work area; beyond it a wall is needed), m
 };
 
-/// Land take, volumes and clearing of a section, a road or a run. A road's figures are the sum of
-/// its sections', a run's the sum of its roads' (where two roads' corridors overlap, near a shared
-/// junction, the overlap counts for each).
+/// Land take, volumes and clearing of a section, a road or a run. The land take is the geodesic
+/// area of the union of the earthworks zones (a section's, a road's sections', the run's roads'),
+/// so ground two zones cover (a hairpin's bends, a junction, a trunk two roads share) counts once;
+/// the clearing scales with it. Cut and fill add up the cross-sections (a road's are its sections',
+/// a run's its roads': a trunk two roads share counts for each).
 struct CorridorTotals {
-  double land_take_ha = 0;   ///< the earthworks zone: carriageway and side slopes (geodesic polygon area)
+  double land_take_ha = 0;   ///< the earthworks zone: platform and side slopes
   double cut_m3 = 0, fill_m3 = 0;
   double cleared_ha = 0;     ///< vegetation cleared: the zone's area times its mean cover (the layer clamped to 0-1)
 };
 
-/// One section of a road: the carriageway (half-width r) and, on surface sections, the earthworks
-/// zone (half-width R on each side: where the side slopes meet the ground), rings in grid
-/// coordinates. Bridges and tunnels have a carriageway only (no earthworks under a deck, piers
-/// aside, nor above a tunnel) and take no land.
+/// One section of a road: the carriageway and, on surface sections, the earthworks zone (half-width
+/// R on each side: where the side slopes from the platform's edge r meet the ground), each the union
+/// of the quadrilaterals its cross-sections sweep between stations (valid polygons even where a
+/// hairpin's inner side folds over itself), in the DEM's CRS. Bridges and tunnels have a
+/// carriageway only (no earthworks under a deck, piers aside, nor above a tunnel) and take no
+/// land; ferries have neither.
 struct SectionCorridor {
   std::size_t road = 0, section = 0;
   std::string structure;
   double length_m = 0;
-  std::vector<GridPoint> carriageway, zone;
+  double half_width_m = 0, carriageway_half_width_m = 0;  ///< r (the platform's) and the carriageway's, m
+  std::vector<Polygon> carriageway, zone;
   double mean_half_width_m = 0, max_half_width_m = 0;  ///< R over the section's stations, both sides (surface sections)
   double walled_m = 0;  ///< length of sides that do not meet the ground within max_height_m (a wall is needed)
   CorridorTotals totals;
@@ -54,14 +74,16 @@ struct Corridors {
   std::vector<SectionCorridor> sections;
   std::vector<CorridorTotals> roads;  ///< per road, in the order given
   CorridorTotals run;
+  std::vector<Polygon> land_take;  ///< the run's earthworks zones united (CRS of the DEM)
   bool vegetation = false;  ///< a vegetation layer was given (cleared_ha means something)
-  double half_width_m = 0;  ///< r
 };
 
-/// The earthworks options these corridor options imply (side slope = 1 / tan(angle), per cell
-/// when a map is given; `slopes` holds the per-cell map and must outlive the result). Throws
-/// bad_input for a half-width or an angle out of range.
-EarthworkOptions earthwork_options(const CorridorOptions& options, Raster<float>& slopes);
+/// The earthworks options these corridor options imply for a road of class `road_class` (r: the
+/// half-width override or the class's half platform; side slope = 1 / tan(angle), per cell when a
+/// map is given; `slopes` holds the per-cell map and must outlive the result). Throws bad_input
+/// for a width or an angle out of range.
+EarthworkOptions earthwork_options(const CorridorOptions& options, Raster<float>& slopes,
+                                   RoadClass road_class = RoadClass::departmental);
 
 /// Corridors of `roads` (on the TerrainField's surface; its vegetation layer, when set, is the
 /// one cleared). Each station of a surface section (the road's points) gets a cross-section on
@@ -70,20 +92,25 @@ EarthworkOptions earthwork_options(const CorridorOptions& options, Raster<float>
 /// fill are the cross-section's areas between ground and z' (m² per metre) times the station's
 /// share of the road's length, so the figures do not depend on the DEM's resolution (the
 /// levelled DEM of earthworks() gives the same volumes where its cells are small against R).
-Corridors corridors(const TerrainField& terrain, const std::vector<const RoadGeometry*>& roads, const CorridorOptions& options);
+/// `classes`: each road's class (the widths), departmental for all when empty.
+Corridors corridors(const TerrainField& terrain, const std::vector<const RoadGeometry*>& roads, const CorridorOptions& options,
+                    const std::vector<RoadClass>& classes = {});
 
 /// corridors.geojson: per section an "earthworks" polygon (surface sections) and a "carriageway"
 /// polygon, with road, section, structure, part, length_m, area_ha (geodesic), half-widths,
-/// cut_m3, fill_m3, cleared_ha (null without a vegetation layer), walled_m.
+/// cut_m3, fill_m3, cleared_ha (null without a vegetation layer), walled_m; then the run's
+/// "land_take" polygons (the zones united; road and section null).
 VectorLayer corridors_layer(const TerrainField& terrain, const Corridors& corridors);
 
 /// Appends land_take_ha, cut_m3, fill_m3 and cleared_ha to the roads layer (one feature per road,
 /// in the order the corridors were computed).
 void add_corridor_fields(VectorLayer& roads_layer, const Corridors& corridors);
 
-/// A QGIS 3 style (.qml) for corridors.geojson: earthworks zones in ochre under the carriageways
-/// (road grey, bridge blue, tunnel dashed).
+/// A QGIS 3 style (.qml) for corridors.geojson: the land take's dashed outline, earthworks zones in
+/// ochre under the carriageways (road grey, bridge blue, tunnel dashed); its <renderer-v2> alone
+/// for a run's project.
 std::string corridors_qml();
+std::string corridors_renderer();
 
 /// "land take 12.30 ha, cut 4567 m³, fill 890 m³, vegetation cleared 1.20 ha, 0.05 s" for a
 /// command's summary (`seconds`: the time the corridors took).

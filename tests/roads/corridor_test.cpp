@@ -93,9 +93,9 @@ TEST(Corridor, FlatPlaneGivesLengthTimesTwoRAndNoVolume) {
   // On a plane the sides meet the ground at once: R = r, area = 40 m x 2 x 4 m (square ends).
   EXPECT_NEAR(c.sections[0].mean_half_width_m, 4.0, 1e-9);
   const VectorLayer layer = corridors_layer(terrain, c);
-  ASSERT_EQ(layer.features.size(), 2u);  // earthworks, carriageway
-  EXPECT_NEAR(field(layer, 0, "area_ha"), 40 * 2 * 4 / 1e4, 1e-6);
-  EXPECT_NEAR(field(layer, 1, "area_ha"), 40 * 2 * 4 / 1e4, 1e-6);
+  ASSERT_EQ(layer.features.size(), 3u);  // earthworks, carriageway, the run's land take
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_NEAR(field(layer, i, "area_ha"), 40 * 2 * 4 / 1e4, 1e-6);
+  EXPECT_EQ(std::get<std::string>(layer.features[2].values[3]), "land_take");
   EXPECT_EQ(c.run.cut_m3, 0);
   EXPECT_EQ(c.run.fill_m3, 0);
   EXPECT_NEAR(c.run.land_take_ha, 40 * 2 * 4 / 1e4, 1e-6);
@@ -178,7 +178,9 @@ TEST(Corridor, GeodesicAreasAndPerRoadFiguresOnARealDem) {
   ASSERT_EQ(c.roads.size(), 2u);
   EXPECT_NEAR(c.roads[0].cut_m3 + c.roads[1].cut_m3, c.run.cut_m3, 1e-6 * c.run.cut_m3);
   EXPECT_NEAR(c.roads[0].fill_m3 + c.roads[1].fill_m3, c.run.fill_m3, 1e-6 * c.run.fill_m3);
-  EXPECT_NEAR(c.roads[0].land_take_ha + c.roads[1].land_take_ha, c.run.land_take_ha, 1e-9);
+  // They meet at the ridge: the run's land take is their union, less than the sum by the overlap.
+  EXPECT_LT(c.run.land_take_ha, c.roads[0].land_take_ha + c.roads[1].land_take_ha);
+  EXPECT_GT(c.run.land_take_ha, 0.95 * (c.roads[0].land_take_ha + c.roads[1].land_take_ha));
   for (const SectionCorridor& s : c.sections) {
     if (s.structure != "road") continue;
     EXPECT_GE(s.mean_half_width_m, 4.0);
@@ -235,4 +237,74 @@ TEST(Corridor, SideAngleMapAndVegetation) {
   EXPECT_NEAR(c.sections[0].max_half_width_m, soft, 1e-3);
   EXPECT_TRUE(c.vegetation);
   EXPECT_NEAR(c.run.cleared_ha, 0.5 * c.run.land_take_ha, 1e-5 * c.run.land_take_ha);
+}
+
+namespace {
+
+/// East along row y0 from column x0 to x1, a half-turn of `radius` (cells, every degree) about
+/// (x1, y0 + radius), and back west along row y0 + 2 radius to x0: a hairpin on a flat plane.
+RoadGeometry hairpin(double x0, double x1, double y0, double radius) {
+  RoadGeometry g;
+  for (double c = x0; c < x1; c += 0.5) g.points.push_back({c, y0});
+  for (int a = 0; a <= 180; ++a)
+    g.points.push_back({x1 + radius * std::sin(a * kDeg), y0 + radius - radius * std::cos(a * kDeg)});
+  for (double c = x1 - 0.5; c >= x0 - 1e-9; c -= 0.5) g.points.push_back({c, y0 + 2 * radius});
+  g.z.assign(g.points.size(), 100.0);
+  g.segments.assign(g.points.size() - 1, Structure::road);
+  return g;
+}
+
+}  // namespace
+
+TEST(Corridor, HairpinAndOverlappingRoadsCountTheirGroundOnce) {
+  // On a flat plane R = r = 4 m. The hairpin's legs are 6 m apart: their 8 m strips overlap by
+  // 2 m, and the half-turn (radius 3 m < r) sweeps a half-disc of radius 3 + 4 m; the union is
+  // the 14 m x 40 m band and the half-disc, 560 + 49 pi / 2 m2 (the ring of the old offsets
+  // crossed itself there).
+  const Dem dem = test::make_dem(80, 50, 1.0, [](int, int) { return 100.0; });
+  const TerrainField terrain(dem, 0.0, 10.0, 0.0);
+  const RoadGeometry road = hairpin(10, 50, 20, 3);
+  const Corridors c = corridors(terrain, {&road}, options(30));
+  const double hairpin_m2 = 560 + 49 * std::numbers::pi / 2;
+  EXPECT_NEAR(c.roads[0].land_take_ha * 1e4, hairpin_m2, 0.005 * hairpin_m2);
+  EXPECT_NEAR(c.run.land_take_ha * 1e4, hairpin_m2, 0.005 * hairpin_m2);
+  ASSERT_EQ(c.sections.size(), 1u);
+  ASSERT_EQ(c.sections[0].zone.size(), 1u);  // one valid polygon
+  // Two parallel straight roads 6 m apart, each 40 m x 8 m: the run's land take is their union
+  // (14 m x 40 m), each road keeps its own 320 m2, and the union is never more than the sum.
+  const RoadGeometry a = straight_road(20.0, 10, 50, [](double) { return 100.0; });
+  const RoadGeometry b = straight_road(26.0, 10, 50, [](double) { return 100.0; });
+  const Corridors two = corridors(terrain, {&a, &b}, options(30));
+  EXPECT_NEAR(two.roads[0].land_take_ha * 1e4, 320, 1e-6);
+  EXPECT_NEAR(two.roads[1].land_take_ha * 1e4, 320, 1e-6);
+  EXPECT_NEAR(two.run.land_take_ha * 1e4, 560, 1e-6);
+  const VectorLayer layer = corridors_layer(terrain, two);
+  double land_take_m2 = 0;
+  for (std::size_t i = 0; i < layer.features.size(); ++i)
+    if (std::get<std::string>(layer.features[i].values[3]) == "land_take") land_take_m2 += field(layer, i, "area_ha") * 1e4;
+  EXPECT_NEAR(land_take_m2, 560, 1e-6);
+}
+
+TEST(Corridor, WidthsFollowTheRoadClass) {
+  // On a plane the zone is the platform: 40 m x the class's platform width; the carriageway its own.
+  const Dem dem = test::make_dem(60, 60, 1.0, [](int, int) { return 100.0; });
+  const TerrainField terrain(dem, 0.0, 10.0, 0.0);
+  const RoadGeometry road = straight_road(30.0, 10, 50, [](double) { return 100.0; });
+  CorridorOptions o;  // the per-class defaults, no override
+  const std::vector<RoadClass> classes = {RoadClass::motorway, RoadClass::local};
+  const Corridors c = corridors(terrain, {&road, &road}, o, classes);
+  for (std::size_t k = 0; k < 2; ++k) {
+    const ClassWidths& w = o.widths[std::size_t(classes[k])];
+    EXPECT_NEAR(c.roads[k].land_take_ha * 1e4, 40 * w.platform_m, 1e-6) << k;
+    EXPECT_NEAR(polygons_area_m2(dem.georef().crs, c.sections[k].carriageway), 40 * w.carriageway_m, 1e-6) << k;
+  }
+  // The same road twice: the motorway's platform covers the local road's.
+  EXPECT_NEAR(c.run.land_take_ha * 1e4, 40 * o.widths[0].platform_m, 1e-6);
+  // The override: every road at r.
+  o.half_width_m = 3;
+  EXPECT_NEAR(corridors(terrain, {&road}, o, {RoadClass::motorway}).run.land_take_ha * 1e4, 40 * 6, 1e-6);
+  o.half_width_m = 0;
+  o.widths[3] = {8, 6};  // a platform narrower than its carriageway
+  Raster<float> slopes;
+  EXPECT_THROW(earthwork_options(o, slopes, RoadClass::local), Error);
 }
