@@ -259,6 +259,10 @@ void check_file(const std::string& pointer, const std::string& path) {
 StageSettings prepare_stages(const Scenario& scenario) {
   try {
     StageSettings s;
+    // Only the hydro and density commands work tile by tile yet (docs/scale.md): a run refuses it.
+    if (const TileSettings t = tile_settings(scenario); t.tile_size > 0 || t.memory_limit_mb > 0)
+      throw bad_input(std::string(t.tile_size > 0 ? "/input/tile_size" : "/input/memory_limit_mb") +
+                      ": a run does not work tile by tile yet (only the hydro and density commands do)");
     s.flat_water = flat_water_options(scenario);
     s.reservoirs = reservoir_specs(scenario);
     s.hydro = hydro_options(scenario);
