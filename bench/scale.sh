@@ -15,6 +15,7 @@
 # terrapolis-mpi on WEAK_RANKS (default "1 2"), one thread a rank: cells/s a rank, CPU, peak
 # resident memory of each rank (GNU time), the engine's reported state, disk written. WEAK_DIR:
 # where the mosaic and outputs go (default a temporary folder; removed at the end).
+# DENSITY=1: the density stage instead, whole grid vs tile by tile (DENSITY_OPTIONS, ";"-separated).
 # SPDX-License-Identifier: MIT
 set -euo pipefail
 bin=$(realpath "${1:-build/src/cli/terrapolis}")
@@ -162,6 +163,34 @@ PY
 }
 if [[ ${WEAK:-0} == 1 ]]; then
   weak
+  exit
+fi
+
+# The density stage by tiles (DENSITY=1): `terrapolis density` whole-grid vs --tile-size and
+# --memory-limit on each DEM, with the hydrometry of the whole-grid hydro command (Belhadj): wall,
+# CPU, peak memory, the engine's report, and a check that the tiled outputs hold the whole-grid cells.
+density_bench() {
+  local dem name
+  for dem in "${dems[@]}"; do
+    name=$(basename "$dem" .hgt)
+    local sea=() side
+    [[ $name == S46W066 ]] && sea=(--sea-level 0)
+    side=$(gdalinfo "$dem" | sed -n 's/^Size is \([0-9]*\),.*/\1/p')
+    "$bin" -q hydro "$dem" "$work/hydro" --outputs hydrometry "${sea[@]}" --overwrite
+    local h=(--hydrometry "$work/hydro/hydrometry.tif")
+    echo "$name density ($side x $side cells), $runs runs, $(nproc) cores, hydrometry from the whole-grid hydro command"
+    run "whole grid" "$bin" -q density "$dem" "$work/out" "${h[@]}" "${sea[@]}"
+    "$bin" -q density "$dem" "$work/whole" "${h[@]}" "${sea[@]}" --overwrite
+    IFS=";" read -ra options <<<"${DENSITY_OPTIONS:---tile-size 1201;--tile-size 600;--tile-size 300;--memory-limit 128;--memory-limit 64}"
+    for option in "${options[@]}"; do
+      run "tiled $option" "$bin" -q density "$dem" "$work/out" "${h[@]}" "${sea[@]}" $option
+      "$bin" -v density "$dem" "$work/tiled" "${h[@]}" "${sea[@]}" $option --overwrite 2>&1 | grep "^density tiles:" | sed 's/^/    /'
+      for o in plain coast plateau buildable density; do same_cells "$work/whole/$o.tif" "$work/tiled/$o.vrt"; done
+    done
+  done
+}
+if [[ ${DENSITY:-0} == 1 ]]; then
+  density_bench
   exit
 fi
 

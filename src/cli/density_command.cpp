@@ -13,11 +13,13 @@
 #include "cli/command.hpp"
 #include "cli/commands_list.hpp"
 #include "cli/dem_input.hpp"
+#include "cli/hydro_tiles.hpp"
 #include "cli/plugin_options.hpp"
 #include "cli/schema_options.hpp"
 #include "core/error.hpp"
 #include "core/text.hpp"
 #include "density/density.hpp"
+#include "density/tiled_density.hpp"
 #include "hydro/hydrometry.hpp"
 #include "io/output_set.hpp"
 #include "io/mask_io.hpp"
@@ -40,16 +42,24 @@ struct Hydrometry {
   bool used = false;
 };
 
+bool hydrometry_used(const density::DensityOptions& options) { return options.weights[1] != 0 || options.river_bed_cap.has_value(); }
+
+/// A --hydrometry file on a grid (the DEM's or a window of it), checked to lie in [0,1].
+Raster<float> read_hydrometry(const std::string& path, const Georef& grid, int cols, int rows) {
+  Raster<float> values = read_resampled(path, grid, cols, rows, Resampling::bilinear);
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    const float v = values[i];
+    if (!std::isnan(v) && (v < -1e-6f || v > 1 + 1e-6f))
+      throw bad_input("--hydrometry " + path + ": values must lie in [0,1] (found " + std::to_string(v) + ")");
+  }
+  return values;
+}
+
 Hydrometry obtain_hydrometry(const Dem& dem, const density::DensityOptions& options, const std::string& path, Progress& progress) {
   Hydrometry h;
-  h.used = options.weights[1] != 0 || options.river_bed_cap.has_value();
+  h.used = hydrometry_used(options);
   if (!path.empty()) {
-    h.values = read_resampled(path, dem.georef(), dem.cols(), dem.rows(), Resampling::bilinear);
-    for (std::size_t i = 0; i < h.values.size(); ++i) {
-      const float v = h.values[i];
-      if (!std::isnan(v) && (v < -1e-6f || v > 1 + 1e-6f))
-        throw bad_input("--hydrometry " + path + ": values must lie in [0,1] (found " + std::to_string(v) + ")");
-    }
+    h.values = read_hydrometry(path, dem.georef(), dem.cols(), dem.rows());
     return h;
   }
   if (!h.used) {
@@ -99,7 +109,8 @@ class DensityCommand final : public Command {
     inputs.push_back(hydrometry_path_);
     OutputSet outputs("density", inputs, overwrite_);
     const fs::path dir = outputs.folder(out_dir_);
-    const bool write_hydro = options.weights[1] != 0 || options.river_bed_cap.has_value();
+    const pipeline::TileSettings tiles = schema_.settings([&] { return pipeline::tile_settings(scenario); });
+    if (tiles.tiled(dem_.path)) return run_tiled(context, scenario, options, tiles, dir, outputs);
 
     using clock = std::chrono::steady_clock;
     const auto seconds = [](clock::time_point a, clock::time_point b) { return format(std::chrono::duration<double>(b - a).count(), 3); };
@@ -115,6 +126,18 @@ class DensityCommand final : public Command {
     const std::clock_t cpu2 = std::clock();
     const auto t2 = clock::now();
 
+    write_rasters(result, options, [&](const std::string& n) { return (dir / (n + ".tif")).string(); });
+    outputs.commit();
+    const auto t3 = clock::now();
+    context.log.detail("density: read " + seconds(t0, t1) + " s, model " + seconds(t1, t2) + " s (cpu " +
+                       format(double(cpu2 - cpu1) / CLOCKS_PER_SEC, 3) + " s), write " + seconds(t2, t3) + " s");
+    finish(context, result.stats);
+  }
+
+ private:
+  /// The rasters of `result` (the whole grid's or a tile's), each to path(name), concurrently.
+  void write_rasters(const density::DensityResult& result, const density::DensityOptions& options,
+                     const std::function<std::string(const std::string&)>& path) const {
     const auto metadata = provenance(options);
     std::vector<std::function<void()>> writes;
     auto write = [&](const std::string& n, const auto& raster) {
@@ -123,30 +146,79 @@ class DensityCommand final : public Command {
         w.cog = cog_;
         w.description = density::describe_output(n);
         w.metadata = metadata;
-        write_raster((dir / (n + ".tif")).string(), raster, w);
+        write_raster(path(n), raster, w);
       });
     };
     write("coast", result.coast);
     write("plateau", result.plateau);
     write("plain", result.plain);
-    if (write_hydro) write("hydrometry", result.hydrometry);
+    if (hydrometry_used(options)) write("hydrometry", result.hydrometry);
     write("buildable", result.buildable);
     write("density", result.density);
     write_concurrently(writes);
-    outputs.commit();
-    const auto t3 = clock::now();
-    context.log.detail("density: read " + seconds(t0, t1) + " s, model " + seconds(t1, t2) + " s (cpu " +
-                       format(double(cpu2 - cpu1) / CLOCKS_PER_SEC, 3) + " s), write " + seconds(t2, t3) + " s");
+  }
 
-    const auto& s = result.stats;
+  void finish(Context& context, const density::DensityStats& s) const {
     const double land = double(s.known_cells - s.water_cells);
     context.log.info("density: " + std::to_string(s.buildable_cells) + " buildable cells (" +
                      format(land > 0 ? 100.0 * double(s.buildable_cells) / land : 0.0) + " % of land), mean density " +
                      format(s.mean_density, 3) + ", written to " + out_dir_);
-    if (report_) print_report(result);
+    if (report_) print_report(s);
   }
 
- private:
+  /// The model tile by tile (docs/scale.md): the DEM read by windows (a huge GeoTIFF, a VRT, a
+  /// folder of tiles), one GeoTIFF a tile and a VRT per output, the whole grid's cells.
+  void run_tiled(Context& context, const pipeline::Scenario& scenario, density::DensityOptions options,
+                 const pipeline::TileSettings& tiles, const fs::path& dir, OutputSet& outputs) {
+    if (!options.factors.empty() || !scenario.resolved["density"]["layers"].empty())
+      throw bad_input("--layer: user layers are rescaled by their range over the grid, not computed on tiles yet");
+    if (!plugins_.specs.empty()) throw bad_input("--plugin: plugins are not run on tiles yet");
+    const bool hydrometry = hydrometry_used(options);
+    if (hydrometry && hydrometry_path_.empty())
+      throw bad_input("density on tiles: the hydrometry is not computed on tiles yet; give --hydrometry FILE (a raster or VRT in [0,1]), "
+                      "or a hydrometry weight of 0 (--weights C,0,P,L) and no --river-bed-cap");
+    const DemWindowReader reader(dem_.path, dem_.options());
+    const RasterHeader& h = reader.header();
+    const std::string water_mask = scenario.path("/water/water_mask");
+    auto read = [&](int c0, int r0, int cols, int rows, bool dem_only) {
+      density::WindowInputs in;
+      in.dem = reader.read(c0, r0, cols, rows);
+      in.options = options;
+      const Georef& grid = in.dem.georef();
+      if (dem_only) {
+        if (!water_mask.empty()) in.options.water_mask = read_mask(water_mask, grid, cols, rows);
+        return in;
+      }
+      pipeline::read_density_files(scenario, grid, cols, rows, water_mask, in.options);
+      in.hydrometry = hydrometry ? read_hydrometry(hydrometry_path_, grid, cols, rows) : in.dem.like<float>(0.0f);
+      return in;
+    };
+    const char* layers[] = {"coast", "plateau", "plain", "hydrometry", "buildable", "density"};
+    for (const char* l : layers)
+      if (hydrometry || std::string(l) != "hydrometry") fs::create_directory(dir / l);
+    const density::TiledDensityReport report = density::run_tiled_density(
+        h.cols, h.rows, h.georef, read, options, tiles.tile_size, tiles.limit_mb(),
+        [&](int t, int across, const density::DensityResult& tile) {
+          write_rasters(tile, options, [&](const std::string& n) { return tile_file(dir.string(), n, t, across); });
+        },
+        context.progress);
+    for (const char* l : layers)
+      if (hydrometry || std::string(l) != "hydrometry") {
+        std::vector<std::string> files;
+        for (int t = 0; t < report.tiles; ++t) files.push_back(tile_file(dir.string(), l, t, report.across));
+        write_vrt((dir / (std::string(l) + ".vrt")).string(), files, false);
+      }
+    outputs.commit();
+    char line[300];
+    std::snprintf(line, sizeof line,
+                  "density tiles: %d of %d cells a side, halo %d x %d cells (r_max + r_min); state %.1f MB a window + %.1f MB global; "
+                  "peak resident %.0f MB",
+                  report.tiles, report.tile_size, report.halo_cols, report.halo_rows, report.window_bytes / 1e6,
+                  report.global_bytes / 1e6, peak_resident_mb());
+    context.log.detail(line);
+    finish(context, report.stats);
+  }
+
   static std::string format(double v, int digits = 1) {
     char buf[64];
     std::snprintf(buf, sizeof buf, "%.*f", digits, v);
@@ -198,8 +270,7 @@ class DensityCommand final : public Command {
     return m;
   }
 
-  void print_report(const density::DensityResult& r) const {
-    const auto& s = r.stats;
+  void print_report(const density::DensityStats& s) const {
     const double land = double(s.known_cells - s.water_cells);
     std::printf("Density report: %s\n", dem_.path.c_str());
     std::printf("  cells:      %zu (%zu with data or water, %zu water)\n", s.cells, s.known_cells, s.water_cells);

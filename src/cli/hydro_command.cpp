@@ -53,8 +53,6 @@ class HydroCommand final : public Command {
     file_kind(app.add_option("--weights", weights_, "Raster of per-cell weights (resampled bilinearly onto the DEM)"), FileKind::raster_in);
     app.add_option("--outputs", outputs_, "Outputs to write, comma-separated: filled,flowdir,accumulation,hydrometry,streams,basins")
         ->capture_default_str();
-    app.add_option("--tile-size", tile_size_, "Work tile by tile, tiles of at most N x N cells (writes one GeoTIFF a tile + a VRT)");
-    app.add_option("--memory-limit", memory_limit_mb_, "Work tile by tile within this much memory (MB), tiles sized to fit");
     app.add_flag("--cog", cog_, "Write Cloud Optimized GeoTIFFs");
     app.add_flag("--overwrite", overwrite_, "Replace the outputs a previous terrapolis command wrote in OUTDIR");
   }
@@ -109,7 +107,8 @@ class HydroCommand final : public Command {
     const std::string acc_unit = units_ == "cells" ? "cells" : units_;
     const std::string acc_description = "Upstream " + std::string(units_ == "cells" ? "cell count" : "area (" + acc_unit + ")") + ", " +
                                         flow + " routing" + (weights_.empty() ? "" : ", weighted");
-    if (tile_size_ > 0 || memory_limit_mb_ > 0 || fs::is_directory(dem_.path)) {
+    const pipeline::TileSettings tiles = schema_.settings([&] { return pipeline::tile_settings(scenario); });
+    if (tiles.tiled(dem_.path)) {
       // The tile engine: fill, D8 and accumulation, tile by tile (docs/scale.md).
       if (o.fill != FillMethod::priority_flood || o.flow != FlowMethod::d8 || !weights_.empty())
         throw bad_input("tiled hydro (--tile-size, --memory-limit, a folder of tiles): only --fill priority-flood, --flow d8, no --weights");
@@ -120,15 +119,13 @@ class HydroCommand final : public Command {
       if (explicit_outputs && wanted[4] && o.unit == AccumulationUnit::cells)
         throw bad_input("--outputs: streams on tiles need --area-units m2 or km2");
       if (classify) throw bad_input("--classify: river types are not computed on tiles yet");
-      if (tile_size_ != 0 && tile_size_ < 8) throw bad_input("--tile-size: must be at least 8 cells");
-      if (memory_limit_mb_ < 0) throw bad_input("--memory-limit: must be a positive number of MB");
       TiledHydroRequest q;
       q.dem_path = dem_.path;
       q.out_dir = dir.string();
       q.out_name = out_dir_;
       q.read = read;
-      q.tile_size = tile_size_;
-      q.memory_limit_mb = memory_limit_mb_ > 0 ? memory_limit_mb_ : 1024;
+      q.tile_size = tiles.tile_size;
+      q.memory_limit_mb = tiles.limit_mb();
       q.sea_level = o.sea_level;
       q.unit = o.unit;
       q.accumulation_scale = units_ == "km2" ? 1e-6 : 1.0;
@@ -193,8 +190,6 @@ class HydroCommand final : public Command {
   static constexpr const char* kDefaultOutputs = "filled,flowdir,accumulation,hydrometry,streams";
   std::string outputs_ = kDefaultOutputs;
   std::string units_ = "m2", weights_;
-  int tile_size_ = 0;
-  double memory_limit_mb_ = 0;
   bool cog_ = false, overwrite_ = false;
   SchemaOptions schema_;
 };

@@ -18,15 +18,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-/// Peak resident memory of this process (Linux VmHWM), MB; 0 elsewhere.
-double peak_resident_mb() {
-  std::ifstream status("/proc/self/status");
-  std::string line;
-  while (std::getline(status, line))
-    if (line.rfind("VmHWM:", 0) == 0) return std::stod(line.substr(6)) / 1024.0;
-  return 0;
-}
-
 TileDistribution* distribution = nullptr;
 
 std::string tiles_of_this_process(const TiledHydroRequest& q, Context& context, hydro::tiled::TileDriver& driver) {
@@ -65,11 +56,7 @@ std::string tiles_of_this_process(const TiledHydroRequest& q, Context& context, 
   o.scratch_dir = scratch.string();
   o.tile_size = q.tile_size > 0 ? q.tile_size : hydro::tiled::tile_size_for(h.cols, h.rows, q.memory_limit_mb, threads);
   const hydro::tiled::TileGrid grid(h.cols, h.rows, o.tile_size);
-  auto tile_path = [&](const Layer& l, int t) {
-    char name[64];
-    std::snprintf(name, sizeof name, "tile_%04d_%04d.tif", t / grid.across(), t % grid.across());
-    return (out / l.name / name).string();
-  };
+  auto tile_path = [&](const Layer& l, int t) { return tile_file(out.string(), l.name, t, grid.across()); };
   hydro::tiled::TileSinks sinks;
   if (q.filled) sinks.filled = [&](int t, const Dem& z) { write_raster(tile_path(layers[0], t), z, q.filled_file); };
   if (q.flowdir)
@@ -116,6 +103,20 @@ std::string tiles_of_this_process(const TiledHydroRequest& q, Context& context, 
 }
 
 }  // namespace
+
+double peak_resident_mb() {
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  while (std::getline(status, line))
+    if (line.rfind("VmHWM:", 0) == 0) return std::stod(line.substr(6)) / 1024.0;
+  return 0;
+}
+
+std::string tile_file(const std::string& out_dir, const std::string& layer, int tile, int across) {
+  char name[64];
+  std::snprintf(name, sizeof name, "tile_%04d_%04d.tif", tile / across, tile % across);
+  return (fs::path(out_dir) / layer / name).string();
+}
 
 void set_tile_distribution(TileDistribution* d) { distribution = d; }
 

@@ -17,6 +17,7 @@
 #include "core/error.hpp"
 #include "core/geodesy.hpp"
 #include "density/disc_sums.hpp"
+#include "density/tiled_density.hpp"
 
 namespace terrapolis::density {
 namespace {
@@ -51,8 +52,7 @@ float habitable_max(const Raster<float>& r, const Raster<std::uint8_t>& buildabl
 
 /// Rescales a characteristic so its largest value on habitable land is 1 (thesis §4.2.1: "ré-échelonnées
 /// dans [0,1]"); uninhabitable land may hold more and is clamped to 1.
-void divide_land_by_max(Raster<float>& r, const std::vector<std::uint8_t>& kind, const Raster<std::uint8_t>& buildable) {
-  const float m = habitable_max(r, buildable);
+void divide_land_by_max(Raster<float>& r, const std::vector<std::uint8_t>& kind, float m) {
   if (m <= 0) return;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, r.size(), 1 << 16), [&](const tbb::blocked_range<std::size_t>& range) {
     for (std::size_t i = range.begin(); i < range.end(); ++i)
@@ -228,6 +228,11 @@ struct Grid {
   std::vector<int> span_lo, span_hi;  ///< land columns of each row: [lo, hi)
   float land_min = 0, land_max = 0;  ///< range of the land's altitudes (min > max: no land)
   bool any_unknown = false, any_water = false;
+  /// The cells whose characteristics are computed: the whole grid, or a tile of a window whose
+  /// other cells are its halo (compute_density_window).
+  Window core;
+  int core_lo(int r) const { return std::max(span_lo[std::size_t(r)], core.x0); }
+  int core_hi(int r) const { return std::min(span_hi[std::size_t(r)], core.x0 + core.cols); }
 };
 
 /// Water, land or unknown per cell: water at or below the sea level, on nodata when it is sea,
@@ -246,10 +251,11 @@ std::vector<std::uint8_t> cell_kinds(const Dem& dem, const DensityOptions& optio
   return kind;
 }
 
-Grid describe_grid(const Dem& dem, const DensityOptions& options) {
+Grid describe_grid(const Dem& dem, const DensityOptions& options, CellMetrics metrics) {
   Grid g;
   g.cols = dem.cols(), g.rows = dem.rows();
-  g.metrics = cell_metrics(dem.georef(), g.cols, g.rows);
+  g.core = Window{0, 0, g.cols, g.rows};
+  g.metrics = std::move(metrics);
   g.kind = cell_kinds(dem, options);
   const auto nrows = static_cast<std::size_t>(g.rows);
   g.span_lo.assign(nrows, 0), g.span_hi.assign(nrows, 0);
@@ -281,9 +287,9 @@ Grid describe_grid(const Dem& dem, const DensityOptions& options) {
 }
 
 /// The largest distance between the centres of two 4-neighbours, metres.
-double largest_cell_step(const Grid& g) {
+double largest_cell_step(const CellMetrics& m) {
   double step = 0;
-  for (std::size_t r = 0; r < std::size_t(g.rows); ++r) step = std::max({step, g.metrics.width_m[r], g.metrics.height_m[r], g.metrics.height_m[r + 1]});
+  for (std::size_t r = 0; r < m.width_m.size(); ++r) step = std::max({step, m.width_m[r], m.height_m[r], m.height_m[r + 1]});
   return step;
 }
 
@@ -384,7 +390,7 @@ Raster<float> plain_characteristic(const Dem& dem, const Grid& g, const DiscPlan
 /// Coast and plateau (§4.2.1, points 1 and 3): the shares of water and of rough plateau ground in
 /// the ring r_min..r_max, each divided by its maximum over habitable land; 0 on water.
 void ring_shares(const Dem& dem, const Grid& g, const DiscPlan& inner, const DiscPlan& outer, const Window& win, const DensityOptions& options,
-                 DensityResult& result, Progress& progress) {
+                 const std::optional<std::array<float, 2>>& maxima, DensityResult& result, Progress& progress) {
   result.coast = dem.like<float>(nan_f);
   result.plateau = dem.like<float>(nan_f);
   ProgressStep step(progress, "density: coast and plateau");
@@ -405,12 +411,12 @@ void ring_shares(const Dem& dem, const Grid& g, const DiscPlan& inner, const Dis
     const bool in_range = kind[i] == land && z >= options.plateau_min_m && z <= options.plateau_max_m;
     return in_range ? std::uint32_t(std::lround((1.0 - double(result.plain[i])) * levels)) : 0u;
   });
-  for_rows(g.rows, step, [&](int r0, int r1) {
+  for_rows(g.core.rows, step, [&](int r0, int r1) {
     std::vector<std::uint32_t> w(static_cast<std::size_t>(g.cols)), k(static_cast<std::size_t>(g.cols)), h(static_cast<std::size_t>(g.cols));
-    for (int r = r0; r < r1; ++r) {
-      for (int x = 0; x < g.cols; ++x)
+    for (int r = r0 + g.core.y0; r < r1 + g.core.y0; ++r) {
+      for (int x = g.core.x0; x < g.core.x0 + g.core.cols; ++x)
         if (kind[dem.index(x, r)] == water) result.coast(x, r) = result.plateau(x, r) = 0;
-      const int x0 = g.span_lo[std::size_t(r)], x1 = g.span_hi[std::size_t(r)];
+      const int x0 = g.core_lo(r), x1 = g.core_hi(r);
       if (x0 >= x1) continue;
       std::fill(w.begin() + x0, w.begin() + x1, 0u);
       std::fill(k.begin() + x0, k.begin() + x1, 0u);
@@ -438,8 +444,11 @@ void ring_shares(const Dem& dem, const Grid& g, const DiscPlan& inner, const Dis
       }
     }
   });
-  divide_land_by_max(result.coast, kind, result.buildable);
-  divide_land_by_max(result.plateau, kind, result.buildable);
+  // The halo's cells have no share (NaN): the maxima are the core's.
+  result.stats.coast_max = habitable_max(result.coast, result.buildable);
+  result.stats.plateau_max = habitable_max(result.plateau, result.buildable);
+  divide_land_by_max(result.coast, kind, maxima ? (*maxima)[0] : result.stats.coast_max);
+  divide_land_by_max(result.plateau, kind, maxima ? (*maxima)[1] : result.stats.plateau_max);
 }
 
 bool terrain_used(const DensityOptions& options) {
@@ -489,7 +498,7 @@ void terrain_terms(const Dem& dem, const Grid& g, const DensityOptions& options,
   const std::vector<float> to_river = rivers_known ? distance_to_m(river, g.metrics, g.cols, g.rows) : std::vector<float>();
   step.update(0.3);
   // Radii of at least two cells, so the disc holds the neighbours on coarse grids.
-  const double largest_step = largest_cell_step(g);
+  const double largest_step = largest_cell_step(g.metrics);
   auto term = [&](TerrainTerm t) -> Raster<float>& { return result.terrain[std::size_t(t)]; };
   term(TerrainTerm::position_1km) = topographic_position(dem, g, std::max(1000.0, 2 * largest_step), options.ring_bands);
   step.update(0.5);
@@ -522,10 +531,10 @@ void combine_terms(const Dem& dem, const Grid& g, const DensityOptions& options,
   // The terrain terms come last, and only when used: the thesis's model sums exactly what it always did.
   const bool with_terrain = terrain_used(options);
   if (with_terrain) weights.insert(weights.end(), options.terrain_weights.begin(), options.terrain_weights.end());
-  for_rows(g.rows, step, [&](int r0, int r1) {
+  for_rows(g.core.rows, step, [&](int r0, int r1) {
     std::vector<double> values(weights.size()), cell_weights(weights);
-    for (int r = r0; r < r1; ++r)
-      for (int x = 0; x < g.cols; ++x) {
+    for (int r = r0 + g.core.y0; r < r1 + g.core.y0; ++r)
+      for (int x = g.core.x0; x < g.core.x0 + g.core.cols; ++x) {
         const std::size_t i = dem.index(x, r);
         if (g.kind[i] == unknown) continue;
         if (result.buildable[i] != 1) {
@@ -556,10 +565,10 @@ void gather_stats(const Dem& dem, const Grid& g, DensityResult& result) {
   const auto nrows = static_cast<std::size_t>(g.rows);
   std::vector<DensityStats> per_row(nrows);
   std::vector<double> row_sum(nrows, 0.0);
-  tbb::parallel_for(tbb::blocked_range<int>(0, g.rows, 8), [&](const tbb::blocked_range<int>& range) {
+  tbb::parallel_for(tbb::blocked_range<int>(g.core.y0, g.core.y0 + g.core.rows, 8), [&](const tbb::blocked_range<int>& range) {
     for (int r = range.begin(); r < range.end(); ++r) {
       DensityStats& t = per_row[std::size_t(r)];
-      for (int x = 0; x < g.cols; ++x) {
+      for (int x = g.core.x0; x < g.core.x0 + g.core.cols; ++x) {
         const std::size_t i = dem.index(x, r);
         if (g.kind[i] != unknown) ++t.known_cells;
         if (g.kind[i] == water) ++t.water_cells;
@@ -582,35 +591,74 @@ void gather_stats(const Dem& dem, const Grid& g, DensityResult& result) {
     for (std::size_t k = 0; k < 10; ++k) stats.histogram[k] += t.histogram[k];
     sum += row_sum[r];
   }
+  stats.density_sum = sum;
   stats.mean_density = stats.buildable_cells ? sum / double(stats.buildable_cells) : 0.0;
+}
+
+}  // namespace
+
+namespace {
+
+/// The model on `grid` once its masks are known, with the discs of the whole grid and, on a
+/// window, the whole grid's coast and plateau maxima.
+void characteristics(const Dem& dem, const Grid& grid, const DiscPlan& inner, const DiscPlan& outer, double r_min,
+                     const std::optional<std::array<float, 2>>& maxima, const DensityOptions& options, DensityResult& result,
+                     Progress& progress) {
+  result.stats.r_min_m = r_min;
+  result.stats.r_max_m = options.r_max_m;
+  result.stats.ring_bands = std::max(inner.band_count(), outer.band_count());
+  result.stats.ring_exact = inner.exact() && outer.exact();
+  const Window win = disc_window(grid, inner, outer);
+  result.plain = plain_characteristic(dem, grid, inner, win, options.plain_max_variation_m, progress);
+  ring_shares(dem, grid, inner, outer, win, options, maxima, result, progress);
+  if (terrain_used(options) || options.terrain_terms) terrain_terms(dem, grid, options, result, progress);
+  combine_terms(dem, grid, options, result, progress);
+  gather_stats(dem, grid, result);
 }
 
 }  // namespace
 
 DensityResult compute_density(const Dem& dem, const Raster<float>& hydrometry, const DensityOptions& options, Progress& progress) {
   check_options(dem, hydrometry, options);
-  const Grid grid = describe_grid(dem, options);
+  const Grid grid = describe_grid(dem, options, cell_metrics(dem.georef(), dem.cols(), dem.rows()));
   DensityResult result;
   result.stats.cells = dem.size();
   mark_buildable(dem, grid, hydrometry, options, result, progress);
 
   // The plain disc must hold at least the 4-neighbours: raise r_min to the largest cell step.
-  const double r_min = std::max(options.r_min_m, largest_cell_step(grid) * (1 + 1e-9));
-  if (!(options.r_max_m > r_min))
-    throw bad_input("--r-max: must be larger than r_min (" + std::to_string(r_min) + " m once raised to the cell size)");
+  const double r_min = raised_r_min(grid.metrics, options);
   const DiscPlan inner(grid.metrics, grid.rows, r_min, options.ring_bands);
   const DiscPlan outer(grid.metrics, grid.rows, options.r_max_m, options.ring_bands);
-  result.stats.r_min_m = r_min;
-  result.stats.r_max_m = options.r_max_m;
-  result.stats.ring_bands = std::max(inner.band_count(), outer.band_count());
-  result.stats.ring_exact = inner.exact() && outer.exact();
-  const Window win = disc_window(grid, inner, outer);
+  characteristics(dem, grid, inner, outer, r_min, std::nullopt, options, result, progress);
+  return result;
+}
 
-  result.plain = plain_characteristic(dem, grid, inner, win, options.plain_max_variation_m, progress);
-  ring_shares(dem, grid, inner, outer, win, options, result, progress);
-  if (terrain_used(options) || options.terrain_terms) terrain_terms(dem, grid, options, result, progress);
-  combine_terms(dem, grid, options, result, progress);
-  gather_stats(dem, grid, result);
+double raised_r_min(const CellMetrics& metrics, const DensityOptions& options) {
+  const double r_min = std::max(options.r_min_m, largest_cell_step(metrics) * (1 + 1e-9));
+  if (!(options.r_max_m > r_min))
+    throw bad_input("--r-max: must be larger than r_min (" + std::to_string(r_min) + " m once raised to the cell size)");
+  return r_min;
+}
+
+std::array<float, 2> land_range(const Dem& dem, const DensityOptions& options) {
+  const std::vector<std::uint8_t> kind = cell_kinds(dem, options);
+  std::array<float, 2> range{std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity()};
+  for (std::size_t i = 0; i < kind.size(); ++i)
+    if (kind[i] == land) range[0] = std::min(range[0], dem[i]), range[1] = std::max(range[1], dem[i]);
+  return range;
+}
+
+DensityResult compute_density_window(const Dem& dem, const Raster<float>& hydrometry, const DensityOptions& options,
+                                     const WholeGridFigures& whole, Progress& progress) {
+  check_options(dem, hydrometry, options);
+  if (terrain_used(options) || options.terrain_terms) throw bad_input("density: the terrain terms are not computed on tiles yet");
+  Grid grid = describe_grid(dem, options, whole.metrics);
+  grid.core = whole.core;
+  grid.land_min = whole.land_range[0], grid.land_max = whole.land_range[1];
+  DensityResult result;
+  result.stats.cells = std::size_t(whole.core.cols) * std::size_t(whole.core.rows);
+  mark_buildable(dem, grid, hydrometry, options, result, progress);
+  characteristics(dem, grid, whole.inner, whole.outer, whole.r_min_m, whole.maxima, options, result, progress);
   return result;
 }
 

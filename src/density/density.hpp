@@ -103,6 +103,9 @@ struct DensityStats {
   double r_min_m = 0.0, r_max_m = 0.0;  ///< radii actually used (r_min may have been raised)
   int ring_bands = 0;                ///< largest number of bands per disc (rows when exact)
   bool ring_exact = true;            ///< every disc was summed row by row
+  double density_sum = 0.0;          ///< sum of the density over buildable cells
+  /// Coast and plateau shares before their division by these maxima over habitable land.
+  float coast_max = 0.0f, plateau_max = 0.0f;
 };
 
 /// The model's rasters, all on the DEM's grid and CRS. Float rasters are in [0,1], NaN where the

@@ -61,7 +61,8 @@ DiscPlan::DiscPlan(const CellMetrics& metrics, int rows, double radius_m, int ma
   // A projected grid has the same metrics on every row: plan once.
   const bool uniform = std::all_of(metrics.width_m.begin(), metrics.width_m.end(), [&](double w) { return w == metrics.width_m[0]; }) &&
                        std::all_of(metrics.height_m.begin(), metrics.height_m.end(), [&](double h) { return h == metrics.height_m[0]; });
-  per_row_.resize(std::size_t(rows));
+  per_row_ = std::make_shared<std::vector<std::vector<Band>>>(std::size_t(rows));
+  std::vector<std::vector<Band>>& per_row = *per_row_;
   auto plan_row = [&](int row) {
     int north = 0, south = 0;
     while (north < reach && half_cols(g, radius_m, row, -(north + 1)) >= 0) ++north;
@@ -69,7 +70,7 @@ DiscPlan::DiscPlan(const CellMetrics& metrics, int rows, double radius_m, int ma
     const int count = north + south + 1;
     std::vector<int> widths(static_cast<std::size_t>(count));
     for (int dr = -north; dr <= south; ++dr) widths[std::size_t(dr + north)] = half_cols(g, radius_m, row, dr);
-    std::vector<Band>& bands = per_row_[std::size_t(row)];
+    std::vector<Band>& bands = per_row[std::size_t(row)];
     if (count <= bands_wanted) {
       for (int dr = -north; dr <= south; ++dr) bands.push_back({dr, dr, widths[std::size_t(dr + north)]});
       return;
@@ -92,14 +93,14 @@ DiscPlan::DiscPlan(const CellMetrics& metrics, int rows, double radius_m, int ma
   };
   if (uniform) {
     if (rows > 0) plan_row(0);
-    for (int row = 1; row < rows; ++row) per_row_[std::size_t(row)] = per_row_[0];
+    for (int row = 1; row < rows; ++row) per_row[std::size_t(row)] = per_row[0];
   } else {
     // Rows are planned independently (geographic grids: one plan per latitude).
     tbb::parallel_for(tbb::blocked_range<int>(0, rows, 16), [&](const tbb::blocked_range<int>& range) {
       for (int row = range.begin(); row < range.end(); ++row) plan_row(row);
     });
   }
-  for (const std::vector<Band>& bands : per_row_) {
+  for (const std::vector<Band>& bands : per_row) {
     double cells = 0;
     bool single_rows = true;
     for (const Band& b : bands) {

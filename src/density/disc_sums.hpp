@@ -3,6 +3,7 @@
 #pragma once
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include <tbb/blocked_range.h>
@@ -71,7 +72,14 @@ class DiscPlan {
   DiscPlan() = default;
   DiscPlan(const CellMetrics& metrics, int rows, double radius_m, int max_bands);
   /// Bands of the disc centred on a cell of row `row` (relative rows may reach outside the grid).
-  const std::vector<Band>& bands(int row) const { return per_row_[std::size_t(row)]; }
+  const std::vector<Band>& bands(int row) const { return (*per_row_)[std::size_t(row + first_row_)]; }
+  /// The same plan for a window of the grid whose row 0 is the grid's row `row0` (a tile with its
+  /// halo): the window's rows get the grid's discs, planned from the grid's metrics. Shares the rows.
+  DiscPlan from_row(int row0) const {
+    DiscPlan p = *this;
+    p.first_row_ += row0;
+    return p;
+  }
   /// Exact half-width in columns of the disc of a centre in row `row` at relative row `dr`, or -1
   /// when that row is outside the disc (the reference shape; used by tests and band planning).
   static int exact_half_cols(const CellMetrics& metrics, int rows, double radius_m, int row, int dr);
@@ -86,7 +94,8 @@ class DiscPlan {
   int reach_cols() const { return reach_cols_; }
 
  private:
-  std::vector<std::vector<Band>> per_row_;
+  std::shared_ptr<std::vector<std::vector<Band>>> per_row_;
+  int first_row_ = 0;
   bool exact_ = true;
   int band_count_ = 0;
   double max_cells_ = 0;

@@ -36,6 +36,9 @@ void RunState::write(const std::string& stage, const std::string& name, const Ra
   // The output folder is where, not what: it stays out of the provenance so runs compare byte for byte.
   nlohmann::ordered_json parameters = scenario.resolved;
   parameters.erase("output");
+  // So is the cutting into tiles (input.tile_size, input.memory_limit_mb): the same cells either way.
+  parameters["input"].erase("tile_size");
+  parameters["input"].erase("memory_limit_mb");
   WriteOptions options;
   options.cog = scenario.resolved["outputs"]["cog"].get<bool>();
   options.description = description;

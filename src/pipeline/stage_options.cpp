@@ -69,6 +69,17 @@ std::vector<lake::LakeSpec> reservoir_specs(const Scenario& scenario) {
   return out;
 }
 
+bool TileSettings::tiled(const std::string& dem_path) const {
+  return tile_size > 0 || memory_limit_mb > 0 || std::filesystem::is_directory(dem_path);
+}
+
+TileSettings tile_settings(const Scenario& scenario) {
+  const json& in = scenario.resolved["input"];
+  TileSettings t{in["tile_size"].get<int>(), in["memory_limit_mb"].get<double>()};
+  if (t.tile_size != 0 && t.tile_size < 8) throw bad_input("/input/tile_size: must be at least 8 cells");
+  return t;
+}
+
 hydro::D8Codes d8_codes(const Scenario& scenario) {
   return choice(scenario.resolved["hydro"]["d8_codes"], hydro::kD8Codes);
 }
@@ -97,18 +108,23 @@ density::DensityOptions density_options(const Scenario& scenario) {
 }
 
 void read_density_files(const Scenario& scenario, const Dem& dem, const std::string& water_mask, density::DensityOptions& o) {
+  read_density_files(scenario, dem.georef(), dem.cols(), dem.rows(), water_mask, o);
+}
+
+void read_density_files(const Scenario& scenario, const Georef& grid, int cols, int rows, const std::string& water_mask,
+                        density::DensityOptions& o) {
   const json& d = scenario.resolved["density"];
   std::vector<density::DensityOptions::Factor> layers;
   for (const auto& layer : d["layers"]) {
     const std::string file = scenario.file(layer["file"].get<std::string>());
-    Raster<float> values = read_resampled(file, dem.georef(), dem.cols(), dem.rows(), Resampling::bilinear);
+    Raster<float> values = read_resampled(file, grid, cols, rows, Resampling::bilinear);
     density::to_unit_range(values);
     layers.push_back({std::filesystem::path(file).filename().string(), std::move(values), layer["weight"].get<double>()});
   }
   o.factors.insert(o.factors.begin(), std::make_move_iterator(layers.begin()), std::make_move_iterator(layers.end()));
   for (const auto& file : d["exclusions"])
-    o.exclusion_masks.push_back(read_mask(scenario.file(file.get<std::string>()), dem.georef(), dem.cols(), dem.rows()));
-  if (!water_mask.empty()) o.water_mask = read_mask(water_mask, dem.georef(), dem.cols(), dem.rows());
+    o.exclusion_masks.push_back(read_mask(scenario.file(file.get<std::string>()), grid, cols, rows));
+  if (!water_mask.empty()) o.water_mask = read_mask(water_mask, grid, cols, rows);
 }
 
 std::vector<std::string> density_files(const Scenario& scenario) {
@@ -250,6 +266,10 @@ void check_file(const std::string& pointer, const std::string& path) {
 StageSettings prepare_stages(const Scenario& scenario) {
   try {
     StageSettings s;
+    // Only the hydro and density commands work tile by tile yet (docs/scale.md): a run refuses it.
+    if (const TileSettings t = tile_settings(scenario); t.tile_size > 0 || t.memory_limit_mb > 0)
+      throw bad_input(std::string(t.tile_size > 0 ? "/input/tile_size" : "/input/memory_limit_mb") +
+                      ": a run does not work tile by tile yet (only the hydro and density commands do)");
     s.flat_water = flat_water_options(scenario);
     s.reservoirs = reservoir_specs(scenario);
     s.hydro = hydro_options(scenario);

@@ -20,6 +20,19 @@
 
 namespace terrapolis::pipeline {
 
+/// input.tile_size and input.memory_limit_mb: whether and how the hydro and density stages work
+/// tile by tile (docs/scale.md).
+struct TileSettings {
+  int tile_size = 0;           ///< 0: from memory_limit_mb
+  double memory_limit_mb = 0;  ///< 0: none given
+  /// Tile by tile: a tile size or a memory limit given, or the DEM is a folder of tiles.
+  bool tiled(const std::string& dem_path) const;
+  /// The limit the tiles are sized to: the one given, or 1 GB.
+  double limit_mb() const { return memory_limit_mb > 0 ? memory_limit_mb : 1024; }
+};
+/// Throws bad_input for a tile size under 8 cells.
+TileSettings tile_settings(const Scenario& scenario);
+
 /// The hydro section (sea level from the water section). Weights are not part of a scenario.
 hydro::HydroOptions hydro_options(const Scenario& scenario);
 /// hydro.classify's thresholds, or none when the reaches are not classified.
@@ -36,6 +49,10 @@ density::DensityOptions density_options(const Scenario& scenario);
 /// plugin's), density.exclusions as masks, and `water_mask` (a command: water.water_mask; a run:
 /// its inland_water.tif, which holds it) as the water mask, when not empty.
 void read_density_files(const Scenario& scenario, const Dem& dem, const std::string& water_mask, density::DensityOptions& options);
+/// The same onto a window of the DEM's grid (density by tiles: the layers, rescaled by their
+/// range on the grid read, are refused there).
+void read_density_files(const Scenario& scenario, const Georef& grid, int cols, int rows, const std::string& water_mask,
+                        density::DensityOptions& options);
 /// The files read_density_files reads (the water mask, the layers, the exclusions), as paths.
 std::vector<std::string> density_files(const Scenario& scenario);
 /// The sites section, with the scenario's seed.

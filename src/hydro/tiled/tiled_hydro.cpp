@@ -41,14 +41,6 @@ std::vector<int> bounds(int n, int tile_size) {
   return b;
 }
 
-Georef shifted(const Georef& g, int col0, int row0) {
-  Georef out = g;
-  const GeoTransform& t = g.transform;
-  out.transform[0] = t[0] + col0 * t[1] + row0 * t[2];
-  out.transform[3] = t[3] + col0 * t[4] + row0 * t[5];
-  return out;
-}
-
 bool out_code(std::uint8_t v) { return v == kNoData || v == kTerminal; }  // drain_flats' "outside" cells
 
 /// The cells of a tile within two of its edges (where neighbouring tiles look): filled values
@@ -213,6 +205,14 @@ class Unpack {
 };
 
 }  // namespace
+
+Georef shifted(const Georef& g, int col0, int row0) {
+  Georef out = g;
+  const GeoTransform& t = g.transform;
+  out.transform[0] = t[0] + col0 * t[1] + row0 * t[2];
+  out.transform[3] = t[3] + col0 * t[4] + row0 * t[5];
+  return out;
+}
 
 TileGrid::TileGrid(int cols, int rows, int tile_size)
     : col_bounds_(bounds(cols, std::max(tile_size, 8))), row_bounds_(bounds(rows, std::max(tile_size, 8))) {}

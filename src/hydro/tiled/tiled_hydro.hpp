@@ -39,6 +39,9 @@ class TileGrid {
   std::vector<int> col_bounds_, row_bounds_;
 };
 
+/// The georeferencing of the window of `g`'s grid whose first cell is (col0, row0).
+Georef shifted(const Georef& g, int col0, int row0);
+
 /// Who processes which tiles, and how what a pass learnt about its tiles (their frames, spill
 /// edges, shared flat cells, links: perimeters and global graphs, never whole tiles) reaches every
 /// process before the next pass. LocalTiles: all tiles in this process; terrapolis-mpi: tiles

@@ -1,0 +1,158 @@
+// The density model tile by tile: three passes over the mosaic, one tile and its halo at a time.
+// SPDX-License-Identifier: MIT
+#include "density/tiled_density.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "core/error.hpp"
+#include "hydro/tiled/tiled_hydro.hpp"
+
+namespace terrapolis::density {
+namespace {
+
+using hydro::tiled::TileGrid;
+using hydro::tiled::TileRect;
+
+/// The rows [row0, row0 + rows) of the whole grid's metrics (height_m and diagonal_m: one more).
+CellMetrics metric_rows(const CellMetrics& m, int row0, int rows) {
+  auto part = [&](const std::vector<double>& v, int n) {
+    return std::vector<double>(v.begin() + row0, v.begin() + row0 + n);
+  };
+  CellMetrics out;
+  out.width_m = part(m.width_m, rows);
+  out.area_m2 = part(m.area_m2, rows);
+  out.height_m = part(m.height_m, rows + 1);
+  out.diagonal_m = part(m.diagonal_m, rows + 1);
+  return out;
+}
+
+/// Reach of the discs of `plan` around the cells of rows [row0, row0 + rows): rows and columns.
+/// On a geographic grid the columns follow the latitude (a disc is wider in columns poleward).
+std::array<int, 2> reach_of_rows(const DiscPlan& plan, int row0, int rows) {
+  std::array<int, 2> reach{0, 0};
+  for (int r = row0; r < row0 + rows; ++r)
+    for (const Band& b : plan.bands(r)) reach = {std::max({reach[0], -b.row_lo, b.row_hi}), std::max(reach[1], b.half_cols)};
+  return reach;
+}
+
+template <class T>
+Raster<T> crop(const Raster<T>& r, const Window& w) {
+  if (r.size() == 0) return r;  // a term not computed
+  Raster<T> out(w.cols, w.rows, hydro::tiled::shifted(r.georef(), w.x0, w.y0));
+  out.nodata = r.nodata;
+  for (int y = 0; y < w.rows; ++y) std::copy_n(&r(w.x0, w.y0 + y), w.cols, &out(0, y));
+  return out;
+}
+
+/// Adds a tile's figures to the mosaic's (counts exactly; areas and the density sum in tile order).
+void add_stats(DensityStats& total, const DensityStats& tile) {
+  total.cells += tile.cells;
+  total.known_cells += tile.known_cells;
+  total.water_cells += tile.water_cells;
+  total.buildable_cells += tile.buildable_cells;
+  for (std::size_t k = 0; k < total.histogram.size(); ++k) total.histogram[k] += tile.histogram[k];
+  total.land_area_km2 += tile.land_area_km2;
+  total.density_sum += tile.density_sum;
+}
+
+double plan_bytes(const DiscPlan& plan, int rows) {
+  double bytes = 0;
+  for (int r = 0; r < rows; ++r) bytes += double(sizeof(std::vector<Band>)) + double(plan.bands(r).size() * sizeof(Band));
+  return bytes;
+}
+
+}  // namespace
+
+int density_tile_size_for(int cols, int rows, int halo_rows, int halo_cols, double global_bytes, double memory_limit_mb) {
+  const double limit = memory_limit_mb * 1e6 - global_bytes;
+  for (int side = 1 << 15; side >= 64; side = side * 7 / 8) {
+    const double window = kDensityBytesPerCell * double(std::min(side, rows) + 2 * halo_rows) * double(std::min(side, cols) + 2 * halo_cols);
+    if (window <= limit) return side;
+  }
+  throw bad_input("--memory-limit: " + std::to_string(int(memory_limit_mb)) + " MB is too little for density tiles of 64 x 64 cells with a halo of " +
+                  std::to_string(halo_cols) + " x " + std::to_string(halo_rows) + " cells (r_max)");
+}
+
+TiledDensityReport run_tiled_density(int cols, int rows, const Georef& georef, const ReadWindowInputs& read,
+                                     const DensityOptions& options, int tile_size, double memory_limit_mb,
+                                     const WriteDensityTile& write, Progress& progress) {
+  TiledDensityReport report;
+  const CellMetrics metrics = cell_metrics(georef, cols, rows);
+  const double r_min = raised_r_min(metrics, options);
+  // The discs are planned once on the whole grid: a plan depends on the northings summed from the
+  // grid's first row, which a window would sum from its own.
+  const DiscPlan inner(metrics, rows, r_min, options.ring_bands), outer(metrics, rows, options.r_max_m, options.ring_bands);
+  report.global_bytes = plan_bytes(inner, rows) + plan_bytes(outer, rows) + 4.0 * sizeof(double) * rows;
+  // A ring cell's plain needs the r_min disc around it: the halo is the two reaches.
+  auto halo_of = [&](int row0, int n) {
+    const std::array<int, 2> ring = reach_of_rows(outer, row0, n);
+    return std::array<int, 2>{ring[0] + inner.reach_rows(), ring[1] + inner.reach_cols()};
+  };
+  const std::array<int, 2> widest = {outer.reach_rows() + inner.reach_rows(), outer.reach_cols() + inner.reach_cols()};
+  report.tile_size = tile_size > 0 ? std::max(tile_size, 8)
+                                   : density_tile_size_for(cols, rows, widest[0], widest[1], report.global_bytes, memory_limit_mb);
+  const TileGrid grid(cols, rows, report.tile_size);
+  report.tiles = grid.count();
+  report.across = grid.across();
+  SilentProgress quiet;  // per-tile steps would flood the console: one step per pass instead
+
+  // 1. The land's altitude range (the plain's sums are taken relative to its middle).
+  std::array<float, 2> range{std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity()};
+  {
+    ProgressStep step(progress, "density by tiles: altitudes");
+    for (int t = 0; t < grid.count(); ++t) {
+      const TileRect r = grid.rect(t);
+      const WindowInputs in = read(r.col0, r.row0, r.cols, r.rows, true);
+      const std::array<float, 2> tile = land_range(in.dem, in.options);
+      range = {std::min(range[0], tile[0]), std::max(range[1], tile[1])};
+      step.update(double(t + 1) / grid.count());
+    }
+  }
+  // 2. The coast and plateau maxima over habitable land, then 3. each tile divided by them.
+  auto pass = [&](const char* what, const std::optional<std::array<float, 2>>& maxima, auto&& use) {
+    ProgressStep step(progress, what);
+    for (int t = 0; t < grid.count(); ++t) {
+      const TileRect r = grid.rect(t);
+      const std::array<int, 2> halo = halo_of(r.row0, r.rows);
+      const int c0 = std::max(0, r.col0 - halo[1]), r0 = std::max(0, r.row0 - halo[0]);
+      const int c1 = std::min(cols, r.col0 + r.cols + halo[1]), r1 = std::min(rows, r.row0 + r.rows + halo[0]);
+      report.halo_rows = std::max(report.halo_rows, halo[0]);
+      report.halo_cols = std::max(report.halo_cols, halo[1]);
+      report.window_bytes = std::max(report.window_bytes, kDensityBytesPerCell * double(c1 - c0) * double(r1 - r0));
+      WindowInputs in = read(c0, r0, c1 - c0, r1 - r0, false);
+      WholeGridFigures whole{metric_rows(metrics, r0, r1 - r0), range, r_min, inner.from_row(r0), outer.from_row(r0),
+                             Window{r.col0 - c0, r.row0 - r0, r.cols, r.rows}, maxima};
+      use(t, compute_density_window(in.dem, in.hydrometry, in.options, whole, quiet), whole.core);
+      step.update(double(t + 1) / grid.count());
+    }
+  };
+  std::array<float, 2> maxima{0, 0};
+  pass("density by tiles: coast and plateau maxima", std::nullopt, [&](int, const DensityResult& d, const Window&) {
+    maxima = {std::max(maxima[0], d.stats.coast_max), std::max(maxima[1], d.stats.plateau_max)};
+  });
+  DensityStats& stats = report.stats;
+  pass("density by tiles", maxima, [&](int t, const DensityResult& d, const Window& core) {
+    DensityResult tile;
+    tile.coast = crop(d.coast, core);
+    tile.plateau = crop(d.plateau, core);
+    tile.plain = crop(d.plain, core);
+    tile.hydrometry = crop(d.hydrometry, core);
+    tile.density = crop(d.density, core);
+    tile.buildable = crop(d.buildable, core);
+    tile.stats = d.stats;
+    add_stats(stats, d.stats);
+    write(t, grid.across(), tile);
+  });
+  stats.mean_density = stats.buildable_cells ? stats.density_sum / double(stats.buildable_cells) : 0.0;
+  stats.r_min_m = r_min;
+  stats.r_max_m = options.r_max_m;
+  stats.ring_bands = std::max(inner.band_count(), outer.band_count());
+  stats.ring_exact = inner.exact() && outer.exact();
+  stats.coast_max = maxima[0];
+  stats.plateau_max = maxima[1];
+  return report;
+}
+
+}  // namespace terrapolis::density

@@ -1,0 +1,64 @@
+#!/usr/bin/env bash
+# `terrapolis density` tile by tile (--tile-size, --memory-limit, a folder of tiles, a VRT): each
+# tile computed with a halo of r_max + r_min; the VRT of every output equals the whole-grid file
+# cell for cell; memory bounded by the window; refusals; nothing left behind.
+# SPDX-License-Identifier: MIT
+source "$(dirname "$0")/lib.sh" "$@"
+bin=$TP samples=$SAMPLES work=$WORK
+
+# SRTM 3" of Zion (geographic, integer metres) cut into 3 x 3 input tiles; processed on 5 x 5
+# tiles of about 93 cells, with the hydrometry the whole-grid hydro command computes.
+zion=$samples/spDataLarge_srtm_zion.tif
+mkdir "$work/zion_tiles"
+for i in 0 1 2; do for j in 0 1 2; do  # 465 x 457 cells: columns 3 x 155, rows 152 + 152 + 153
+  gdal_translate -q -srcwin $((i * 155)) $((j * 152)) 155 $((j == 2 ? 153 : 152)) "$zion" "$work/zion_tiles/z_${j}_${i}.tif"
+done; done
+"$bin" -q hydro "$zion" "$work/hydro" --outputs hydrometry
+hydrometry=$work/hydro/hydrometry.tif
+"$bin" -q density "$zion" "$work/whole" --hydrometry "$hydrometry" --max-slope 25 --report > "$work/whole.txt"
+"$bin" -v density "$work/zion_tiles" "$work/tiled" --hydrometry "$hydrometry" --max-slope 25 --tile-size 93 --report \
+  > "$work/tiled.txt" 2> "$work/tiled.log"
+for o in coast plateau plain hydrometry buildable density; do
+  same_cells "$work/whole/$o.tif" "$work/tiled/$o.vrt" || fail "zion: tiled $o differs"
+  [[ $(ls "$work/tiled/$o"/tile_*.tif | wc -l) -eq 25 ]] || fail "zion: expected 25 $o tiles"
+done
+grep -q 'ID\["EPSG",4326\]' <(gdalinfo "$work/tiled/density.vrt") || fail "VRT without the CRS"
+grep -q "WEIGHTS_COAST_HYDROMETRY_PLATEAU_PLAIN=1,1,1.5,0" <(gdalinfo "$work/tiled/density/tile_0002_0003.tif") || fail "tile without its provenance"
+# The same report: buildable cells, radii, histogram (sums of integers); the mean to its 3 digits.
+diff <(grep -v "^Density report" "$work/whole.txt") <(grep -v "^Density report" "$work/tiled.txt") || fail "zion: the reports differ"
+# The halo follows the discs: r_max 5 km + r_min 500 m is about 74 columns of 74 m and 60 rows of 92 m at 37 N.
+line=$(grep "^density tiles: [0-9]" "$work/tiled.log") || fail "no tile report: $(cat "$work/tiled.log")"
+[[ $line =~ halo\ ([0-9]+)\ x\ ([0-9]+)\ cells ]] || fail "unreadable tile report: $line"
+(( BASH_REMATCH[1] >= 70 && BASH_REMATCH[1] <= 80 && BASH_REMATCH[2] >= 56 && BASH_REMATCH[2] <= 64 )) || fail "unexpected halo: $line"
+
+# North Corsica (GEBCO 15", sea below 0) through a VRT, hydrometry neutral, on one thread: coasts
+# and the sea cross tile edges.
+gdalbuildvrt -q "$work/corsica.vrt" "$samples/gebco2022_15s_north_corsica_capcorse.asc"
+"$bin" -q density "$samples/gebco2022_15s_north_corsica_capcorse.asc" "$work/cor_whole" --weights 1,0,1.5,0
+"$bin" -q --threads 1 density "$work/corsica.vrt" "$work/cor_tiled" --weights 1,0,1.5,0 --tile-size 40
+for o in coast plateau plain buildable density; do
+  same_cells "$work/cor_whole/$o.tif" "$work/cor_tiled/$o.vrt" || fail "corsica: tiled $o differs"
+done
+[[ ! -e $work/cor_tiled/hydrometry.vrt && ! -e $work/cor_tiled/hydrometry ]] || fail "corsica: hydrometry written although unused"
+
+# Memory: Zion with r_max 1.5 km within 4 MB for the window and the global state (from the report).
+"$bin" -q density "$zion" "$work/small_whole" --hydrometry "$hydrometry" --r-max 1500
+"$bin" -v density "$zion" "$work/small_tiled" --hydrometry "$hydrometry" --r-max 1500 --memory-limit 4 2> "$work/small.log"
+for o in plain buildable density; do
+  same_cells "$work/small_whole/$o.tif" "$work/small_tiled/$o.vrt" || fail "memory limit: tiled $o differs"
+done
+line=$(grep "^density tiles: [0-9]" "$work/small.log") || fail "no tile report: $(cat "$work/small.log")"
+[[ $line =~ ^density\ tiles:\ ([0-9]+)\ of.*state\ ([0-9.]+)\ MB\ a\ window\ \+\ ([0-9.]+)\ MB\ global ]] || fail "unreadable tile report: $line"
+(( BASH_REMATCH[1] >= 4 )) || fail "expected several tiles: $line"
+awk -v w="${BASH_REMATCH[2]}" -v g="${BASH_REMATCH[3]}" 'BEGIN { exit !(w + g <= 4.0) }' || fail "state over the memory limit: $line"
+no_leftovers "$work"
+
+# Refusals: exit 2, one line, nothing written.
+expect_refused "$work/r1" "give --hydrometry FILE" "$bin" density "$zion" "$work/r1" --tile-size 100
+expect_refused "$work/r2" "--layer: .*not computed on tiles" "$bin" density "$zion" "$work/r2" --tile-size 100 --weights 1,0,1.5,0 \
+  --layer "$hydrometry:1"
+expect_refused "$work/r3" "--tile-size: must be at least 8" "$bin" density "$zion" "$work/r3" --tile-size 3
+expect_refused "$work/r4" "--memory-limit: .*too little" "$bin" density "$zion" "$work/r4" --weights 1,0,1.5,0 --memory-limit 1
+echo "density tiles: ok"
+expect_fail 2 "/input/tile_size: a run does not work tile by tile yet" "$bin" run -o "$work/r5" --set input.tile_size=100
+[[ ! -e $work/r5 ]] || fail "a refused run left its folder"
