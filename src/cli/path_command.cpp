@@ -98,7 +98,7 @@ class PathCommand final : public Command {
     double corridor_seconds = 0;
     if (!corridor.empty()) {
       const auto t1 = std::chrono::steady_clock::now();
-      corridors = RoadOptions::corridors(terrain, roads, corridor_options);
+      corridors = roads::road_corridors(terrain, roads, corridor_options);
       corridor_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
       roads::add_corridor_fields(layer, corridors);
     }

@@ -70,12 +70,6 @@ struct RoadOptions {
     for (const roads::Road& r : roads) out.push_back(&r.geometry);
     return out;
   }
-  /// The corridors of `roads`, each at its class's widths.
-  static roads::Corridors corridors(const roads::TerrainField& terrain, const std::vector<roads::Road>& roads, const roads::CorridorOptions& options) {
-    std::vector<roads::RoadClass> classes;
-    for (const roads::Road& r : roads) classes.push_back(r.road_class);
-    return roads::corridors(terrain, geometries(roads), options, classes);
-  }
 
   /// Lakes the DEM flattens (hydro::detect_flat_water), for the TerrainField.
   hydro::FlatWater flat_water(const Dem& dem) const { return hydro::detect_flat_water(dem, pipeline::flat_water_options(scenario())); }

@@ -80,7 +80,7 @@ class RoadsCommand final : public Command {
     double corridor_seconds = 0;
     if (corridor_) {
       const auto t1 = std::chrono::steady_clock::now();
-      corridors = RoadOptions::corridors(terrain, result.roads, corridor);
+      corridors = roads::road_corridors(terrain, result.roads, corridor);
       corridor_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
       roads::add_corridor_fields(roads_layer, corridors);
       write_vector((dir / "corridors.geojson").string(), roads::corridors_layer(terrain, corridors));

@@ -271,13 +271,7 @@ json corridor_hook(RunState& s, const roads::TerrainField& terrain, const std::v
   if (!c.enabled) return nullptr;
   if (!c.side_angles.empty())
     c.options.side_angles_deg = read_resampled(c.side_angles, s.dem.georef(), s.dem.cols(), s.dem.rows(), Resampling::nearest);
-  std::vector<const roads::RoadGeometry*> geometries;
-  std::vector<roads::RoadClass> classes;
-  for (const roads::Road& r : built) {
-    geometries.push_back(&r.geometry);
-    classes.push_back(r.road_class);
-  }
-  const roads::Corridors corridors = roads::corridors(terrain, geometries, c.options, classes);
+  const roads::Corridors corridors = roads::road_corridors(terrain, built, c.options);
   s.write("roads", "corridors.geojson", roads::corridors_layer(terrain, corridors),
           "per section the carriageway and earthworks zone (cut, fill), and the land take united", Style::corridors);
   json out = {{"land_take_ha", round_to(corridors.run.land_take_ha, 0.01)}, {"cut_m3", round_to(corridors.run.cut_m3, 1)},

@@ -9,6 +9,7 @@
 
 #include "core/error.hpp"
 #include "io/polygon_union.hpp"
+#include "roads/road_network.hpp"
 
 namespace terrapolis::roads {
 namespace {
@@ -354,6 +355,13 @@ std::string corridor_summary(const Corridors& c, double seconds) {
   }
   std::snprintf(line, sizeof line, ", %.2f s", seconds);
   return out + line;
+}
+
+Corridors road_corridors(const TerrainField& terrain, const std::vector<Road>& roads, const CorridorOptions& options) {
+  std::vector<const RoadGeometry*> geometries;
+  std::vector<RoadClass> classes;
+  for (const Road& r : roads) geometries.push_back(&r.geometry), classes.push_back(r.road_class);
+  return corridors(terrain, geometries, options, classes);
 }
 
 }  // namespace terrapolis::roads

@@ -96,6 +96,10 @@ EarthworkOptions earthwork_options(const CorridorOptions& options, Raster<float>
 Corridors corridors(const TerrainField& terrain, const std::vector<const RoadGeometry*>& roads, const CorridorOptions& options,
                     const std::vector<RoadClass>& classes = {});
 
+struct Road;
+/// The corridors of routed roads, each at its class's widths (the roads and path commands, the run).
+Corridors road_corridors(const TerrainField& terrain, const std::vector<Road>& roads, const CorridorOptions& options);
+
 /// corridors.geojson: per section an "earthworks" polygon (surface sections) and a "carriageway"
 /// polygon, with road, section, structure, part, length_m, area_ha (geodesic), half-widths,
 /// cut_m3, fill_m3, cleared_ha (null without a vegetation layer), walled_m; then the run's

@@ -135,8 +135,7 @@ void TerrainField::add_cost_layer(const std::string& name, const Raster<float>& 
 
 float TerrainField::vegetation_at(double col, double row) const {
   if (vegetation_.empty()) return 0.f;
-  const int c = std::clamp(nearest_cell(col), 0, cols_ - 1), r = std::clamp(nearest_cell(row), 0, rows_ - 1);
-  return vegetation_[index(c, r)];
+  return vegetation_[nearest_index(col, row)];
 }
 
 double TerrainField::metres_x(double row) const {

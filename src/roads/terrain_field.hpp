@@ -42,6 +42,10 @@ class TerrainField {
   std::size_t size() const { return std::size_t(cols_) * std::size_t(rows_); }
   bool inside(int col, int row) const { return col >= 0 && row >= 0 && col < cols_ && row < rows_; }
   std::size_t index(int col, int row) const { return std::size_t(row) * std::size_t(cols_) + std::size_t(col); }
+  /// Index of the cell nearest to a position, clamped to the grid.
+  std::size_t nearest_index(double col, double row) const {
+    return index(std::clamp(nearest_cell(col), 0, cols_ - 1), std::clamp(nearest_cell(row), 0, rows_ - 1));
+  }
 
   /// Ground or water surface height (m) at a cell: max(elevation, sea level); sea level on nodata.
   float surface(int col, int row) const { return surface_[index(col, row)]; }
@@ -53,8 +57,7 @@ class TerrainField {
   double ground_at(double col, double row) const;
   /// Water depth (m) at the nearest cell, the maximum within the road radius; 0 on land.
   float depth_at(double col, double row) const {
-    const int c = std::clamp(nearest_cell(col), 0, cols_ - 1), r = std::clamp(nearest_cell(row), 0, rows_ - 1);
-    return depth_[index(c, r)];
+    return depth_[nearest_index(col, row)];
   }
   /// Sets the vegetation / land-cover density layer (same grid as the DEM; NaN counts as 0).
   void set_vegetation(const Raster<float>& density);
@@ -72,8 +75,7 @@ class TerrainField {
   float extra_cost_at(Structure s, double col, double row) const {
     const auto& v = extra_[int(s)];
     if (v.empty()) return 0.f;
-    const int c = std::clamp(nearest_cell(col), 0, cols_ - 1), r = std::clamp(nearest_cell(row), 0, rows_ - 1);
-    return v[index(c, r)];
+    return v[nearest_index(col, row)];
   }
   bool water(int col, int row) const { return water_[index(col, row)] != 0; }
   bool has_bathymetry() const { return bathymetry_; }
