@@ -50,7 +50,8 @@ r = next(x for x in json.load(open(sys.argv[1]))["regions"] if x["region"] == sy
 print(int(r["settlements"]["total"]), json.dumps(r["held_out_weights"], separators=(",", ":")))
 PY
 )
-  sets=(--set dem="\"$DEMS/$f\"" --set sites.population="$total" --set sites.reference="\"$PLACES/$name.geojson\""
+  # The reference total is the people of the places themselves: all of it settled (urban_share 1).
+  sets=(--set dem="\"$DEMS/$f\"" --set sites.population="$total" --set sites.urban_share=1 --set sites.reference="\"$PLACES/$name.geojson\""
         --set density.weights="$weights")
   "$TP" --quiet run "$scen" -o "run_$name" --until sites "${sets[@]}" ${REALISM_SET:+--set "$REALISM_SET"}
 done
@@ -95,7 +96,8 @@ print(f"\nregions meeting each bar (of {n}): count within x1.5 {ok['count']}, la
       f"rank-size exponent within 0.25 {ok['q']}, held-out AUC >= 0.75 and above the best baseline {ok['auc']}")
 d = json.load(open("run_default/run.json"))["summary"]
 r = d["realism"]
-print(f"default run on the bundled DEM: {d['sites']['target_population']:.0f} people ({d['sites']['population_source']}); "
+print(f"default run on the bundled DEM: {d['sites']['target_population']:.0f} people ({d['sites']['population_source']}), "
+      f"{d['sites'].get('settled_population', 0):.0f} settled, sizes {d['sites'].get('sizes')} (exponent {d['sites'].get('sizes_exponent', 0):.2f}); "
       f"reference {r['total']['reference']:.0f}: ratio {r['total']['ratio']}; {r['count']['generated']} settlements of 1,000+ for "
       f"{r['count']['reference']}, largest {r['largest']['generated']:.0f} for {r['largest']['reference']:.0f}")
 print("fitted weights (all regions):", json.dumps(json.load(open("fitted.json"))["density"]["weights"]))

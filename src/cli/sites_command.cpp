@@ -84,8 +84,9 @@ class SitesCommand final : public Command {
       std::printf("total %9s %7d %7d %7zu\n", "", quota, placed, result.sites.size());
     }
     if (options.quotas == sites::SitesOptions::Quotas::rank_size)
-      std::printf("sites: %.0f people (%s), rank-size law down to %.0f\n", result.target_population,
-                  result.population_assumed ? "assumed: default people/km2 x buildable land" : "given", options.min_population);
+      std::printf("sites: %.0f people (%s), %.0f in settlements, rank-size exponent %.2f (%s)\n", result.target_population,
+                  result.population_assumed ? "assumed: default people/km2 x buildable land" : "given", result.settled_population,
+                  result.sizes_exponent, options.sizes == sites::SitesOptions::Sizes::catchment ? "from the catchments" : "zipf_exponent");
     if (result.count_limited)
       std::printf("sites: count held to the %lld settlements the land holds %g km apart (--spacing)\n", static_cast<long long>(result.room),
                   options.spacing_km);

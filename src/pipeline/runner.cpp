@@ -246,6 +246,10 @@ std::string format_summary(const json& manifest) {
     if (c.contains("population_source"))
       line("           %.0f people in the region, %s; largest %.0f\n", c["target_population"].get<double>(),
            c["population_source"].get<std::string>().c_str(), c["largest"].get<double>());
+    if (c.contains("settled_population"))
+      line("           %.0f of them in the settlements (sites.urban_share %g), split by a rank-size law of exponent %.2f (%s)\n",
+           c["settled_population"].get<double>(), c["urban_share"].get<double>(), c["sizes_exponent"].get<double>(),
+           c["sizes"] == "catchment" ? "read from the catchments" : "sites.zipf_exponent");
     if (c.value("count_limited_by_spacing", false))
       line("           count held to the %lld settlements the land holds at sites.spacing_km\n", c["room"].get<long long>());
     for (const auto& [k, v] : c["per_class"].items())

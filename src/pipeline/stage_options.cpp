@@ -155,6 +155,8 @@ sites::SitesOptions sites_options(const Scenario& scenario) {
   o.quotas = s["quotas"] == "belhadj2007" ? sites::SitesOptions::Quotas::belhadj2007 : sites::SitesOptions::Quotas::rank_size;
   o.population = s["population"].get<double>();
   o.people_per_km2 = s["people_per_km2"].get<double>();
+  o.urban_share = s["urban_share"].get<double>();
+  o.sizes = s["sizes"] == "rank_size" ? sites::SitesOptions::Sizes::rank_size : sites::SitesOptions::Sizes::catchment;
   o.zipf_exponent = s["zipf_exponent"].get<double>();
   o.min_population = s["min_population"].get<double>();
   o.spacing_km = s["spacing_km"].get<double>();

@@ -212,6 +212,10 @@ void sites_run(RunState& s, Progress& progress, const Log& log) {
     summary["quotas"] = "rank_size";
     summary["target_population"] = r.target_population;
     summary["population_source"] = source;
+    summary["urban_share"] = options.urban_share;
+    summary["settled_population"] = r.settled_population;  // urban_share x target_population, in the settlements
+    summary["sizes"] = options.sizes == sites::SitesOptions::Sizes::catchment ? "catchment" : "rank_size";
+    summary["sizes_exponent"] = r.sizes_exponent;  // q of the law that split the settled people
     summary["room"] = r.room;  // settlements the land holds at sites.spacing_km; 0: no limit
     summary["count_limited_by_spacing"] = r.count_limited;
     summary["largest"] = r.sites.empty() ? 0 : std::max_element(r.sites.begin(), r.sites.end(), [](const auto& a, const auto& b) {

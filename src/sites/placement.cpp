@@ -160,14 +160,40 @@ SitesResult place_sites(const Raster<float>& density, const Raster<std::uint8_t>
     result.population_assumed = !(options.population > 0);
     result.land_area_km2 = land_km2;
     result.target_population = result.population_assumed ? std::round(options.people_per_km2 * land_km2) : options.population;
-    const auto law = [&](std::size_t max_count) {
-      return rank_size_populations(result.target_population, options.zipf_exponent, options.min_population, max_count);
-    };
+    if (!(std::isfinite(options.urban_share) && options.urban_share > 0 && options.urban_share <= 1))
+      throw bad_input("sites: urban_share must lie in (0, 1]");
+    result.settled_population = std::round(options.urban_share * result.target_population);
+    result.sizes_exponent = options.zipf_exponent;
     const std::size_t room = settleable_count(land_km2, options);
-    const auto sizes = law(room);
-    if (room != std::numeric_limits<std::size_t>::max()) {
-      result.room = std::int64_t(room);
-      result.count_limited = sizes.size() == room && law(room + 1).size() > room;
+    std::vector<std::int64_t> sizes;
+    if (options.sizes == SitesOptions::Sizes::catchment) {
+      // The central places of all the region's people by the law, their catchments on the
+      // density model, and the law's exponent read from those of min_population or more.
+      SitesOptions pilot = options;
+      pilot.sizes = SitesOptions::Sizes::rank_size;
+      pilot.urban_share = 1;
+      pilot.influence_factor = 0;
+      pilot.population = result.target_population;
+      pilot.land_area_km2 = land_km2;
+      const SitesResult central = place_sites(density, buildable, pilot, progress);
+      result.room = central.room;
+      result.count_limited = central.count_limited;
+      std::vector<double> settled;
+      for (double p : catchment_people(density, buildable, central.sites, result.settled_population))
+        if (p >= options.min_population) settled.push_back(p);
+      const double q = rank_size_exponent(settled);
+      if (std::isfinite(q)) result.sizes_exponent = q;  // fewer than 3 catchments that large: zipf_exponent
+      sizes = rank_size_split(result.settled_population, result.sizes_exponent, central.sites.size());
+      sizes.erase(std::find(sizes.begin(), sizes.end(), 0), sizes.end());  // more places than settled people
+    } else {
+      const auto law = [&](std::size_t max_count) {
+        return rank_size_populations(result.settled_population, options.zipf_exponent, options.min_population, max_count);
+      };
+      sizes = law(room);
+      if (room != std::numeric_limits<std::size_t>::max()) {
+        result.room = std::int64_t(room);
+        result.count_limited = sizes.size() == room && law(room + 1).size() > room;
+      }
     }
     table = rank_size_quotas(cell_size, sizes, options);
     if (options.refill_rounds < 0 || options.candidates < 0) throw bad_input("sites: candidates and refill rounds must be >= 0");

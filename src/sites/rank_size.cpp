@@ -27,8 +27,17 @@ std::vector<std::int64_t> rank_size_populations(double total, double q, double m
     count = n;
     if (count > 50000000) throw bad_input("sites: the rank-size law gives more than 5x10^7 settlements; raise min_population");
   }
+  return rank_size_split(total, q, count);
+}
+
+std::vector<std::int64_t> rank_size_split(double total, double q, std::size_t count) {
+  if (!(std::isfinite(total) && total >= 0)) throw bad_input("sites: population must be a number of people >= 0");
+  if (!(std::isfinite(q) && q >= 0)) throw bad_input("sites: a rank-size exponent must be >= 0");
+  total = std::round(total);
   std::vector<std::int64_t> sizes(count);
   if (count == 0) return sizes;
+  double harmonic = 0;  // H_N(q), summed as rank_size_populations sums it
+  for (std::size_t k = 1; k <= count; ++k) harmonic += std::pow(double(k), -q);
   // Largest remainders: floors first, then one more person to the largest fractional parts.
   std::vector<double> exact(count);
   std::int64_t assigned = 0;

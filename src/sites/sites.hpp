@@ -36,6 +36,18 @@ struct SitesOptions {
   /// Default density of people when `population` is 0: 60 per km² of land, the world's average
   /// (World Bank, World Development Indicators EN.POP.DNST, 2020).
   double people_per_km2 = 60;
+  /// Share of the region's people living in the settlements (of min_population or more); the
+  /// rest lives in hamlets and scattered houses. 0.55: the urban share of the world's population
+  /// (UN DESA, World Urbanization Prospects 2018); the EU's cities, towns and suburbs hold 0.75
+  /// (Eurostat, degree of urbanisation, 2021). 1: every person in a settlement.
+  double urban_share = 0.55;
+  /// How the settled people are split. rank_size: P_k = P_1 k^-zipf_exponent down to
+  /// min_population. catchment: the exponent is read from the land: a first placement by the
+  /// rank_size law (all the region's people, zipf_exponent) gives the central places, the
+  /// people spread over the land by the density model go to the nearest centre (catchments),
+  /// and q is the rank-size exponent of the catchments of min_population or more; the settled
+  /// people are then split over as many settlements by P_k = P_1 k^-q, and placed again.
+  enum class Sizes { rank_size, catchment } sizes = Sizes::catchment;
   /// Land area of the region, km²; 0: the area of the buildable cells.
   double land_area_km2 = 0;
   /// q of the rank-size law P_k = P_1 k^-q (Zipf's law: q = 1, Gabaix 1999; Soo 2005 measures
@@ -116,7 +128,9 @@ struct SitesResult {
   double dr_m = 0;                  ///< class step used, metres
   int candidates = 0;               ///< M, candidates drawn
   std::uint64_t seed = 1;           ///< seed used
-  double target_population = 0;     ///< rank_size: the region's people the law was fitted to
+  double target_population = 0;     ///< rank_size: the region's people
+  double settled_population = 0;    ///< rank_size: urban_share x target_population, split over the settlements
+  double sizes_exponent = 0;        ///< rank_size: q of the law that split them (zipf_exponent, or read from the catchments)
   double land_area_km2 = 0;         ///< rank_size: the land area used for the default population
   bool population_assumed = false;  ///< rank_size: target from people_per_km2 (no census figure given)
   std::int64_t room = 0;            ///< rank_size: settlements the land holds at spacing_km (settleable_count); 0: no limit
@@ -141,6 +155,17 @@ QuotaTable compute_quotas(double cell_size_m, const SitesOptions& options);
 /// remainders: the sizes add up to round(total) exactly. Largest first.
 std::vector<std::int64_t> rank_size_populations(double total, double zipf_exponent, double min_population,
                                                 std::size_t max_count = std::numeric_limits<std::size_t>::max());
+
+/// `total` people split over `count` ranks by P_k = total k^-q / H_count(q) (q >= 0), rounded to
+/// whole people by largest remainders (they add up to round(total)). Largest first.
+std::vector<std::int64_t> rank_size_split(double total, double q, std::size_t count);
+
+/// People of each site's catchment: `total` people spread over the habitable cells (buildable 1,
+/// density finite) in proportion to density x cell area, each cell's people going to the site
+/// whose centre is nearest (ties: the lower index). The result adds up to `total` (up to
+/// rounding) when a site and a habitable cell exist.
+std::vector<double> catchment_people(const Raster<float>& density, const Raster<std::uint8_t>& buildable, const std::vector<Site>& sites,
+                                     double total);
 
 /// The most settlements of min_population people `land_area_km2` holds at options.spacing_km
 /// apart on a hexagonal lattice (at least 1; unlimited when spacing_km is 0).

@@ -14,6 +14,16 @@
 using namespace terrapolis;
 using namespace terrapolis::sites;
 
+namespace {
+/// The rank-size law with its fixed exponent, every person in a settlement.
+SitesOptions fixed_law() {
+  SitesOptions o;
+  o.sizes = SitesOptions::Sizes::rank_size;
+  o.urban_share = 1;
+  return o;
+}
+}  // namespace
+
 // 3000 people, q = 1, at least 1000 each: N = 2 gives 3000 x (1/2) / (1 + 1/2) = 1000 >= 1000;
 // N = 3 gives 3000 x (1/3) / (11/6) = 545 < 1000. So two settlements, 2000 and 1000.
 TEST(RankSize, HandComputedSplit) {
@@ -92,7 +102,7 @@ TEST(RankSize, ClassesCoverTheRadii) {
 // them (the law alone: no spacing limit, which would hold 400 km2 to 9).
 TEST(RankSize, CountsFollowThePopulationNotTheGrid) {
   SilentProgress progress;
-  SitesOptions o;
+  SitesOptions o = fixed_law();
   o.population = 200000;
   o.spacing_km = 0;
   const auto coarse = fixtures::flat_scenario(200, 200, 100.0), fine = fixtures::flat_scenario(400, 400, 50.0);
@@ -125,7 +135,7 @@ TEST(RankSize, CountsFollowThePopulationNotTheGrid) {
 // count, 8 (24000 / (8 H_8) = 1104 >= 1000 > 24000 / (9 H_9) = 943), is below the limit and stays.
 TEST(RankSize, SpacingLimitsTheCountOnCrowdedLand) {
   SilentProgress progress;
-  SitesOptions o;
+  SitesOptions o = fixed_law();
   const auto coarse = fixtures::flat_scenario(200, 200, 100.0), fine = fixtures::flat_scenario(400, 400, 50.0);
   for (double people : {200000.0, 2000000.0})
     for (const auto* g : {&coarse, &fine}) {
@@ -184,7 +194,7 @@ TEST(Suburbs, StrongestPullAmongLargerSettlementsInReach) {
 // parent; with influence_factor 0 only Algorithm 15's partial inclusions remain, far fewer.
 TEST(Suburbs, PlacementLinksSmallerSettlements) {
   SilentProgress progress;
-  SitesOptions o;
+  SitesOptions o = fixed_law();
   o.population = 200000;
   o.spacing_km = 0;  // the law's 45 settlements on 400 km2
   const auto flat = fixtures::flat_scenario(200, 200, 100.0);

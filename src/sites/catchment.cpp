@@ -1,0 +1,72 @@
+// Catchments of the settlements: the people of the land nearest to each centre (Voronoi over the density).
+// SPDX-License-Identifier: MIT
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+#include "core/error.hpp"
+#include "sites/sites.hpp"
+
+namespace terrapolis::sites {
+
+std::vector<double> catchment_people(const Raster<float>& density, const Raster<std::uint8_t>& buildable, const std::vector<Site>& sites,
+                                     double total) {
+  const int cols = density.cols(), rows = density.rows();
+  if (buildable.cols() != cols || buildable.rows() != rows)
+    throw bad_input("sites: the buildable mask and the density model are not on the same grid");
+  std::vector<double> people(sites.size(), 0.0);
+  if (sites.empty()) return people;
+  const GridDistance distance(density.georef(), cols, rows);
+  // Sites by row: a cell's search runs outwards from its own row and stops once the
+  // north-south distance alone exceeds the nearest centre found.
+  std::vector<int> by_row(sites.size());
+  std::iota(by_row.begin(), by_row.end(), 0);
+  std::stable_sort(by_row.begin(), by_row.end(), [&](int a, int b) { return sites[std::size_t(a)].row < sites[std::size_t(b)].row; });
+  std::vector<int> owner(density.size(), -1);
+  tbb::parallel_for(tbb::blocked_range<int>(0, rows), [&](const tbb::blocked_range<int>& range) {
+    for (int r = range.begin(); r < range.end(); ++r) {
+      const auto first = std::lower_bound(by_row.begin(), by_row.end(), r, [&](int k, int row) { return sites[std::size_t(k)].row < row; });
+      const std::ptrdiff_t start = first - by_row.begin();
+      const double y = distance.northing(r);
+      for (int c = 0; c < cols; ++c) {
+        const std::size_t i = std::size_t(r) * std::size_t(cols) + std::size_t(c);
+        if (buildable[i] != 1 || buildable.is_nodata(i) || !std::isfinite(density[i])) continue;
+        double best = std::numeric_limits<double>::infinity();
+        int nearest = -1;
+        const auto consider = [&](std::ptrdiff_t k) {  // false once every further site in this direction is farther
+          const Site& s = sites[std::size_t(by_row[std::size_t(k)])];
+          if (std::abs(distance.northing(s.row) - y) > best) return false;
+          const double d = distance(c, r, s.col, s.row);
+          const int id = by_row[std::size_t(k)];
+          if (d < best || (d == best && id < nearest)) best = d, nearest = id;
+          return true;
+        };
+        for (std::ptrdiff_t k = start; k < std::ptrdiff_t(by_row.size()) && consider(k); ++k) {
+        }
+        for (std::ptrdiff_t k = start - 1; k >= 0 && consider(k); --k) {
+        }
+        owner[i] = nearest;
+      }
+    }
+  });
+  // Sequential sums in cell order: the same figures whatever the number of threads.
+  const CellMetrics& metrics = distance.metrics();
+  double mass = 0;
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c) {
+      const std::size_t i = std::size_t(r) * std::size_t(cols) + std::size_t(c);
+      if (owner[i] < 0) continue;
+      const double w = double(density[i]) * metrics.area_m2[std::size_t(r)];
+      people[std::size_t(owner[i])] += w;
+      mass += w;
+    }
+  if (mass > 0)
+    for (double& p : people) p *= total / mass;
+  return people;
+}
+
+}  // namespace terrapolis::sites
