@@ -20,10 +20,16 @@ assert [t["stage"] for t in m["timings"]] == ["terrain", "hydro", "density", "si
 assert s["population_source"].startswith("assumed: 60 people/km2"), s
 land = m["summary"]["density"]["land_area_km2"]
 assert 1400 < land < 1700 and abs(s["target_population"] - round(60 * land)) <= 1, (land, s)
-assert s["population"] == s["target_population"], s  # every settlement of the law placed
+# The settled share (sites.urban_share) lives in the settlements, every one of them placed; sizes by
+# the law whose exponent the density's catchments give.
+assert s["sizes"] == "catchment" and s["settled_population"] == round(s["urban_share"] * s["target_population"]), s
+assert s["population"] == s["settled_population"], s
 assert 0 < s["suburbs"] < s["cities"], s  # villages in a town's influence area are its suburbs
 # Right in magnitude: the total within a factor 3 of the real places' sum (43,093).
 assert r["total"]["reference"] == 43093 and 1 / 3 < r["total"]["ratio"] < 3, r["total"]
+# A rural cape: the largest town within a factor 2 of the real largest (5,552), the exponent within 0.25.
+assert r["largest"]["reference"] == 5552 and 0.5 < r["largest"]["generated"] / 5552 < 2, r["largest"]
+assert abs(r["rank_size_exponent"]["generated"] - r["rank_size_exponent"]["reference"]) <= 0.25, r["rank_size_exponent"]
 assert r["places"] == 15 and 0 <= r["skill"]["auc"] <= 1 and len(r["top10"]["places"]) == 10, r
 PY
 "$TP" --quiet run -o thesis_run --until sites --set density.preset='"belhadj2007"' --set sites.quotas='"belhadj2007"' \
