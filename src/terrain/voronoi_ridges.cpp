@@ -23,6 +23,9 @@ std::vector<RidgeSegment> voronoi_ridges(const std::vector<Point2>& points, cons
   input.reserve(points.size());
   for (std::size_t i = 0; i < points.size(); ++i) input.emplace_back(K::Point_2(points[i].x, points[i].y), int(i));
   Delaunay dt(input.begin(), input.end());  // spatial sort: the triangulation does not depend on input order
+  // Fewer than three nodes, or all on one line (a tiny region may hold a single river): no triangle,
+  // hence no Voronoi vertex. CGAL's faces are then 1-dimensional and have no circumcentre.
+  if (dt.dimension() < 2) return {};
   std::set<std::pair<int, int>> rivers;
   for (auto [a, b] : river_edges) rivers.emplace(std::min(a, b), std::max(a, b));
 

@@ -81,6 +81,23 @@ TEST(RiverGrammar, SameSeedSameTerrain) {
   EXPECT_EQ(ta.nodes.size(), tb.nodes.size());
 }
 
+TEST(RiverGrammar, VoronoiRidgesOfDegenerateNodeSets) {
+  const auto lambda = [](Point2) { return 0.1; };
+  // Two nodes (a region holding one river reach, as `generate --method coast --size 193x161
+  // --cell 30 --seed 11` made) and three collinear ones: no triangle, so no ridge (it crashed).
+  EXPECT_TRUE(voronoi_ridges({{0, 0}, {100, 0}}, {0, 5}, {{1, 0}}, lambda).empty());
+  EXPECT_TRUE(voronoi_ridges({{0, 0}, {100, 0}, {200, 0}}, {0, 5, 9}, {{1, 0}, {2, 1}}, lambda).empty());
+  EXPECT_TRUE(voronoi_ridges({}, {}, {}, lambda).empty());
+  // A square of four nodes with one river edge: two triangles share one inner Delaunay edge (the
+  // diagonal), which is not a river edge, so one ridge joins the two circumcentres. Both are the
+  // square's centre here (cocircular points), at q_z = max(p_z) + λ d with d = 50√2.
+  const auto square_ridges = voronoi_ridges({{0, 0}, {100, 0}, {100, 100}, {0, 100}}, {0, 1, 2, 3}, {{1, 0}}, lambda);
+  ASSERT_EQ(square_ridges.size(), 1u);
+  EXPECT_NEAR(square_ridges[0].a.x, 50, 1e-9);
+  EXPECT_NEAR(square_ridges[0].a.y, 50, 1e-9);
+  EXPECT_NEAR(std::max(square_ridges[0].za, square_ridges[0].zb), 3 + 0.1 * 50 * std::sqrt(2.0), 1e-9);  // node 3 is in one triangle
+}
+
 TEST(RiverGrammar, NetworkInvariants) {
   CoastParams p;
   p.seed = 5;
