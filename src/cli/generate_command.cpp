@@ -179,6 +179,7 @@ class GenerateCommand final : public Command {
   void default_local_grid() {
     grid_.crs = "EPSG:3035";
     if (!grid_.origin.empty()) return;
+    grid_.default_crs = true;
     const auto x = grid_.size.find_first_of("xX");
     if (x == std::string::npos) return;  // make() reports the bad size
     double cols = 0, rows = 0;

@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 
 #include <array>
+#include <cstdio>
 #include <limits>
 #include <string>
 #include <utility>
@@ -12,6 +13,7 @@
 #include "cli/command.hpp"
 #include "core/error.hpp"
 #include "io/crs.hpp"
+#include "io/raster_io.hpp"
 #include "terrain/fill.hpp"
 
 namespace terrapolis::cli {
@@ -81,6 +83,7 @@ struct TerrainOptions {
 struct GridOptions {
   std::string size, crs, origin;
   double cell_m = 0;
+  bool default_crs = false;  ///< crs and origin were chosen by the command, not given: errors name --size and --cell only
 
   void add(CLI::App& app, bool required) {
     auto* s = app.add_option("--size", size, "Grid size in cells, WxH (e.g. 513x513)");
@@ -115,6 +118,16 @@ struct GridOptions {
     const auto o = origin.empty() ? std::array<double, 2>{0, 0} : parse_pair("--origin", origin);
     const double unit = georef.crs.linear_unit_m > 0 ? georef.crs.linear_unit_m : 1.0;
     georef.transform = {o[0], cell_m / unit, 0, o[1], 0, -cell_m / unit};
+    RasterHeader header;
+    header.cols = cols;
+    header.rows = rows;
+    header.georef = georef;
+    char cell_text[32];
+    std::snprintf(cell_text, sizeof(cell_text), "%g", cell_m);
+    std::string what = "--size " + size + " --cell " + cell_text;
+    if (!crs.empty() && !default_crs) what += " --crs " + crs;
+    if (!origin.empty() && !default_crs) what += " --origin " + origin;
+    check_grid_georeferencing(what, header);
     return Raster<float>(cols, rows, georef, std::numeric_limits<float>::quiet_NaN());
   }
 };

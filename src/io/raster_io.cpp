@@ -248,6 +248,11 @@ std::size_t to_metres(const std::string& path, GDALRasterBand* band, const Raste
 
 }  // namespace
 
+void check_grid_georeferencing(const std::string& what, const RasterHeader& header) {
+  check_georeferencing(what, header);
+  check_lonlat_domain(what, header);
+}
+
 void init_gdal() {
   static std::once_flag once;  // GDAL's driver registry is process-wide by design
   std::call_once(once, [] {

@@ -30,6 +30,10 @@ struct RasterHeader {
   double scale = 1.0, offset = 0.0;
 };
 
+/// The georeferencing checks every raster read applies (finite, non-degenerate cells; an extent on
+/// the globe; cells that transform to WGS 84), for a grid built in code: throws bad_input naming `what`.
+void check_grid_georeferencing(const std::string& what, const RasterHeader& header);
+
 /// Reads the header of `path`, applying the same checks as read_dem except for reading pixels.
 RasterHeader read_header(const std::string& path, const ReadOptions& options = {});
 

@@ -9,6 +9,7 @@
 #include <numbers>
 
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 #include "terrain/generators.hpp"
 #include "terrain/subdivision.hpp"
 
@@ -217,6 +218,7 @@ void place_mouths(RiverGraph& graph, const std::vector<std::vector<Point2>>& coa
   const double step = params.edge_m / 2, disc = 4 * params.edge_m;
   for (const auto& ring : coast)
     for (std::size_t i = 0, n = ring.size(); i < n; ++i) {
+      stop_if_interrupted();  // no progress bar here: a long coast still stops on Ctrl-C
       const Point2 a = ring[i], b = ring[(i + 1) % n];
       const int pieces = std::max(1, int(std::ceil(norm(b - a) / step)));
       for (int k = 0; k < pieces; ++k) {
@@ -267,6 +269,7 @@ void grow(RiverGraph& graph, std::vector<Point2> directions, const CoastParams& 
   std::vector<int> priority;
   std::size_t steps = 0;
   while (!open.empty()) {
+    stop_if_interrupted();  // each step scans every open candidate: 256 steps can take long
     z.clear();
     priority.clear();
     for (const Candidate& c : open) {

@@ -32,4 +32,14 @@ set +e
 [ $rc -eq 2 ] && grep -q "geographic" "$T/err" && [ ! -e "$T/bad.tif" ] || { echo "geographic crs: rc=$rc"; cat "$T/err"; exit 1; }
 "$BIN" generate "$T/bad.tif" --size 10x10 --cell 30 --hurst 3 2>"$T/err"; rc=$?
 [ $rc -ne 0 ] && [ ! -e "$T/bad.tif" ] || { echo "bad hurst: rc=$rc"; exit 1; }
+# A grid larger than the Earth, or outside its CRS's domain, is refused like a raster read with that georeferencing.
+for method in dmmc coast flow; do
+  "$BIN" generate "$T/bad.tif" --method $method --size 65x65 --cell 1e12 2>"$T/err"; rc=$?
+  [ $rc -eq 2 ] && grep -q "larger than the Earth" "$T/err" && ! grep -q -- "--origin" "$T/err" && [ ! -e "$T/bad.tif" ] || { echo "$method huge cell: rc=$rc"; cat "$T/err"; exit 1; }
+done
+"$BIN" generate "$T/bad.tif" --size 65x65 --cell 30 --crs EPSG:32632 --origin 9e7,0 2>"$T/err"; rc=$?
+[ $rc -eq 2 ] && grep -q -- "--origin 9e7,0.*cannot be transformed" "$T/err" && [ ! -e "$T/bad.tif" ] || { echo "origin off the CRS: rc=$rc"; cat "$T/err"; exit 1; }
+# A region that holds a single river reach (no Voronoi vertex) crashed the coast method.
+"$BIN" generate "$T/one_reach.tif" --method coast --seed 11 --size 193x161 --cell 30 2>"$T/err" >/dev/null || { echo "coast, one reach: rc=$?"; cat "$T/err"; exit 1; }
+[ -s "$T/one_reach.tif" ] || { echo "coast, one reach: no output"; exit 1; }
 exit 0
