@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Realism of the settlements against real places (GeoNames, CC BY 4.0) on every shared region with
-# places: the density's skill after calibration on the other regions (leave one region out), the
+# places: the density's skill after calibration on the other regions (leave one region out, with the
+# options the schema's default weights were fitted with: bench/realism_regions.sh), the
 # counts, largest and rank-size exponent with sites.population set to the reference total (the
 # default: settlements at most land / hexagon(sites.spacing_km)), the ten largest real places near a generated top-10 settlement
 # against random land points, and the default run's total on the bundled DEM. Prints one table
@@ -21,29 +22,17 @@ else
 fi
 cd "$OUT"
 
-# The regions with 10 or more places on their land; NZ's sea is nodata (NaN).
-regions=(N47E009.hgt N57E011.hgt demcompare_reduced_gironde_topobathy.tif osmtransform_heidelberg_mannheim_srtm3.tif
-         pyflwdir_rhine_elv0.tif spDataLarge_nz_elev.tif terra_elev_luxembourg.tif gebco2022_15s_la_palma.asc
-         gebco2022_15s_north_corsica_capcorse.asc gebco2022_15s_tenerife_east.asc)
-echo '{}' > plain.json
-echo '{"water": {"nodata_is_sea": true}}' > sea_nodata.json
-dems=() places=() scenarios=()
-for f in "${regions[@]}"; do
-  dems+=("$DEMS/$f")
-  places+=("$PLACES/${f%.*}.geojson")
-  [[ $f == spDataLarge_nz_elev.tif ]] && scenarios+=(--scenario sea_nodata.json) || scenarios+=(--scenario plain.json)
-done
+source "$SRC/bench/realism_regions.sh"
 
 echo "== calibration, leave one region out ($(date -u +%F))"
 /usr/bin/time -f "calibrate: %e s, %M kB" "$TP" --quiet calibrate "${dems[@]}" --settlements "${places[@]}" "${scenarios[@]}" \
-  --report calibration.json --fragment fitted.json
+  "${default_fit[@]}" --report calibration.json --fragment fitted.json
 
 echo "== runs with sites.population = the reference total, held-out weights"
 for k in "${!regions[@]}"; do
   f=${regions[$k]}
   name=${f%.*}
-  scen=plain.json
-  [[ $f == spDataLarge_nz_elev.tif ]] && scen=sea_nodata.json
+  scen=$(region_scenario "$f")
   read -r total weights < <(/usr/bin/python3 - calibration.json "$name" <<'PY'
 import json, sys
 r = next(x for x in json.load(open(sys.argv[1]))["regions"] if x["region"] == sys.argv[2])

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 #include "core/geodesy.hpp"
@@ -87,10 +88,12 @@ json realism_figures(RunState& s, density::DensityOptions options, const sites::
   for (std::size_t k = 0; k < 3; ++k)
     baselines[density::kBaselineNames[k]] = {{"auc", rounded(skill.baseline_auc[k], 1e-3)}, {"weighted_auc", rounded(skill.baseline_weighted_auc[k], 1e-3)}};
   out["skill"] = {{"auc", rounded(skill.auc, 1e-3)}, {"weighted_auc", rounded(skill.weighted_auc, 1e-3)}, {"baselines", baselines}};
-  if (skill.auc < skill.best_baseline())
-    warnings.push_back("the density model ranks the reference places worse (AUC " + std::to_string(skill.auc).substr(0, 5) +
-                       ") than a single-factor baseline (AUC " + std::to_string(skill.best_baseline()).substr(0, 5) +
-                       "); calibrate it (terrapolis calibrate)");
+  if (skill.auc < skill.best_baseline()) {
+    // Rounded as in the summary's figures (truncating would print 0.654 beside a summary's 0.655).
+    char aucs[64];
+    std::snprintf(aucs, sizeof aucs, "(AUC %.3f) than a single-factor baseline (AUC %.3f)", skill.auc, skill.best_baseline());
+    warnings.push_back("the density model ranks the reference places worse " + std::string(aucs) + "; calibrate it (terrapolis calibrate)");
+  }
 
   // Location: the ten largest real places against the ten largest generated settlements.
   const Crs& crs = s.dem.georef().crs;
