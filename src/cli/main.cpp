@@ -75,8 +75,13 @@ int terrapolis::cli::run_command_line(int argc, char** argv) {
   try {
     app.parse(args);
   } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : 2;
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    // One line, as for every other bad input (CLI11's own format adds a second line).
+    std::string command = "terrapolis";
+    for (auto& [sub, c] : subs)
+      if (sub->parsed()) command += " " + sub->get_name();
+    std::fprintf(stderr, "terrapolis: error: %s (%s --help lists the options)\n", e.what(), command.c_str());
+    return 2;
   }
 
   std::optional<tbb::global_control> limit;
