@@ -13,6 +13,7 @@
 
 #include "cli/command.hpp"
 #include "cli/commands_list.hpp"
+#include "cli/dem_input.hpp"
 #include "cli/schema_options.hpp"
 #include "core/error.hpp"
 #include "density/calibration.hpp"
@@ -107,6 +108,7 @@ class CalibrateCommand final : public Command {
 
   void setup(CLI::App& app) override {
     file_kind(app.add_option("DEM", dems_, "DEM(s) of the region(s), any GDAL raster")->required(), FileKind::raster_in);
+    dem_.add_read_options(app, "of every DEM");
     file_kind(app.add_option("--settlements", places_, "Real places of each DEM, in the same order: GeoJSON/GPKG points or CSV (lon,lat) with a population field")
         ->required(), FileKind::file_in);
     file_kind(app.add_option("--scenario", scenarios_, "Scenario whose water, hydro and density options are used: one for every DEM, or one per DEM in order (default: the defaults)"), FileKind::file_in);
@@ -200,7 +202,7 @@ class CalibrateCommand final : public Command {
  private:
   Region load_region(const std::string& dem_path, const std::string& places_path, const pipeline::Scenario& scenario, double min_population,
                      Context& context) {
-    const Dem dem = read_dem(dem_path);
+    const Dem dem = dem_.read(dem_path);
     hydro::HydroResult hydro = hydro::run_hydro(dem, pipeline::hydro_options(scenario), context.progress);
     density::DensityOptions options = pipeline::density_options(scenario);
     pipeline::read_density_files(scenario, dem, scenario.path("/water/water_mask"), options);
@@ -284,6 +286,7 @@ class CalibrateCommand final : public Command {
   }
 
   std::vector<std::string> dems_, places_, scenarios_, terms_;
+  DemInput dem_;  // --band and --assume-crs of the DEMs
   std::vector<std::size_t> fitted_;
   std::string fragment_, report_;
   int folds_ = 5;

@@ -10,6 +10,8 @@ namespace CLI { class App; }
 
 namespace terrapolis::cli {
 
+/// How a command reads its DEM(s): every command that reads one takes --band and --assume-crs
+/// and reads through read() or header(), so the georeferencing checks of read_dem apply.
 struct DemInput {
   std::string path;
   int band = 0;
@@ -17,8 +19,15 @@ struct DemInput {
 
   /// Declares the positional DEM argument and the --band / --assume-crs options.
   void add_to(CLI::App& app, const std::string& name = "DEM");
-  ReadOptions options() const;
-  Dem read() const { return read_dem(path, options()); }
+  /// Declares --band and --assume-crs only, for a command that declares its DEM argument(s) itself
+  /// (several DEMs, a DEM or a folder, a --like DEM); `of` says which file they apply to.
+  void add_read_options(CLI::App& app, const std::string& of = "");
+  /// True when --band or --assume-crs was given.
+  bool given() const { return band > 0 || !assume_crs.empty(); }
+  ReadOptions options() const { return read_options(band, assume_crs); }
+  Dem read() const { return read(path); }
+  Dem read(const std::string& file) const { return read_dem(file, options()); }
+  RasterHeader header(const std::string& file) const { return read_header(file, options()); }
 };
 
 }  // namespace terrapolis::cli

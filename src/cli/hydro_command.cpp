@@ -2,6 +2,7 @@
 // SPDX-License-Identifier: MIT
 #include <CLI/CLI.hpp>
 
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <functional>
@@ -68,17 +69,7 @@ class HydroCommand final : public Command {
     const std::string fill = h["fill"], flow = h["flow"], hydrometry = h["hydrometry"];
     o.unit = units_ == "cells" ? AccumulationUnit::cells : AccumulationUnit::area_m2;
 
-    const std::string names[6] = {"filled.tif", "flowdir.tif", "accumulation.tif", "hydrometry.tif", "streams.geojson", "basins.tif"};
-    bool wanted[6] = {false, false, false, false, false, false};
-    for (std::size_t start = 0; start <= outputs_.size();) {
-      const std::size_t comma = std::min(outputs_.find(',', start), outputs_.size());
-      const std::string item = outputs_.substr(start, comma - start);
-      bool known = false;
-      for (int i = 0; i < 6; ++i)
-        if (item + (i == 4 ? ".geojson" : ".tif") == names[i]) wanted[i] = known = true;
-      if (!known) throw bad_input("--outputs: unknown output '" + item + "'");
-      start = comma + 1;
-    }
+    const std::array<bool, 6> wanted = wanted_outputs();
     o.with_hydrometry = wanted[3];
     o.with_streams = wanted[4];
     if (classify && !wanted[4]) throw bad_input("--classify: needs the streams output (--outputs ... ,streams)");
@@ -110,15 +101,7 @@ class HydroCommand final : public Command {
     const pipeline::TileSettings tiles = schema_.settings([&] { return pipeline::tile_settings(scenario); });
     if (tiles.tiled(dem_.path)) {
       // The tile engine: fill, D8 and accumulation, tile by tile (docs/scale.md).
-      if (o.fill != FillMethod::priority_flood || o.flow != FlowMethod::d8 || !weights_.empty())
-        throw bad_input("tiled hydro (--tile-size, --memory-limit, a folder of tiles): only --fill priority-flood, --flow d8, no --weights");
-      // The default outputs on tiles: all but the hydrometry, and the streams when the accumulation is an area.
-      const bool explicit_outputs = outputs_ != kDefaultOutputs;
-      if (explicit_outputs && wanted[3])
-        throw bad_input("--outputs: the hydrometry is not computed on tiles yet; ask for filled,flowdir,accumulation,streams,basins");
-      if (explicit_outputs && wanted[4] && o.unit == AccumulationUnit::cells)
-        throw bad_input("--outputs: streams on tiles need --area-units m2 or km2");
-      if (classify) throw bad_input("--classify: river types are not computed on tiles yet");
+      check_tiled(o, wanted, classify);
       TiledHydroRequest q;
       q.dem_path = dem_.path;
       q.out_dir = dir.string();
@@ -165,7 +148,7 @@ class HydroCommand final : public Command {
       for (std::size_t i = 0; i < acc.size(); ++i) acc[i] = float(result.accumulation[i] * scale);
       result.accumulation = Raster<double>();  // release before writing
     }
-    auto path = [&](int i) { return (dir / names[i]).string(); };
+    auto path = [&](int i) { return (dir / kNames[std::size_t(i)]).string(); };
     std::vector<std::function<void()>> writes;
     if (wanted[0])
       writes.push_back([&, p = path(0)] {
@@ -185,6 +168,37 @@ class HydroCommand final : public Command {
   }
 
  private:
+  static constexpr std::array<const char*, 6> kNames = {"filled.tif", "flowdir.tif", "accumulation.tif", "hydrometry.tif", "streams.geojson",
+                                                        "basins.tif"};
+
+  /// The outputs --outputs names, in the order of kNames.
+  std::array<bool, 6> wanted_outputs() const {
+    std::array<bool, 6> wanted{};
+    for (std::size_t start = 0; start <= outputs_.size();) {
+      const std::size_t comma = std::min(outputs_.find(',', start), outputs_.size());
+      const std::string item = outputs_.substr(start, comma - start);
+      bool known = false;
+      for (std::size_t i = 0; i < kNames.size(); ++i)
+        if (item + (i == 4 ? ".geojson" : ".tif") == kNames[i]) wanted[i] = known = true;
+      if (!known) throw bad_input("--outputs: unknown output '" + item + "'");
+      start = comma + 1;
+    }
+    return wanted;
+  }
+
+  /// What the tile engine does not compute (yet), refused by name.
+  void check_tiled(const HydroOptions& o, const std::array<bool, 6>& wanted, bool classify) const {
+    if (o.fill != FillMethod::priority_flood || o.flow != FlowMethod::d8 || !weights_.empty())
+      throw bad_input("tiled hydro (--tile-size, --memory-limit, a folder of tiles): only --fill priority-flood, --flow d8, no --weights");
+    // The default outputs on tiles: all but the hydrometry, and the streams when the accumulation is an area.
+    const bool explicit_outputs = outputs_ != kDefaultOutputs;
+    if (explicit_outputs && wanted[3])
+      throw bad_input("--outputs: the hydrometry is not computed on tiles yet; ask for filled,flowdir,accumulation,streams,basins");
+    if (explicit_outputs && wanted[4] && o.unit == AccumulationUnit::cells)
+      throw bad_input("--outputs: streams on tiles need --area-units m2 or km2");
+    if (classify) throw bad_input("--classify: river types are not computed on tiles yet");
+  }
+
   DemInput dem_;
   std::string out_dir_;
   static constexpr const char* kDefaultOutputs = "filled,flowdir,accumulation,hydrometry,streams";

@@ -10,6 +10,7 @@
 
 #include "cli/command.hpp"
 #include "cli/commands_list.hpp"
+#include "cli/dem_input.hpp"
 #include "cli/terrain_options.hpp"
 #include "cli/schema_options.hpp"
 #include "core/error.hpp"
@@ -64,6 +65,7 @@ class ReconstructCommand final : public Command {
     file_kind(app.add_option("SAMPLES", input_, "Heights: .csv (lon,lat,z), a vector file of points (.geojson, .gpkg) or a raster with nodata")->required(), FileKind::file_in);
     file_kind(app.add_option("OUT", output_, "Output GeoTIFF (float32, metres)")->required(), FileKind::raster_out);
     file_kind(app.add_option("--like", like_, "DEM whose grid and CRS the output takes"), FileKind::raster_in);
+    dem_.add_read_options(app, "of the --like DEM, or of a raster of SAMPLES without --like");
     grid_.add(app, false);
     app.add_option("--z-field", z_field_, "Vector samples: the field holding the height in metres")->capture_default_str();
     options_.add(app, true, 0.0);
@@ -79,12 +81,12 @@ class ReconstructCommand final : public Command {
     const bool points = ext == "csv" || ext == "txt" || ext == "geojson" || ext == "json" || ext == "gpkg" || ext == "shp";
     Raster<float> grid;
     if (!like_.empty()) {
-      const RasterHeader header = read_header(like_);
+      const RasterHeader header = dem_.header(like_);
       grid = Raster<float>(header.cols, header.rows, header.georef, std::numeric_limits<float>::quiet_NaN());
     } else if (grid_.given()) {
       grid = grid_.make();
     } else if (!points) {
-      grid = read_dem(input_);  // a sparse raster on its own grid
+      grid = dem_.read(input_);  // a sparse raster on its own grid
     } else {
       throw bad_input(input_ + ": points need a grid; give --like DEM or --size WxH --cell M --crs EPSG:n");
     }
@@ -146,6 +148,7 @@ class ReconstructCommand final : public Command {
     if (outside) context.log.warn("reconstruct: " + std::to_string(outside) + " samples outside the grid were ignored");
   }
 
+  DemInput dem_;  // --band and --assume-crs of the DEM the grid comes from
   std::string input_, output_, like_, z_field_ = "z";
   GridOptions grid_;
   TerrainOptions options_;

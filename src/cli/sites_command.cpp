@@ -10,6 +10,7 @@
 
 #include "cli/command.hpp"
 #include "cli/commands_list.hpp"
+#include "cli/dem_input.hpp"
 #include "cli/schema_options.hpp"
 #include "core/error.hpp"
 #include "density/density.hpp"
@@ -26,8 +27,7 @@ namespace {
 
 /// A DEM instead of a density folder: the density model with its defaults (hydrometry by
 /// Belhadj's method, the sea at 0 m as outlet and water), as `terrapolis density` writes it.
-pipeline::DensityFolder density_from_dem(const std::string& path, Progress& progress) {
-  const Dem dem = read_dem(path);
+pipeline::DensityFolder density_from_dem(const Dem& dem, Progress& progress) {
   const density::DensityOptions options;
   hydro::HydrometryOptions hydrometry;
   hydrometry.sea_level = options.sea_level_m;
@@ -45,6 +45,7 @@ class SitesCommand final : public Command {
                    "Folder holding density.tif (float, [0,1]) and buildable.tif (1 = buildable) on the DEM grid, or a DEM "
                    "(the density model is then computed with its defaults)")
         ->required(), FileKind::folder_in);
+    dem_.add_read_options(app, "of a DEM");
     file_kind(app.add_option("OUTDIR", out_, "Output folder: cities.geojson, city_extents.geojson")->required(), FileKind::folder_out);
     schema_.setup(app, name());
     app.add_flag("--report", report_, "Print the quota table");
@@ -58,7 +59,8 @@ class SitesCommand final : public Command {
     const std::filesystem::path out_dir = outputs.folder(out_);
     const auto t0 = std::chrono::steady_clock::now();
     const bool dem = std::filesystem::is_regular_file(dir_);
-    const pipeline::DensityFolder in = dem ? density_from_dem(dir_, context.progress) : pipeline::read_density_folder(dir_);
+    if (!dem && dem_.given()) throw bad_input("--band, --assume-crs: only for a DEM, and " + dir_ + " is a density folder");
+    const pipeline::DensityFolder in = dem ? density_from_dem(dem_.read(dir_), context.progress) : pipeline::read_density_folder(dir_);
     const auto t1 = std::chrono::steady_clock::now();
     const sites::SitesResult result = sites::place_sites(in.density, in.buildable, options, context.progress);
     const auto t2 = std::chrono::steady_clock::now();
@@ -96,6 +98,7 @@ class SitesCommand final : public Command {
 
  private:
   std::string dir_, out_;
+  DemInput dem_;  // --band and --assume-crs when DENSITY_DIR_OR_DEM is a DEM
   SchemaOptions schema_;
   bool report_ = false, overwrite_ = false;
 };

@@ -264,6 +264,13 @@ void init_gdal() {
   });
 }
 
+ReadOptions read_options(int band, const std::string& assume_crs) {
+  ReadOptions o;
+  if (band > 0) o.band = band;
+  if (!assume_crs.empty()) o.assume_crs = assume_crs;
+  return o;
+}
+
 RasterHeader read_header(const std::string& path, const ReadOptions& options) {
   auto ds = open_raster(path);
   GDALRasterBand* band = nullptr;

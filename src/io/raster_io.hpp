@@ -21,6 +21,10 @@ struct ReadOptions {
   bool windowed = false;
 };
 
+/// ReadOptions of a DEM input as commands and scenarios give it: `band` 0 for the only band,
+/// `assume_crs` "" for none (the scenario's input.band and input.assume_crs, --band and --assume-crs).
+ReadOptions read_options(int band, const std::string& assume_crs);
+
 /// What a raster file holds, read from its header only (no pixel is read).
 struct RasterHeader {
   int cols = 0, rows = 0, bands = 0;

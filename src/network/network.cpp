@@ -192,36 +192,16 @@ void check_sites(const std::vector<sites::Site>& sites) {
   }
 }
 
-}  // namespace
-
-const char* to_string(EdgeKind kind) {
-  switch (kind) {
-    case EdgeKind::inter_urban: return "inter_urban";
-    case EdgeKind::parent_child: return "parent_child";
-    case EdgeKind::all_sites: return "all_sites";
-  }
-  return "?";
-}
-
-SiteGraph build_network(const std::vector<sites::Site>& sites, const Crs& crs, const NetworkOptions& options,
-                        Progress& progress) {
-  if (!(std::isfinite(options.k) && options.k > 1)) throw bad_input("network: k must be a number greater than 1");
-  check_sites(sites);
+/// Plane coordinates for the triangulations: metres on a projected CRS; on a geographic CRS an
+/// equirectangular plane around the mean latitude (Delaunay is planar; lengths stay geodesic).
+std::vector<Point> plane_points(const std::vector<sites::Site>& sites, const Crs& crs) {
   const int n = int(sites.size());
-  const std::size_t count = sites.size();
-  SiteGraph graph;
-  if (n < 2) return graph;
-
-  // Plane coordinates for the triangulations: metres on a projected CRS; on a geographic CRS an
-  // equirectangular plane around the mean latitude (Delaunay is planar; lengths stay geodesic).
-  std::vector<Point> points(count);
-  std::vector<int> parent(count);
+  std::vector<Point> points(sites.size());
   double lon0 = 0, lat0 = 0;
   for (const auto& s : sites) lon0 += s.x / n, lat0 += s.y / n;
   const double shrink = std::cos(lat0 * M_PI / 180.0);
   for (int i = 0; i < n; ++i) {
     const auto& s = sites[std::size_t(i)];
-    parent[std::size_t(i)] = s.parent;
     if (crs.geographic) {
       const double dlon = std::remainder(s.x - lon0, 360.0);
       points[std::size_t(i)] = Point(dlon * shrink, s.y - lat0);
@@ -229,13 +209,19 @@ SiteGraph build_network(const std::vector<sites::Site>& sites, const Crs& crs, c
       points[std::size_t(i)] = Point(s.x, s.y);
     }
   }
+  return points;
+}
 
+/// The union of the triangulations (the roots', each family's, all the sites') and the
+/// parent-child links, each pair once with its highest-priority kind.
+std::vector<Candidate> candidate_edges(const std::vector<Point>& points, const std::vector<int>& parent, Progress& progress) {
+  const int n = int(points.size());
   std::vector<Candidate> candidates;
   {
     ProgressStep step(progress, "network: triangulations");
-    std::vector<int> all(count), roots;
+    std::vector<int> all(points.size()), roots;
     std::iota(all.begin(), all.end(), 0);
-    std::vector<std::vector<int>> families(count);
+    std::vector<std::vector<int>> families(points.size());
     for (int i = 0; i < n; ++i) {
       if (parent[std::size_t(i)] < 0) roots.push_back(i);
       else families[std::size_t(parent[std::size_t(i)])].push_back(i);
@@ -259,25 +245,14 @@ SiteGraph build_network(const std::vector<sites::Site>& sites, const Crs& crs, c
   });
   candidates.erase(std::unique(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) { return a.key == b.key; }),
                    candidates.end());
+  return candidates;
+}
 
-  const std::size_t m = candidates.size();
-  graph.edges.resize(m);
-  std::vector<double> length(m);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, 1024), [&](const tbb::blocked_range<std::size_t>& range) {
-    for (std::size_t e = range.begin(); e < range.end(); ++e) {
-      Edge& edge = graph.edges[e];
-      int a = int(candidates[e].key >> 32), b = int(candidates[e].key & 0xffffffffu);
-      if (candidates[e].kind == EdgeKind::parent_child && parent[std::size_t(a)] == b) std::swap(a, b);  // parent first
-      edge.from = a;
-      edge.to = b;
-      edge.kind = candidates[e].kind;
-      edge.kept = true;
-      edge.detour_ratio = kNaN;
-      const auto &sa = sites[std::size_t(a)], &sb = sites[std::size_t(b)];
-      edge.length_m = length[e] = crs_distance_m(crs, sa.x, sa.y, sb.x, sb.y);
-    }
-  });
-
+/// Every edge not a parent-child link, examined in order, removed when a detour through the
+/// kept edges is shorter than k times its length. `length`: the edges' lengths, m.
+void simplify(SiteGraph& graph, const std::vector<sites::Site>& sites, const Crs& crs, const std::vector<double>& length,
+              const NetworkOptions& options, Progress& progress) {
+  const std::size_t count = sites.size(), m = graph.edges.size();
   // Adjacency (CSR) of every candidate edge; removal only flags edges.
   std::vector<std::uint32_t> offsets(count + 1, 0);
   for (const Edge& e : graph.edges) ++offsets[std::size_t(e.from) + 1], ++offsets[std::size_t(e.to) + 1];
@@ -304,28 +279,28 @@ SiteGraph build_network(const std::vector<sites::Site>& sites, const Crs& crs, c
   };
   std::sort(order.begin(), order.end(), [&](int a, int b) { return size_key(a) < size_key(b); });
 
-  {
-    ProgressStep step(progress, "network: simplification");
-    std::vector<char> removed(m, 0);
-    const DistanceBound lower_bound(sites, crs);
-    DetourSearch search(n, offsets, adjacency, length, removed, lower_bound);
-    for (std::size_t k = 0; k < order.size(); ++k) {
-      const int e = order[k];
-      Edge& edge = graph.edges[std::size_t(e)];
-      edge.rank = int(k);
-      const double detour = search(edge.from, edge.to, e, options.k * edge.length_m);
-      if (!std::isnan(detour)) {
-        removed[std::size_t(e)] = 1;
-        edge.kept = false;
-        edge.detour_ratio = edge.length_m > 0 ? detour / edge.length_m : kNaN;
-      }
-      if ((k & 4095) == 0) step.update(double(k) / double(order.size()));
+  ProgressStep step(progress, "network: simplification");
+  std::vector<char> removed(m, 0);
+  const DistanceBound lower_bound(sites, crs);
+  DetourSearch search(int(count), offsets, adjacency, length, removed, lower_bound);
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    const int e = order[k];
+    Edge& edge = graph.edges[std::size_t(e)];
+    edge.rank = int(k);
+    const double detour = search(edge.from, edge.to, e, options.k * edge.length_m);
+    if (!std::isnan(detour)) {
+      removed[std::size_t(e)] = 1;
+      edge.kept = false;
+      edge.detour_ratio = edge.length_m > 0 ? detour / edge.length_m : kNaN;
     }
-    step.update(1.0);
+    if ((k & 4095) == 0) step.update(double(k) / double(order.size()));
   }
+  step.update(1.0);
+}
 
-  // Removing an edge only when another path joins its ends keeps the union connected; check it.
-  std::vector<int> root(count);
+/// Removing an edge only when another path joins its ends keeps the union connected; check it.
+void check_connected(const SiteGraph& graph, int n) {
+  std::vector<int> root(static_cast<std::size_t>(n));
   std::iota(root.begin(), root.end(), 0);
   auto find = [&](int v) {
     while (root[std::size_t(v)] != v) v = root[std::size_t(v)] = root[std::size_t(root[std::size_t(v)])];
@@ -338,6 +313,50 @@ SiteGraph build_network(const std::vector<sites::Site>& sites, const Crs& crs, c
       if (a != b) root[std::size_t(a)] = b, --components;
     }
   if (components != 1) throw processing_error("network: the simplified network is not connected (" + std::to_string(components) + " parts)");
+}
+
+}  // namespace
+
+const char* to_string(EdgeKind kind) {
+  switch (kind) {
+    case EdgeKind::inter_urban: return "inter_urban";
+    case EdgeKind::parent_child: return "parent_child";
+    case EdgeKind::all_sites: return "all_sites";
+  }
+  return "?";
+}
+
+SiteGraph build_network(const std::vector<sites::Site>& sites, const Crs& crs, const NetworkOptions& options,
+                        Progress& progress) {
+  if (!(std::isfinite(options.k) && options.k > 1)) throw bad_input("network: k must be a number greater than 1");
+  check_sites(sites);
+  const int n = int(sites.size());
+  SiteGraph graph;
+  if (n < 2) return graph;
+
+  std::vector<int> parent(sites.size());
+  for (int i = 0; i < n; ++i) parent[std::size_t(i)] = sites[std::size_t(i)].parent;
+  const std::vector<Candidate> candidates = candidate_edges(plane_points(sites, crs), parent, progress);
+
+  const std::size_t m = candidates.size();
+  graph.edges.resize(m);
+  std::vector<double> length(m);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, 1024), [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t e = range.begin(); e < range.end(); ++e) {
+      Edge& edge = graph.edges[e];
+      int a = int(candidates[e].key >> 32), b = int(candidates[e].key & 0xffffffffu);
+      if (candidates[e].kind == EdgeKind::parent_child && parent[std::size_t(a)] == b) std::swap(a, b);  // parent first
+      edge.from = a;
+      edge.to = b;
+      edge.kind = candidates[e].kind;
+      edge.kept = true;
+      edge.detour_ratio = kNaN;
+      const auto &sa = sites[std::size_t(a)], &sb = sites[std::size_t(b)];
+      edge.length_m = length[e] = crs_distance_m(crs, sa.x, sa.y, sb.x, sb.y);
+    }
+  });
+  simplify(graph, sites, crs, length, options, progress);
+  check_connected(graph, n);
   return graph;
 }
 

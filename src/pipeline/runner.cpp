@@ -149,10 +149,7 @@ json run_scenario(const Scenario& scenario, const RunOptions& options, Progress&
   const fs::path temp = run_folder.folder(output.string(), rerun);
 
   const std::string dem_path = scenario.path("dem");
-  ReadOptions read;
-  if (int band = scenario.resolved["input"]["band"].get<int>(); band > 0) read.band = band;
-  if (auto crs = scenario.resolved["input"]["assume_crs"].get<std::string>(); !crs.empty()) read.assume_crs = crs;
-
+  const ReadOptions read = read_options(scenario.resolved["input"]["band"].get<int>(), scenario.resolved["input"]["assume_crs"].get<std::string>());
   Dem dem = read_dem(dem_path, read);  // before creating anything: bad input leaves no folder
   const std::string dem_sha256 = file_sha256(dem_path);
   plugin::PluginSet plugins = plugin::load_plugins(nlohmann::json::parse(scenario.resolved["plugins"].dump()), log,

@@ -194,152 +194,188 @@ struct Attempt {
   std::vector<std::uint8_t> tiles;
 };
 
+/// The links routed in importance order, each on the roads of every link before it (the
+/// sequential definition), the next links routed ahead, in parallel, on the roads built so far; an
+/// attempt is kept only if no road added since changed a factor it read (nor the floor): its
+/// search would then have run exactly the same, so the roads are those of routing one link after
+/// the other, whatever the threads or the look-ahead (docs/roads.md, "How routing is scheduled").
+class NetworkRouter {
+ public:
+  NetworkRouter(const TerrainField& t, const RoadGraph& base, const std::vector<Link>& links, const RoutingOptions& options,
+                Progress& progress)
+      : t_(t), base_(base), links_(links), options_(options), built_(t, options.reuse_discount),
+        tile_cols_((std::size_t(t.cols()) >> kShift) + 1), tile_rows_((std::size_t(t.rows()) >> kShift) + 1) {
+    // One graph per road class, under the class's design standards, built before routing (the
+    // searches share them read-only).
+    for (const Link& l : links) {
+      const std::size_t k = std::size_t(l.road_class);
+      if (k < graphs_.size() && !graphs_[k])
+        graphs_[k].emplace(t, class_model(base.model(), options.max_grade_pct[k], options.min_radius_m[k]), base.options());
+    }
+    for (std::size_t i = 0; i < links.size(); ++i) {
+      const auto a = cell_at(t, links[i].a[0], links[i].a[1]), b = cell_at(t, links[i].b[0], links[i].b[1]);
+      if (!a || !b)
+        throw bad_input("network: link " + std::to_string(links[i].from) + "-" + std::to_string(links[i].to) + " has an end outside the DEM");
+      edges_.push_back({*a, *b});
+    }
+    // Importance order (Galin et al. 2011): class, then the longer link first (trunks before branches),
+    // then the link order.
+    order_.resize(edges_.size());
+    std::vector<double> span(edges_.size());
+    for (std::size_t i = 0; i < edges_.size(); ++i) {
+      order_[i] = i;
+      span[i] = t.length_m({double(edges_[i].a.col), double(edges_[i].a.row)}, {double(edges_[i].b.col), double(edges_[i].b.row)});
+    }
+    std::stable_sort(order_.begin(), order_.end(), [&](std::size_t x, std::size_t y) {
+      if (links[x].road_class != links[y].road_class) return links[x].road_class < links[y].road_class;
+      return span[x] > span[y];
+    });
+    out_.resize(edges_.size());
+    redundant_.assign(edges_.size(), false);
+    for (std::size_t a = 0; a < base.surface_arcs(); ++a)
+      reach_ = std::max({reach_, std::abs(base.arcs()[a].dcol), std::abs(base.arcs()[a].drow)});
+    attempts_.resize(order_.size());
+    step_.emplace(progress, "roads");
+  }
+
+  NetworkResult run() {
+    const std::size_t lookahead = options_.lookahead > 0
+                                      ? options_.lookahead
+                                      : std::max<std::size_t>(1, tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+    NetworkResult result;
+    for (std::size_t head = 0; head < order_.size();) {
+      const std::vector<std::size_t> todo = next_batch(head, lookahead);
+      result.searches += todo.size();
+      tbb::parallel_for(std::size_t(0), todo.size(), [&](std::size_t j) { route(todo[j]); });
+      while (head < order_.size() && attempts_[head].routed && still_valid(attempts_[head])) commit(head++);
+    }
+    step_->update(1.0);
+    for (std::size_t i = 0; i < edges_.size(); ++i) {
+      const std::string name = std::to_string(links_[i].from) + "-" + std::to_string(links_[i].to);
+      if (!out_[i]) {
+        if (!(edges_[i].a == edges_[i].b)) result.failed.push_back(name);
+      } else if (out_[i]->over_budget) {
+        result.over_budget.push_back(name);
+      } else if (redundant_[i]) {
+        result.redundant.push_back(name);
+      } else {
+        result.roads.push_back(std::move(*out_[i]));
+      }
+    }
+    std::vector<CellChain> chains;
+    std::vector<RoadClass> classes;
+    for (const Road& r : result.roads) chains.push_back(r.chain), classes.push_back(r.road_class);
+    result.layout = network_layout(t_, chains, classes);
+    return result;
+  }
+
+ private:
+  static constexpr int kShift = ArcDiscount::kReadTileShift;
+  struct Edge {
+    Cell a, b;
+  };
+
+  const RoadGraph& graph_of(RoadClass c) const { return std::size_t(c) < graphs_.size() ? *graphs_[std::size_t(c)] : base_; }
+  std::uint32_t cell_index(Cell c) const { return std::uint32_t(t_.index(c.col, c.row)); }
+
+  /// The head link (routed on the current roads, so always kept) and up to lookahead - 1 next ones
+  /// not yet routed or whose attempt the roads added since made stale, to route at once. A link
+  /// sharing an end with an earlier uncommitted link is left for later: that link's road will reach
+  /// the end, where the search starts or ends, and make the attempt stale.
+  std::vector<std::size_t> next_batch(std::size_t head, std::size_t lookahead) const {
+    std::vector<std::size_t> todo{head};
+    std::vector<std::uint32_t> ends{cell_index(edges_[order_[head]].a), cell_index(edges_[order_[head]].b)};
+    for (std::size_t k = head + 1; k < std::min(order_.size(), head + 4 * lookahead) && todo.size() < lookahead; ++k) {
+      const Edge& e = edges_[order_[k]];
+      const std::uint32_t a = cell_index(e.a), b = cell_index(e.b);
+      const bool after_an_end = std::find(ends.begin(), ends.end(), a) != ends.end() || std::find(ends.begin(), ends.end(), b) != ends.end();
+      ends.push_back(a), ends.push_back(b);
+      if (!after_an_end && (!attempts_[k].routed || !still_valid(attempts_[k]))) todo.push_back(k);
+    }
+    return todo;
+  }
+
+  bool still_valid(const Attempt& at) const {
+    if (at.floor != built_.floor()) return false;
+    const auto& changes = built_.changes();
+    if (at.tiles.empty()) return at.version == changes.size();  // routed without reuse
+    for (std::size_t j = at.version; j < changes.size(); ++j) {
+      const int col = int(changes[j] % std::uint32_t(t_.cols())), row = int(changes[j] / std::uint32_t(t_.cols()));
+      const int c0 = std::max(0, col - reach_) >> kShift, c1 = std::min(t_.cols() - 1, col + reach_) >> kShift;
+      const int r0 = std::max(0, row - reach_) >> kShift, r1 = std::min(t_.rows() - 1, row + reach_) >> kShift;
+      for (int r = r0; r <= r1; ++r)
+        for (int c = c0; c <= c1; ++c)
+          if (at.tiles[std::size_t(r) * tile_cols_ + std::size_t(c)]) return false;
+    }
+    return true;
+  }
+
+  void route(std::size_t k) {
+    Attempt& at = attempts_[k];
+    at = Attempt{};
+    at.routed = true;
+    at.version = built_.changes().size();
+    at.floor = built_.floor();
+    const std::size_t i = order_[k];
+    if (edges_[i].a == edges_[i].b) return;
+    std::optional<ArcDiscount> seen;
+    if (const ArcDiscount* d = built_.discount()) {
+      at.tiles.assign(tile_cols_ * tile_rows_, 0);
+      seen = *d;
+      seen->read_tiles = at.tiles.data();
+      seen->read_tile_cols = tile_cols_;
+    }
+    RoutingOptions o = options_;
+    o.bezier.seed = splitmix64(options_.bezier.seed ^ splitmix64(i));
+    try {
+      at.road = route_road(t_, graph_of(links_[i].road_class), edges_[i].a, edges_[i].b, o, nullptr, nullptr, seen ? &*seen : nullptr);
+    } catch (...) {
+      at.error = std::current_exception();
+    }
+  }
+
+  void commit(std::size_t k) {
+    Attempt& at = attempts_[k];
+    if (at.error) std::rethrow_exception(at.error);
+    const std::size_t i = order_[k];
+    std::optional<Road>& r = out_[i];
+    r = std::move(at.road);
+    at = Attempt{};
+    step_->update(double(k + 1) / double(edges_.size()), std::to_string(k + 1) + " of " + std::to_string(edges_.size()) + " roads");
+    if (!r) return;
+    r->from = links_[i].from;
+    r->to = links_[i].to;
+    r->road_class = r->ferry ? RoadClass::maritime : links_[i].road_class;
+    if (r->over_budget || r->chain.cells.empty()) return;
+    if (built_.shared_share(r->chain) >= options_.redundant_share && built_.joined(r->chain.cells.front(), r->chain.cells.back())) {
+      redundant_[i] = true;
+      return;
+    }
+    built_.add(r->chain, r->road_class);
+  }
+
+  const TerrainField& t_;
+  const RoadGraph& base_;
+  const std::vector<Link>& links_;
+  const RoutingOptions& options_;
+  std::array<std::optional<RoadGraph>, 4> graphs_;
+  std::vector<Edge> edges_;
+  std::vector<std::size_t> order_;
+  BuiltRoads built_;
+  std::vector<std::optional<Road>> out_;
+  std::vector<bool> redundant_;
+  std::optional<ProgressStep> step_;  // begun once the links are checked
+  const std::size_t tile_cols_, tile_rows_;
+  int reach_ = 0;  // cells a surface arc's factors lie from the cell the search marks
+  std::vector<Attempt> attempts_;
+};
+
 }  // namespace
 
 NetworkResult route_network(const TerrainField& t, const RoadGraph& base, const std::vector<Link>& links, const RoutingOptions& options,
                             Progress& progress) {
-  // One graph per road class, under the class's design standards, built before routing (the
-  // searches share them read-only).
-  std::array<std::optional<RoadGraph>, 4> graphs;
-  for (const Link& l : links) {
-    const std::size_t k = std::size_t(l.road_class);
-    if (k < graphs.size() && !graphs[k])
-      graphs[k].emplace(t, class_model(base.model(), options.max_grade_pct[k], options.min_radius_m[k]), base.options());
-  }
-  auto graph_of = [&](RoadClass c) -> const RoadGraph& { return std::size_t(c) < graphs.size() ? *graphs[std::size_t(c)] : base; };
-  struct Edge {
-    Cell a, b;
-  };
-  std::vector<Edge> edges;
-  for (std::size_t i = 0; i < links.size(); ++i) {
-    const auto a = cell_at(t, links[i].a[0], links[i].a[1]), b = cell_at(t, links[i].b[0], links[i].b[1]);
-    if (!a || !b)
-      throw bad_input("network: link " + std::to_string(links[i].from) + "-" + std::to_string(links[i].to) + " has an end outside the DEM");
-    edges.push_back({*a, *b});
-  }
-  // Importance order (Galin et al. 2011): class, then the longer link first (trunks before branches),
-  // then the link order.
-  std::vector<std::size_t> order(edges.size());
-  std::vector<double> span(edges.size());
-  for (std::size_t i = 0; i < edges.size(); ++i) {
-    order[i] = i;
-    span[i] = t.length_m({double(edges[i].a.col), double(edges[i].a.row)}, {double(edges[i].b.col), double(edges[i].b.row)});
-  }
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) {
-    if (links[x].road_class != links[y].road_class) return links[x].road_class < links[y].road_class;
-    return span[x] > span[y];
-  });
-  BuiltRoads built(t, options.reuse_discount);
-  std::vector<std::optional<Road>> out(edges.size());
-  std::vector<bool> redundant(edges.size(), false);
-  ProgressStep step(progress, "roads");
-  // Each link is routed on the roads of every link before it (the sequential definition), but the
-  // next links are routed ahead, in parallel, on the roads built so far, and an attempt is kept
-  // only if no road added since changed a factor it read (nor the floor): its search would then
-  // have run exactly the same, so the roads are those of routing one link after the other, whatever
-  // the threads or the look-ahead (docs/roads.md, "How routing is scheduled").
-  const int shift = ArcDiscount::kReadTileShift;
-  const std::size_t tile_cols = (std::size_t(t.cols()) >> shift) + 1, tile_rows = (std::size_t(t.rows()) >> shift) + 1;
-  int reach = 0;  // cells a surface arc's factors lie from the cell the search marks
-  for (std::size_t a = 0; a < base.surface_arcs(); ++a) reach = std::max({reach, std::abs(base.arcs()[a].dcol), std::abs(base.arcs()[a].drow)});
-  std::vector<Attempt> attempts(order.size());
-  auto cell_index = [&](Cell c) { return std::uint32_t(t.index(c.col, c.row)); };
-  auto still_valid = [&](const Attempt& at) {
-    if (at.floor != built.floor()) return false;
-    const auto& changes = built.changes();
-    if (at.tiles.empty()) return at.version == changes.size();  // routed without reuse
-    for (std::size_t j = at.version; j < changes.size(); ++j) {
-      const int col = int(changes[j] % std::uint32_t(t.cols())), row = int(changes[j] / std::uint32_t(t.cols()));
-      const int c0 = std::max(0, col - reach) >> shift, c1 = std::min(t.cols() - 1, col + reach) >> shift;
-      const int r0 = std::max(0, row - reach) >> shift, r1 = std::min(t.rows() - 1, row + reach) >> shift;
-      for (int r = r0; r <= r1; ++r)
-        for (int c = c0; c <= c1; ++c)
-          if (at.tiles[std::size_t(r) * tile_cols + std::size_t(c)]) return false;
-    }
-    return true;
-  };
-  auto route = [&](std::size_t k) {
-    Attempt& at = attempts[k];
-    at = Attempt{};
-    at.routed = true;
-    at.version = built.changes().size();
-    at.floor = built.floor();
-    const std::size_t i = order[k];
-    if (edges[i].a == edges[i].b) return;
-    std::optional<ArcDiscount> seen;
-    if (const ArcDiscount* d = built.discount()) {
-      at.tiles.assign(tile_cols * tile_rows, 0);
-      seen = *d;
-      seen->read_tiles = at.tiles.data();
-      seen->read_tile_cols = tile_cols;
-    }
-    RoutingOptions o = options;
-    o.bezier.seed = splitmix64(options.bezier.seed ^ splitmix64(i));
-    try {
-      at.road = route_road(t, graph_of(links[i].road_class), edges[i].a, edges[i].b, o, nullptr, nullptr, seen ? &*seen : nullptr);
-    } catch (...) {
-      at.error = std::current_exception();
-    }
-  };
-  auto commit = [&](std::size_t k) {
-    Attempt& at = attempts[k];
-    if (at.error) std::rethrow_exception(at.error);
-    const std::size_t i = order[k];
-    std::optional<Road>& r = out[i];
-    r = std::move(at.road);
-    at = Attempt{};
-    step.update(double(k + 1) / double(edges.size()), std::to_string(k + 1) + " of " + std::to_string(edges.size()) + " roads");
-    if (!r) return;
-    r->from = links[i].from;
-    r->to = links[i].to;
-    r->road_class = r->ferry ? RoadClass::maritime : links[i].road_class;
-    if (r->over_budget || r->chain.cells.empty()) return;
-    if (built.shared_share(r->chain) >= options.redundant_share && built.joined(r->chain.cells.front(), r->chain.cells.back())) {
-      redundant[i] = true;
-      return;
-    }
-    built.add(r->chain, r->road_class);
-  };
-  const std::size_t lookahead =
-      options.lookahead > 0 ? options.lookahead : std::max<std::size_t>(1, tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
-  NetworkResult result;
-  for (std::size_t head = 0; head < order.size();) {
-    // The head link (routed on the current roads, so always kept) and up to lookahead - 1 next ones
-    // not yet routed or whose attempt the roads added since made stale, routed at once; then every
-    // valid attempt in order.
-    // A link sharing an end with an earlier uncommitted link is left for later: that link's road
-    // will reach the end, where the search starts or ends, and make the attempt stale.
-    std::vector<std::size_t> todo{head};
-    std::vector<std::uint32_t> ends{cell_index(edges[order[head]].a), cell_index(edges[order[head]].b)};
-    for (std::size_t k = head + 1; k < std::min(order.size(), head + 4 * lookahead) && todo.size() < lookahead; ++k) {
-      const Edge& e = edges[order[k]];
-      const std::uint32_t a = cell_index(e.a), b = cell_index(e.b);
-      const bool after_an_end = std::find(ends.begin(), ends.end(), a) != ends.end() || std::find(ends.begin(), ends.end(), b) != ends.end();
-      ends.push_back(a), ends.push_back(b);
-      if (!after_an_end && (!attempts[k].routed || !still_valid(attempts[k]))) todo.push_back(k);
-    }
-    result.searches += todo.size();
-    tbb::parallel_for(std::size_t(0), todo.size(), [&](std::size_t j) { route(todo[j]); });
-    while (head < order.size() && attempts[head].routed && still_valid(attempts[head])) commit(head++);
-  }
-  step.update(1.0);
-  for (std::size_t i = 0; i < edges.size(); ++i) {
-    const std::string name = std::to_string(links[i].from) + "-" + std::to_string(links[i].to);
-    if (!out[i]) {
-      if (!(edges[i].a == edges[i].b)) result.failed.push_back(name);
-    } else if (out[i]->over_budget) {
-      result.over_budget.push_back(name);
-    } else if (redundant[i]) {
-      result.redundant.push_back(name);
-    } else {
-      result.roads.push_back(std::move(*out[i]));
-    }
-  }
-  std::vector<CellChain> chains;
-  std::vector<RoadClass> classes;
-  for (const Road& r : result.roads) chains.push_back(r.chain), classes.push_back(r.road_class);
-  result.layout = network_layout(t, chains, classes);
-  return result;
+  NetworkRouter router(t, base, links, options, progress);
+  return router.run();
 }
 
 namespace {

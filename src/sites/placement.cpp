@@ -128,6 +128,185 @@ std::vector<std::uint8_t> covered_cells(const std::vector<Site>& sites, const Gr
   return covered;
 }
 
+/// The rank_size quotas: the region's people (the figure given, else the default density times
+/// the land area), the settled share of them split by the rank-size law (its exponent given, or
+/// read from the catchments of a first placement), at most as many places as the land holds.
+QuotaTable rank_size_table(const Raster<float>& density, const Raster<std::uint8_t>& buildable, const SitesOptions& options,
+                           const CellMetrics& metrics, double cell_size, SitesResult& result, Progress& progress) {
+  double land_km2 = options.land_area_km2;
+  if (!(land_km2 > 0)) {
+    double m2 = 0;
+    for (int r = 0; r < density.rows(); ++r)
+      for (int c = 0; c < density.cols(); ++c)
+        if (buildable(c, r) == 1) m2 += metrics.area_m2[std::size_t(r)];
+    land_km2 = m2 * 1e-6;
+  }
+  if (!(std::isfinite(options.people_per_km2) && options.people_per_km2 >= 0)) throw bad_input("sites: people_per_km2 must be >= 0");
+  if (!(std::isfinite(options.influence_factor) && options.influence_factor >= 0)) throw bad_input("sites: influence_factor must be >= 0");
+  result.population_assumed = !(options.population > 0);
+  result.land_area_km2 = land_km2;
+  result.target_population = result.population_assumed ? std::round(options.people_per_km2 * land_km2) : options.population;
+  if (!(std::isfinite(options.urban_share) && options.urban_share > 0 && options.urban_share <= 1))
+    throw bad_input("sites: urban_share must lie in (0, 1]");
+  result.settled_population = std::round(options.urban_share * result.target_population);
+  result.sizes_exponent = options.zipf_exponent;
+  const std::size_t room = settleable_count(land_km2, options);
+  std::vector<std::int64_t> sizes;
+  if (options.sizes == SitesOptions::Sizes::catchment) {
+    // The central places of all the region's people by the law, their catchments on the
+    // density model, and the law's exponent read from those of min_population or more.
+    SitesOptions pilot = options;
+    pilot.sizes = SitesOptions::Sizes::rank_size;
+    pilot.urban_share = 1;
+    pilot.influence_factor = 0;
+    pilot.population = result.target_population;
+    pilot.land_area_km2 = land_km2;
+    const SitesResult central = place_sites(density, buildable, pilot, progress);
+    result.room = central.room;
+    result.count_limited = central.count_limited;
+    std::vector<double> settled;
+    for (double p : catchment_people(density, buildable, central.sites, result.settled_population))
+      if (p >= options.min_population) settled.push_back(p);
+    const double q = rank_size_exponent(settled);
+    if (std::isfinite(q)) result.sizes_exponent = q;  // fewer than 3 catchments that large: zipf_exponent
+    sizes = rank_size_split(result.settled_population, result.sizes_exponent, central.sites.size());
+    sizes.erase(std::find(sizes.begin(), sizes.end(), 0), sizes.end());  // more places than settled people
+  } else {
+    const auto law = [&](std::size_t max_count) {
+      return rank_size_populations(result.settled_population, options.zipf_exponent, options.min_population, max_count);
+    };
+    sizes = law(room);
+    if (room != std::numeric_limits<std::size_t>::max()) {
+      result.room = std::int64_t(room);
+      result.count_limited = sizes.size() == room && law(room + 1).size() > room;
+    }
+  }
+  QuotaTable table = rank_size_quotas(cell_size, sizes, options);
+  if (options.refill_rounds < 0 || options.candidates < 0) throw bad_input("sites: candidates and refill rounds must be >= 0");
+  if (options.r_min_m > 0 || options.r_max_m > 0)
+    throw bad_input("sites: r_min and r_max set the classes of the belhadj2007 quotas; with rank_size the radii come from the populations");
+  return table;
+}
+
+/// Habitable cells: buildable == 1 with a density value.
+std::vector<std::uint8_t> habitable_cells(const Raster<float>& density, const Raster<std::uint8_t>& buildable) {
+  std::vector<std::uint8_t> habitable(density.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, density.size(), 1 << 16), [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t i = range.begin(); i < range.end(); ++i)
+      habitable[i] = buildable[i] == 1 && !buildable.is_nodata(i) && std::isfinite(density[i]);
+  });
+  return habitable;
+}
+
+/// M distinct candidates drawn uniformly among the habitable cells (partial Fisher-Yates), by
+/// density, decreasing; equal densities keep the draw order, itself random.
+std::vector<std::uint32_t> draw_candidates(const Raster<float>& density, const std::vector<std::uint8_t>& habitable, std::int64_t wanted,
+                                           std::uint64_t seed) {
+  std::vector<std::uint32_t> pool;
+  if (density.size() > std::numeric_limits<std::uint32_t>::max()) throw bad_input("sites: grid larger than 2^32 cells");
+  for (std::size_t i = 0; i < habitable.size(); ++i)
+    if (habitable[i]) pool.push_back(std::uint32_t(i));
+  if (pool.empty()) throw bad_input("sites: no buildable cell in the density model");
+  const std::size_t m = std::size_t(std::clamp<std::int64_t>(wanted, 1, std::int64_t(pool.size())));
+  std::mt19937_64 generator(seed);
+  for (std::size_t k = 0; k < m; ++k) std::swap(pool[k], pool[k + bounded(generator, pool.size() - k)]);
+  pool.resize(m);
+  std::stable_sort(pool.begin(), pool.end(), [&](std::uint32_t a, std::uint32_t b) { return density[a] > density[b]; });
+  return pool;
+}
+
+/// Growth (Algorithm 14) over the candidates in density order, resumable: each call goes on from
+/// the first candidate not reached yet.
+class Growth {
+ public:
+  /// `radius`: ascending radius index i of Algorithm 14 (r = r_min + i dr); class = n - 1 - i.
+  Growth(const Raster<float>& density, const std::vector<std::uint8_t>& habitable, std::vector<std::uint32_t> pool,
+         std::vector<double> radius, const SitesOptions& options, const GridDistance& distance)
+      : density_(density), pool_(std::move(pool)), radius_(std::move(radius)), options_(options), cols_(density.cols()),
+        tester_(habitable, density.cols(), density.rows(), distance) {
+    if (options.disc_test == SitesOptions::DiscTest::exact) tester_.build_row_pass();
+  }
+
+  bool candidates_left() const { return next_ < pool_.size(); }
+
+  /// From candidate `next_` on, with quota[] left, skipping candidates whose cell is `covered`;
+  /// appends the sites to `out`. Disc tests run in parallel a batch ahead; the quota bookkeeping is
+  /// sequential, in density order.
+  void grow(const std::vector<std::uint8_t>* covered, std::vector<int>& quota, QuotaTable& table, std::vector<Site>& out, ProgressStep& step) {
+    const std::size_t m = pool_.size();
+    const int n = int(radius_.size());
+    int remaining = std::accumulate(quota.begin(), quota.end(), 0);
+    std::vector<int> limit;
+    const std::size_t batch = 4096;
+    while (next_ < m && remaining > 0) {
+      const std::size_t begin = next_, end = std::min(m, begin + batch);
+      limit.assign(end - begin, 0);
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, 16), [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t k = range.begin(); k < range.end(); ++k)
+          limit[k - begin] = covered && (*covered)[pool_[k]] ? 0 : clear_classes(pool_[k]);
+      });
+      for (std::size_t k = begin; k < end && remaining > 0; ++k, next_ = k) {
+        int j = limit[k - begin] - 1;
+        while (j >= 0 && quota[std::size_t(j)] == 0) --j;  // the largest valid class with quota left
+        if (j < 0) continue;                                 // supprimer(L_sites, S)
+        --quota[std::size_t(j)];
+        --remaining;
+        ++table.classes[std::size_t(n - 1 - j)].placed;
+        out.push_back(site_at(k, j));
+      }
+      step.update(double(next_) / double(m));
+    }
+  }
+
+  /// By radius, decreasing; equal radii keep the density order.
+  void sort_by_size(std::vector<Site>& sites) const {
+    std::sort(sites.begin(), sites.end(), [&](const Site& a, const Site& b) {
+      if (a.radius_m != b.radius_m) return a.radius_m > b.radius_m;
+      return rank_of_.at(std::uint32_t(a.row) * std::uint32_t(cols_) + std::uint32_t(a.col)) <
+             rank_of_.at(std::uint32_t(b.row) * std::uint32_t(cols_) + std::uint32_t(b.col));
+    });
+  }
+
+ private:
+  /// Number of leading classes whose disc is clear: the growth stops at the first intersection.
+  int clear_classes(std::uint32_t cell) const {
+    const int c = int(cell % std::uint32_t(cols_)), r = int(cell / std::uint32_t(cols_));
+    if (options_.disc_test == SitesOptions::DiscTest::exact) {
+      const double d = tester_.clear_distance_m(c, r, radius_.back() + 1.0);
+      return int(std::lower_bound(radius_.begin(), radius_.end(), d) - radius_.begin());  // classes with radius < d
+    }
+    int i = 0;
+    while (i < int(radius_.size()) && !tester_.circle_hits(c, r, radius_[std::size_t(i)])) ++i;
+    return i;
+  }
+
+  /// The site of candidate k in radius index j.
+  Site site_at(std::size_t k, int j) {
+    const int n = int(radius_.size());
+    Site s;
+    s.col = int(pool_[k] % std::uint32_t(cols_));
+    s.row = int(pool_[k] / std::uint32_t(cols_));
+    const auto xy = density_.georef().cell_centre(s.col, s.row);
+    s.x = xy[0];
+    s.y = xy[1];
+    s.radius_m = radius_[std::size_t(j)];
+    s.radius_class = n - 1 - j;
+    s.population = std::llround(options_.people_per_m * s.radius_m);
+    s.density = density_[pool_[k]];
+    rank_of_[pool_[k]] = k;
+    return s;
+  }
+
+  const Raster<float>& density_;
+  const std::vector<std::uint32_t> pool_;
+  const std::vector<double> radius_;
+  const SitesOptions& options_;
+  const int cols_;
+  DiscTester tester_;
+  std::size_t next_ = 0;
+  std::unordered_map<std::uint32_t, std::size_t> rank_of_;  // candidate cell -> position in density order
+};
+
 }  // namespace
 
 SitesResult place_sites(const Raster<float>& density, const Raster<std::uint8_t>& buildable, const SitesOptions& options,
@@ -142,64 +321,8 @@ SitesResult place_sites(const Raster<float>& density, const Raster<std::uint8_t>
   const int centre = rows / 2;
   const double cell_size = std::max(metrics.width_m[std::size_t(centre)], metrics.height_m[std::size_t(centre)]);
   SitesResult result;
-  QuotaTable table;
-  if (options.quotas == SitesOptions::Quotas::belhadj2007) {
-    table = compute_quotas(cell_size, options);
-  } else {
-    // The region's people: the figure given, else the default density times the land area.
-    double land_km2 = options.land_area_km2;
-    if (!(land_km2 > 0)) {
-      double m2 = 0;
-      for (int r = 0; r < rows; ++r)
-        for (int c = 0; c < cols; ++c)
-          if (buildable(c, r) == 1) m2 += metrics.area_m2[std::size_t(r)];
-      land_km2 = m2 * 1e-6;
-    }
-    if (!(std::isfinite(options.people_per_km2) && options.people_per_km2 >= 0)) throw bad_input("sites: people_per_km2 must be >= 0");
-    if (!(std::isfinite(options.influence_factor) && options.influence_factor >= 0)) throw bad_input("sites: influence_factor must be >= 0");
-    result.population_assumed = !(options.population > 0);
-    result.land_area_km2 = land_km2;
-    result.target_population = result.population_assumed ? std::round(options.people_per_km2 * land_km2) : options.population;
-    if (!(std::isfinite(options.urban_share) && options.urban_share > 0 && options.urban_share <= 1))
-      throw bad_input("sites: urban_share must lie in (0, 1]");
-    result.settled_population = std::round(options.urban_share * result.target_population);
-    result.sizes_exponent = options.zipf_exponent;
-    const std::size_t room = settleable_count(land_km2, options);
-    std::vector<std::int64_t> sizes;
-    if (options.sizes == SitesOptions::Sizes::catchment) {
-      // The central places of all the region's people by the law, their catchments on the
-      // density model, and the law's exponent read from those of min_population or more.
-      SitesOptions pilot = options;
-      pilot.sizes = SitesOptions::Sizes::rank_size;
-      pilot.urban_share = 1;
-      pilot.influence_factor = 0;
-      pilot.population = result.target_population;
-      pilot.land_area_km2 = land_km2;
-      const SitesResult central = place_sites(density, buildable, pilot, progress);
-      result.room = central.room;
-      result.count_limited = central.count_limited;
-      std::vector<double> settled;
-      for (double p : catchment_people(density, buildable, central.sites, result.settled_population))
-        if (p >= options.min_population) settled.push_back(p);
-      const double q = rank_size_exponent(settled);
-      if (std::isfinite(q)) result.sizes_exponent = q;  // fewer than 3 catchments that large: zipf_exponent
-      sizes = rank_size_split(result.settled_population, result.sizes_exponent, central.sites.size());
-      sizes.erase(std::find(sizes.begin(), sizes.end(), 0), sizes.end());  // more places than settled people
-    } else {
-      const auto law = [&](std::size_t max_count) {
-        return rank_size_populations(result.settled_population, options.zipf_exponent, options.min_population, max_count);
-      };
-      sizes = law(room);
-      if (room != std::numeric_limits<std::size_t>::max()) {
-        result.room = std::int64_t(room);
-        result.count_limited = sizes.size() == room && law(room + 1).size() > room;
-      }
-    }
-    table = rank_size_quotas(cell_size, sizes, options);
-    if (options.refill_rounds < 0 || options.candidates < 0) throw bad_input("sites: candidates and refill rounds must be >= 0");
-    if (options.r_min_m > 0 || options.r_max_m > 0)
-      throw bad_input("sites: r_min and r_max set the classes of the belhadj2007 quotas; with rank_size the radii come from the populations");
-  }
+  QuotaTable table = options.quotas == SitesOptions::Quotas::belhadj2007 ? compute_quotas(cell_size, options)
+                                                                         : rank_size_table(density, buildable, options, metrics, cell_size, result, progress);
   const int n = int(table.classes.size());
   // Ascending radius index i of Algorithm 14 (r = r_min + i dr); class = n - 1 - i.
   std::vector<double> radius(static_cast<std::size_t>(n));
@@ -212,104 +335,27 @@ SitesResult place_sites(const Raster<float>& density, const Raster<std::uint8_t>
   result.dr_m = table.dr_m;
   result.seed = options.seed;
 
-  // Habitable cells: buildable == 1 with a density value.
-  std::vector<std::uint8_t> habitable(density.size());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, density.size(), 1 << 16), [&](const tbb::blocked_range<std::size_t>& range) {
-    for (std::size_t i = range.begin(); i < range.end(); ++i)
-      habitable[i] = buildable[i] == 1 && !buildable.is_nodata(i) && std::isfinite(density[i]);
-  });
-  std::vector<std::uint32_t> pool;
-  if (density.size() > std::numeric_limits<std::uint32_t>::max()) throw bad_input("sites: grid larger than 2^32 cells");
-  for (std::size_t i = 0; i < habitable.size(); ++i)
-    if (habitable[i]) pool.push_back(std::uint32_t(i));
-  if (pool.empty()) throw bad_input("sites: no buildable cell in the density model");
-
-  // Draw M distinct candidates uniformly among buildable cells (partial Fisher-Yates).
+  const std::vector<std::uint8_t> habitable = habitable_cells(density, buildable);
   const std::int64_t wanted = options.candidates > 0 ? std::int64_t(options.candidates) : 20 * std::int64_t(table.total());
-  const std::size_t m = std::size_t(std::clamp<std::int64_t>(wanted, 1, std::int64_t(pool.size())));
-  std::mt19937_64 generator(options.seed);
-  for (std::size_t k = 0; k < m; ++k) std::swap(pool[k], pool[k + bounded(generator, pool.size() - k)]);
-  pool.resize(m);
-  result.candidates = int(m);
-  // By density, decreasing; equal densities keep the draw order, itself random.
-  std::stable_sort(pool.begin(), pool.end(), [&](std::uint32_t a, std::uint32_t b) { return density[a] > density[b]; });
-
-  DiscTester tester(habitable, cols, rows, distance);
-  if (options.disc_test == SitesOptions::DiscTest::exact) tester.build_row_pass();
-  const double cap = radius.back() + 1.0;
-  // Number of leading classes whose disc is clear: the growth stops at the first intersection.
-  auto clear_classes = [&](std::uint32_t cell) {
-    const int c = int(cell % std::uint32_t(cols)), r = int(cell / std::uint32_t(cols));
-    if (options.disc_test == SitesOptions::DiscTest::exact) {
-      const double d = tester.clear_distance_m(c, r, cap);
-      return int(std::lower_bound(radius.begin(), radius.end(), d) - radius.begin());  // classes with radius < d
-    }
-    int i = 0;
-    while (i < n && !tester.circle_hits(c, r, radius[std::size_t(i)])) ++i;
-    return i;
-  };
-
-  // Growth (Algorithm 14) from candidate `next` on, with quota[] left, skipping candidates whose
-  // cell is `covered`; appends the sites to `out`. Disc tests run in parallel a batch ahead; the
-  // quota bookkeeping is sequential, in density order.
-  std::size_t next = 0;
-  std::unordered_map<std::uint32_t, std::size_t> rank_of;  // candidate cell -> position in density order
-  auto grow = [&](const std::vector<std::uint8_t>* covered, std::vector<Site>& out, ProgressStep& step) {
-    int remaining = std::accumulate(quota.begin(), quota.end(), 0);
-    std::vector<int> limit;
-    const std::size_t batch = 4096;
-    while (next < m && remaining > 0) {
-      const std::size_t begin = next, end = std::min(m, begin + batch);
-      limit.assign(end - begin, 0);
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, 16), [&](const tbb::blocked_range<std::size_t>& range) {
-        for (std::size_t k = range.begin(); k < range.end(); ++k)
-          limit[k - begin] = covered && (*covered)[pool[k]] ? 0 : clear_classes(pool[k]);
-      });
-      for (std::size_t k = begin; k < end && remaining > 0; ++k, next = k) {
-        int j = limit[k - begin] - 1;
-        while (j >= 0 && quota[std::size_t(j)] == 0) --j;  // the largest valid class with quota left
-        if (j < 0) continue;                                 // supprimer(L_sites, S)
-        --quota[std::size_t(j)];
-        --remaining;
-        ++table.classes[std::size_t(n - 1 - j)].placed;
-        Site s;
-        s.col = int(pool[k] % std::uint32_t(cols));
-        s.row = int(pool[k] / std::uint32_t(cols));
-        const auto xy = density.georef().cell_centre(s.col, s.row);
-        s.x = xy[0];
-        s.y = xy[1];
-        s.radius_m = radius[std::size_t(j)];
-        s.radius_class = n - 1 - j;
-        s.population = std::llround(options.people_per_m * s.radius_m);
-        s.density = density[pool[k]];
-        rank_of[pool[k]] = k;
-        out.push_back(s);
-      }
-      step.update(double(next) / double(m));
-    }
-  };
-  // By radius, decreasing; equal radii keep the density order.
-  auto by_size = [&](const Site& a, const Site& b) {
-    if (a.radius_m != b.radius_m) return a.radius_m > b.radius_m;
-    return rank_of.at(std::uint32_t(a.row) * std::uint32_t(cols) + std::uint32_t(a.col)) <
-           rank_of.at(std::uint32_t(b.row) * std::uint32_t(cols) + std::uint32_t(b.col));
-  };
+  std::vector<std::uint32_t> pool = draw_candidates(density, habitable, wanted, options.seed);
+  result.candidates = int(pool.size());
+  Growth growth(density, habitable, std::move(pool), std::move(radius), options, distance);
 
   std::vector<Site> placed;
   {
     ProgressStep step(progress, "sites: growth");
-    grow(nullptr, placed, step);
+    growth.grow(nullptr, quota, table, placed, step);
   }
   {
     ProgressStep step(progress, "sites: inclusions");
-    std::sort(placed.begin(), placed.end(), by_size);
+    growth.sort_by_size(placed);
     result.sites = resolve_inclusions(placed, options.mode, distance, cols, rows);
     step.update(1.0);
   }
   // Refill (Belhadj §4.3.1.2 names it as the remedy for the imbalance left by the inclusion
   // removal): the quota of removed sites goes back to the growth, which resumes on the
   // candidates not reached yet, skipping those whose centre lies in a kept disc.
-  for (int round = 0; round < options.refill_rounds && next < m; ++round) {
+  for (int round = 0; round < options.refill_rounds && growth.candidates_left(); ++round) {
     std::vector<int> kept(static_cast<std::size_t>(n), 0);
     for (const Site& s : result.sites) ++kept[std::size_t(n - 1 - s.radius_class)];
     for (int i = 0; i < n; ++i) quota[std::size_t(i)] = table.classes[std::size_t(n - 1 - i)].quota - kept[std::size_t(i)];
@@ -318,9 +364,9 @@ SitesResult place_sites(const Raster<float>& density, const Raster<std::uint8_t>
     const std::vector<std::uint8_t> covered = covered_cells(result.sites, distance, cols, rows);
     std::vector<Site> merged = result.sites;
     const std::size_t before = merged.size();
-    grow(&covered, merged, step);
+    growth.grow(&covered, quota, table, merged, step);
     if (merged.size() == before) break;
-    std::sort(merged.begin(), merged.end(), by_size);
+    growth.sort_by_size(merged);
     result.sites = resolve_inclusions(merged, options.mode, distance, cols, rows);
   }
   for (Site& s : result.sites) {

@@ -463,56 +463,25 @@ std::vector<RiverPath> channels(const std::vector<RiverPath>& paths, std::size_t
   return out;
 }
 
-}  // namespace
-
-GeneratedTerrain generate_flow(const GenerateRequest& request) {
-  using clock = std::chrono::steady_clock;
-  const auto t0 = clock::now();
-  const int cols = request.grid.cols(), rows = request.grid.rows();
-  Field f{cols, rows, std::vector<float>(std::size_t(cols) * rows, 0.0f), std::vector<int>(std::size_t(cols) * rows, -1),
-          std::vector<int>(std::size_t(cols) * rows, -1)};
-  Rng rng(request.seed);
-  const double size = std::min(cols, rows);
-  RidgeParams rp;
-  rp.speed = std::max(2.0, size / 50);
-  rp.sigma1 = size / 16;
-  rp.sigma2 = size / 4;
-  // A base rising gently away from the border: the thesis's only mouths are the border, and this
-  // keeps every basin draining to it (the basins alone leave flat floors where particles stall).
-  const double base_m = 0.1 * request.relief_m;
-  for (int r = 0; r < rows; ++r)
-    for (int c = 0; c < cols; ++c) {
-      const double d = std::min({c + 0.5, r + 0.5, cols - c - 0.5, rows - r - 0.5});
-      f.a[f.at(c, r)] = float(base_m * std::min(1.0, d / (size / 2)));
+/// The 3x3 mean the thesis applies to the basins so that segment joints leave no local minimum.
+void smooth_basins(Field& f) {
+  std::vector<float> s(f.a.size());
+  for (int r = 0; r < f.rows; ++r)
+    for (int c = 0; c < f.cols; ++c) {
+      double sum = 0;
+      int n = 0;
+      for (int dr = -1; dr <= 1; ++dr)
+        for (int dc = -1; dc <= 1; ++dc)
+          if (f.inside(c + dc, r + dr)) sum += f.a[f.at(c + dc, r + dr)], ++n;
+      s[f.at(c, r)] = float(sum / n);
     }
-  Skeleton skeleton;
-  if (request.lines.empty()) {
-    const int pairs = std::max(2, int(std::lround(double(cols) * rows / 60000.0)));
-    skeleton.ridges = random_ridges(f, pairs, request.relief_m, rp, rng);
-  } else {
-    skeleton.ridges = given_ridges(f, request.lines, request.relief_m, rp);
-  }
-  // The 3x3 mean the thesis applies to the basins so that segment joints leave no local minimum.
-  {
-    std::vector<float> s(f.a.size());
-    for (int r = 0; r < rows; ++r)
-      for (int c = 0; c < cols; ++c) {
-        double sum = 0;
-        int n = 0;
-        for (int dr = -1; dr <= 1; ++dr)
-          for (int dc = -1; dc <= 1; ++dc)
-            if (f.inside(c + dc, r + dr)) sum += f.a[f.at(c + dc, r + dr)], ++n;
-        s[f.at(c, r)] = float(sum / n);
-      }
-    f.a.swap(s);
-  }
+  f.a.swap(s);
+}
 
-  // River particles on both sides of every ridge, one pair every few ridge cells (§2.2.2).
-  RiverSystem rivers(f, request.cell_m, RiverParams{}, rng);
-  // A particle stands for the water of its strip of slope, `spacing` cells wide: its channel head
-  // is `spacing` cells down its track, where it drains spacing² cells (see channels()).
-  const double spacing = std::max(3.0, size / 20), offset = 2.0;
-  for (const auto& ridge : skeleton.ridges) {
+/// River particles on both sides of every ridge, one pair every `spacing` ridge cells (§2.2.2).
+void seed_particles(RiverSystem& rivers, const std::vector<RidgeLine>& ridges, double spacing) {
+  const double offset = 2.0;
+  for (const auto& ridge : ridges) {
     double travelled = spacing;
     for (std::size_t i = 1; i < ridge.line.size(); ++i) {
       const auto& p = ridge.line[i - 1];
@@ -529,26 +498,14 @@ GeneratedTerrain generate_flow(const GenerateRequest& request) {
       }
     }
   }
-  rivers.run();
-  std::vector<RiverPath> paths = rivers.paths();
-  const auto masses = path_masses(paths);
-  for (std::size_t i = 0; i < paths.size(); ++i)
-    for (double m : masses[i]) paths[i].width_m.push_back(std::max(1.0, std::log2(m)) * request.cell_m);
-  skeleton.rivers = reaches_from_paths(channels(paths, std::size_t(std::lround(spacing))));
-  const double skeleton_s = std::chrono::duration<double>(clock::now() - t0).count();
+}
 
-  // The skeleton DEM: ridge and river cells keep their altitude, everything else is unknown.
-  // River beds are made to descend (by at least 1 mm per metre) from source to mouth and to
-  // reach each confluence above the receiving river, so the DEM drains along them.
-  GeneratedTerrain out;
-  out.dem = request.grid;
-  out.skeleton = std::move(skeleton);
-  Raster<float>& dem = out.dem;
-  for (int r = 0; r < rows; ++r)
-    for (int c = 0; c < cols; ++c)
-      if (f.ridge[f.at(c, r)] >= 0) dem(c, r) = f.a[f.at(c, r)];
-  const double drop = 1e-3 * request.cell_m;
-  std::vector<char> centre(dem.size(), 0);  // river centre cells: their bed is never lowered by a neighbour's bank
+/// River beds burnt into `dem`, made to descend (by at least `drop` m a cell) from source to mouth
+/// and to reach each confluence above the receiving river, so the DEM drains along them. Returns
+/// the river centre cells (their bed is never lowered by a neighbour's bank).
+std::vector<char> burn_beds(Raster<float>& dem, const Field& f, const std::vector<RiverPath>& paths,
+                            const std::vector<std::vector<double>>& masses, double drop) {
+  std::vector<char> centre(dem.size(), 0);
   std::vector<std::vector<double>> bed(paths.size());
   std::vector<int> order;  // receiving rivers before their tributaries
   {
@@ -584,40 +541,99 @@ GeneratedTerrain generate_flow(const GenerateRequest& request) {
         }
     }
   }
-  // Interfluves (beyond the thesis): the skeleton leaves the ground between two rivers free, and
-  // DMMC between two beds at one altitude gives a floor that drains anywhere (45 % of the river
-  // length on a D8 stream at 257², seed 3). The cells half-way between rivers (where the nearest
-  // river cell jumps) are fixed at the basin height plus a hillslope from the nearer bed as steep
-  // as the basin's own slope there (0.15 to 2 m/m, the rise at most half the relief), so that the ground falls towards the river
-  // at least as fast as down the basin and DMMC draws a valley around every river.
-  {
-    auto gradient = [&](int c, int r) {  // |grad a| in m/m, central differences
-      const int c0 = std::max(0, c - 1), c1 = std::min(cols - 1, c + 1), r0 = std::max(0, r - 1), r1 = std::min(rows - 1, r + 1);
-      const double gx = (f.a[f.at(c1, r)] - f.a[f.at(c0, r)]) / ((c1 - c0) * request.cell_m);
-      const double gy = (f.a[f.at(c, r1)] - f.a[f.at(c, r0)]) / ((r1 - r0) * request.cell_m);
-      return std::hypot(gx, gy);
-    };
-    std::vector<double> dist;
-    std::vector<std::size_t> nearest;
-    distance_to(centre, cols, rows, dist, nearest);
-    for (int r = 0; r < rows; ++r)
-      for (int c = 0; c < cols; ++c) {
-        const std::size_t i = dem.index(c, r);
-        if (std::isfinite(dem[i]) || dist[i] < 2) continue;
-        bool divide = false;
-        for (int k = 0; k < 8 && !divide; k += 2) {
-          const int nc = c + dcol[std::size_t(k)], nr = r + drow[std::size_t(k)];
-          if (!dem.inside(nc, nr)) continue;
-          const std::size_t a = nearest[i], b = nearest[dem.index(nc, nr)];
-          const double jump = std::hypot(double(a % std::size_t(cols)) - double(b % std::size_t(cols)),
-                                         double(a / std::size_t(cols)) - double(b / std::size_t(cols)));
-          divide = jump > 3;
-        }
-        const double hill = std::clamp(gradient(c, r), 0.15, 2.0);  // at most 63°
-        const double rise = std::min(hill * dist[i] * request.cell_m, 0.5 * request.relief_m);
-        if (divide) dem[i] = float(std::max<double>(f.a[i], dem[nearest[i]]) + rise);
+  return centre;
+}
+
+/// Interfluves (beyond the thesis): the skeleton leaves the ground between two rivers free, and
+/// DMMC between two beds at one altitude gives a floor that drains anywhere (45 % of the river
+/// length on a D8 stream at 257², seed 3). The cells half-way between rivers (where the nearest
+/// river cell jumps) are fixed at the basin height plus a hillslope from the nearer bed as steep
+/// as the basin's own slope there (0.15 to 2 m/m, the rise at most half the relief), so that the ground falls towards the river
+/// at least as fast as down the basin and DMMC draws a valley around every river.
+void fix_interfluves(Raster<float>& dem, const Field& f, const std::vector<char>& centre, double cell_m, double relief_m) {
+  const int cols = f.cols, rows = f.rows;
+  auto gradient = [&](int c, int r) {  // |grad a| in m/m, central differences
+    const int c0 = std::max(0, c - 1), c1 = std::min(cols - 1, c + 1), r0 = std::max(0, r - 1), r1 = std::min(rows - 1, r + 1);
+    const double gx = (f.a[f.at(c1, r)] - f.a[f.at(c0, r)]) / ((c1 - c0) * cell_m);
+    const double gy = (f.a[f.at(c, r1)] - f.a[f.at(c, r0)]) / ((r1 - r0) * cell_m);
+    return std::hypot(gx, gy);
+  };
+  std::vector<double> dist;
+  std::vector<std::size_t> nearest;
+  distance_to(centre, cols, rows, dist, nearest);
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c) {
+      const std::size_t i = dem.index(c, r);
+      if (std::isfinite(dem[i]) || dist[i] < 2) continue;
+      bool divide = false;
+      for (int k = 0; k < 8 && !divide; k += 2) {
+        const int nc = c + dcol[std::size_t(k)], nr = r + drow[std::size_t(k)];
+        if (!dem.inside(nc, nr)) continue;
+        const std::size_t a = nearest[i], b = nearest[dem.index(nc, nr)];
+        const double jump = std::hypot(double(a % std::size_t(cols)) - double(b % std::size_t(cols)),
+                                       double(a / std::size_t(cols)) - double(b / std::size_t(cols)));
+        divide = jump > 3;
       }
+      const double hill = std::clamp(gradient(c, r), 0.15, 2.0);  // at most 63°
+      const double rise = std::min(hill * dist[i] * cell_m, 0.5 * relief_m);
+      if (divide) dem[i] = float(std::max<double>(f.a[i], dem[nearest[i]]) + rise);
+    }
+}
+
+}  // namespace
+
+GeneratedTerrain generate_flow(const GenerateRequest& request) {
+  using clock = std::chrono::steady_clock;
+  const auto t0 = clock::now();
+  const int cols = request.grid.cols(), rows = request.grid.rows();
+  Field f{cols, rows, std::vector<float>(std::size_t(cols) * rows, 0.0f), std::vector<int>(std::size_t(cols) * rows, -1),
+          std::vector<int>(std::size_t(cols) * rows, -1)};
+  Rng rng(request.seed);
+  const double size = std::min(cols, rows);
+  RidgeParams rp;
+  rp.speed = std::max(2.0, size / 50);
+  rp.sigma1 = size / 16;
+  rp.sigma2 = size / 4;
+  // A base rising gently away from the border: the thesis's only mouths are the border, and this
+  // keeps every basin draining to it (the basins alone leave flat floors where particles stall).
+  const double base_m = 0.1 * request.relief_m;
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c) {
+      const double d = std::min({c + 0.5, r + 0.5, cols - c - 0.5, rows - r - 0.5});
+      f.a[f.at(c, r)] = float(base_m * std::min(1.0, d / (size / 2)));
+    }
+  Skeleton skeleton;
+  if (request.lines.empty()) {
+    const int pairs = std::max(2, int(std::lround(double(cols) * rows / 60000.0)));
+    skeleton.ridges = random_ridges(f, pairs, request.relief_m, rp, rng);
+  } else {
+    skeleton.ridges = given_ridges(f, request.lines, request.relief_m, rp);
   }
+  smooth_basins(f);
+
+  RiverSystem rivers(f, request.cell_m, RiverParams{}, rng);
+  // A particle stands for the water of its strip of slope, `spacing` cells wide: its channel head
+  // is `spacing` cells down its track, where it drains spacing² cells (see channels()).
+  const double spacing = std::max(3.0, size / 20);
+  seed_particles(rivers, skeleton.ridges, spacing);
+  rivers.run();
+  std::vector<RiverPath> paths = rivers.paths();
+  const auto masses = path_masses(paths);
+  for (std::size_t i = 0; i < paths.size(); ++i)
+    for (double m : masses[i]) paths[i].width_m.push_back(std::max(1.0, std::log2(m)) * request.cell_m);
+  skeleton.rivers = reaches_from_paths(channels(paths, std::size_t(std::lround(spacing))));
+  const double skeleton_s = std::chrono::duration<double>(clock::now() - t0).count();
+
+  // The skeleton DEM: ridge and river cells keep their altitude, everything else is unknown.
+  GeneratedTerrain out;
+  out.dem = request.grid;
+  out.skeleton = std::move(skeleton);
+  Raster<float>& dem = out.dem;
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c)
+      if (f.ridge[f.at(c, r)] >= 0) dem(c, r) = f.a[f.at(c, r)];
+  const std::vector<char> centre = burn_beds(dem, f, paths, masses, 1e-3 * request.cell_m);
+  fix_interfluves(dem, f, centre, request.cell_m, request.relief_m);
   const auto t1 = clock::now();
   dmmc(dem, request.dmmc, request.progress);
   out.timings.emplace_back("skeleton", skeleton_s);

@@ -105,27 +105,26 @@ Plates make_plates(const std::vector<GridPoint>& mountains, int cols, int rows, 
   return p;
 }
 
-}  // namespace
+/// Random mountain chains: a few lines of points, as a user would sketch them.
+std::vector<GridPoint> random_mountains(int cols, int rows, Rng& rng) {
+  const double size = std::min(cols, rows);
+  std::vector<GridPoint> mountains;
+  const int chains = std::max(2, int(std::lround(double(cols) * rows / 40000.0)));
+  for (int k = 0; k < chains; ++k) {
+    const double x = (0.15 + 0.7 * rng.uniform()) * cols, y = (0.15 + 0.7 * rng.uniform()) * rows;
+    const double t = rng.uniform() * 3.14159265358979;
+    for (int j = -2; j <= 2; ++j)
+      mountains.push_back({x + j * size / 12 * std::cos(t) + rng.symmetric() * size / 40, y + j * size / 12 * std::sin(t) + rng.symmetric() * size / 40});
+  }
+  return mountains;
+}
 
-GeneratedTerrain generate_tectonic(const GenerateRequest& request) {
-  const auto t0 = std::chrono::steady_clock::now();
-  const int cols = request.grid.cols(), rows = request.grid.rows();
+/// Folds: an fBm stretched across each plate's motion (ridges perpendicular to the shortening)
+/// and distorted by the velocity field, damped with the distance to a boundary; convergent
+/// boundaries fold fully, divergent ones a quarter (the report's suggested map of boundary types).
+std::vector<double> plate_folds(const Plates& plates, int cols, int rows, std::uint64_t seed) {
   const std::size_t n = std::size_t(cols) * rows;
   const double size = std::min(cols, rows);
-  Rng rng(request.seed);
-
-  std::vector<GridPoint> mountains = request.points;
-  if (mountains.empty()) {  // random mountain chains: a few lines of points, as a user would sketch them
-    const int chains = std::max(2, int(std::lround(double(cols) * rows / 40000.0)));
-    for (int k = 0; k < chains; ++k) {
-      const double x = (0.15 + 0.7 * rng.uniform()) * cols, y = (0.15 + 0.7 * rng.uniform()) * rows;
-      const double t = rng.uniform() * 3.14159265358979;
-      for (int j = -2; j <= 2; ++j)
-        mountains.push_back({x + j * size / 12 * std::cos(t) + rng.symmetric() * size / 40, y + j * size / 12 * std::sin(t) + rng.symmetric() * size / 40});
-    }
-  }
-  const Plates plates = make_plates(mountains, cols, rows, 0.9);
-
   // Plate boundaries and how much they converge: (v_a - v_b) . o > 0 when plate a moves towards b.
   std::vector<char> boundary(n, 0);
   std::vector<double> convergence(n, 0);
@@ -150,9 +149,6 @@ GeneratedTerrain generate_tectonic(const GenerateRequest& request) {
   if (std::find(boundary.begin(), boundary.end(), 1) == boundary.end()) boundary[0] = 1;  // one plate: damp from a corner
   distance_to(boundary, cols, rows, to_boundary, nearest_boundary);
 
-  // Folds: an fBm stretched across each plate's motion (ridges perpendicular to the shortening)
-  // and distorted by the velocity field, damped with the distance to a boundary; convergent
-  // boundaries fold fully, divergent ones a quarter (the report's suggested map of boundary types).
   const double wavelength = size / 10, damping = size / 6;
   std::vector<double> folds(n);
   for (int r = 0; r < rows; ++r)
@@ -161,58 +157,112 @@ GeneratedTerrain generate_tectonic(const GenerateRequest& request) {
       const Vec& v = plates.velocity[std::size_t(plates.of[i])];
       const double norm = std::hypot(v[0], v[1]);
       const Vec u = norm > 0 ? Vec{v[0] / norm, v[1] / norm} : Vec{1, 0};
-      const double warp = 0.5 * fbm(request.seed ^ 0x51u, c / wavelength, r / wavelength, 3);
+      const double warp = 0.5 * fbm(seed ^ 0x51u, c / wavelength, r / wavelength, 3);
       const double x = c + warp * v[0], y = r + warp * v[1];
       const double along = (x * u[0] + y * u[1]) / wavelength, across = (-x * u[1] + y * u[0]) / (4 * wavelength);
-      const double fold = 0.5 + 0.5 * fbm(request.seed, along, across, 5);
+      const double fold = 0.5 + 0.5 * fbm(seed, along, across, 5);
       const double kind = 0.25 + 0.75 * std::clamp(convergence[nearest_boundary[i]], 0.0, 1.0);
       folds[i] = fold * kind * std::exp(-std::pow(to_boundary[i] / damping, 2));
     }
+  return folds;
+}
 
-  // River base map, grown from the ocean (the grid border) along a random drainage tree: invasion
-  // percolation (Stark 1991, Nature 352), the front always taking the land cell of least resistance,
-  // so the network grows headwards; low folds resist least, so rivers take the fold valleys. Heights then rise from the ocean along the tree with Flint's slope-area law
-  // S = k A^-0.5 (Flint 1974), the concave long profiles of real rivers.
-  std::vector<std::size_t> receiver(n, n);
+/// The drainage tree: each cell's receiver (n for the ocean) and the cells in growth order.
+struct DrainageTree {
+  std::vector<std::size_t> receiver, order;
+};
+
+/// The river base map's tree, grown from the ocean (the grid border): invasion percolation
+/// (Stark 1991, Nature 352), the front always taking the land cell of least resistance, so the
+/// network grows headwards; low folds resist least, so rivers take the fold valleys.
+DrainageTree drainage_tree(const std::vector<double>& folds, int cols, int rows, std::uint64_t seed) {
+  const std::size_t n = std::size_t(cols) * rows;
+  DrainageTree tree{std::vector<std::size_t>(n, n), {}};
   std::vector<double> cost(n, 1e300);
-  std::vector<std::size_t> order;
-  order.reserve(n);
-  {
-    using Item = std::pair<double, std::size_t>;
-    std::priority_queue<Item, std::vector<Item>, std::greater<>> queue;
-    for (int r = 0; r < rows; ++r)
-      for (int c = 0; c < cols; ++c)
-        if (r == 0 || c == 0 || r == rows - 1 || c == cols - 1) {
-          const std::size_t i = std::size_t(r) * std::size_t(cols) + std::size_t(c);
-          cost[i] = 0, queue.push({0.0, i});
-        }
-    std::vector<char> done(n, 0);
-    while (!queue.empty()) {
-      const std::size_t i = queue.top().second;
-      queue.pop();
-      if (done[i]) continue;
-      done[i] = 1;
-      order.push_back(i);
-      const int c = int(i % std::size_t(cols)), r = int(i / std::size_t(cols));
-      for (int k = 0; k < 8; ++k) {
-        const int nc = c + dcol[std::size_t(k)], nr = r + drow[std::size_t(k)];
-        if (nc < 0 || nr < 0 || nc >= cols || nr >= rows) continue;
-        const std::size_t j = std::size_t(nr) * std::size_t(cols) + std::size_t(nc);
-        if (done[j]) continue;
-        // Folds steer the growth: rivers grow more easily where the folds are low (the valleys).
-        const double resistance = position_noise(request.seed ^ 0xa5u, nc, nr) + 1 + 3 * folds[j];
-        if (resistance < cost[j]) cost[j] = resistance, receiver[j] = i, queue.push({resistance, j});
+  tree.order.reserve(n);
+  using Item = std::pair<double, std::size_t>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<>> queue;
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c)
+      if (r == 0 || c == 0 || r == rows - 1 || c == cols - 1) {
+        const std::size_t i = std::size_t(r) * std::size_t(cols) + std::size_t(c);
+        cost[i] = 0, queue.push({0.0, i});
       }
+  std::vector<char> done(n, 0);
+  while (!queue.empty()) {
+    const std::size_t i = queue.top().second;
+    queue.pop();
+    if (done[i]) continue;
+    done[i] = 1;
+    tree.order.push_back(i);
+    const int c = int(i % std::size_t(cols)), r = int(i / std::size_t(cols));
+    for (int k = 0; k < 8; ++k) {
+      const int nc = c + dcol[std::size_t(k)], nr = r + drow[std::size_t(k)];
+      if (nc < 0 || nr < 0 || nc >= cols || nr >= rows) continue;
+      const std::size_t j = std::size_t(nr) * std::size_t(cols) + std::size_t(nc);
+      if (done[j]) continue;
+      // Folds steer the growth: rivers grow more easily where the folds are low (the valleys).
+      const double resistance = position_noise(seed ^ 0xa5u, nc, nr) + 1 + 3 * folds[j];
+      if (resistance < cost[j]) cost[j] = resistance, tree.receiver[j] = i, queue.push({resistance, j});
     }
   }
+  return tree;
+}
+
+/// The skeleton: river paths from every source down the tree to the ocean or a confluence.
+std::vector<RiverPath> tree_rivers(const DrainageTree& tree, const std::vector<char>& river, int cols) {
+  const std::size_t n = river.size();
+  const auto& receiver = tree.receiver;
+  std::vector<int> path_of(n, -1);
+  std::vector<std::size_t> index_in(n, 0);
+  std::vector<char> has_upstream(n, 0);
+  for (std::size_t i = 0; i < n; ++i)
+    if (river[i] && receiver[i] < n && river[receiver[i]]) has_upstream[receiver[i]] = 1;
+  std::vector<RiverPath> paths;
+  for (std::size_t k = tree.order.size(); k-- > 0;) {  // sources in a fixed order: upstream first
+    const std::size_t s = tree.order[k];
+    if (!river[s] || has_upstream[s]) continue;
+    RiverPath p;
+    const int id = int(paths.size());
+    std::size_t i = s;
+    for (; i < n && river[i] && path_of[i] < 0; i = receiver[i]) {
+      path_of[i] = id, index_in[i] = p.line.size();
+      p.line.push_back({double(i % std::size_t(cols)), double(i / std::size_t(cols))});
+    }
+    if (i < n) {
+      p.line.push_back({double(i % std::size_t(cols)), double(i / std::size_t(cols))});
+      if (path_of[i] >= 0) p.into = path_of[i], p.at = index_in[i];
+    }
+    if (p.line.size() >= 2) paths.push_back(std::move(p));
+  }
+  return paths;
+}
+
+}  // namespace
+
+GeneratedTerrain generate_tectonic(const GenerateRequest& request) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const int cols = request.grid.cols(), rows = request.grid.rows();
+  const std::size_t n = std::size_t(cols) * rows;
+  const double size = std::min(cols, rows);
+  Rng rng(request.seed);
+
+  const std::vector<GridPoint> mountains = request.points.empty() ? random_mountains(cols, rows, rng) : request.points;
+  const Plates plates = make_plates(mountains, cols, rows, 0.9);
+  const std::vector<double> folds = plate_folds(plates, cols, rows, request.seed);
+
+  // River base map along a random drainage tree; heights then rise from the ocean along the tree
+  // with Flint's slope-area law S = k A^-0.5 (Flint 1974), the concave long profiles of real rivers.
+  const DrainageTree tree = drainage_tree(folds, cols, rows, request.seed);
+  const auto& receiver = tree.receiver;
   std::vector<double> area(n, 1.0);
-  for (std::size_t k = order.size(); k-- > 0;)
-    if (receiver[order[k]] < n) area[receiver[order[k]]] += area[order[k]];
+  for (std::size_t k = tree.order.size(); k-- > 0;)
+    if (receiver[tree.order[k]] < n) area[receiver[tree.order[k]]] += area[tree.order[k]];
   const double cell_km2 = request.cell_m * request.cell_m / 1e6;
   const double channel_cells = std::max(8.0, 0.1 / cell_km2);  // channels from 0.1 km² upstream
   std::vector<double> base(n, 0.0);
   const double k_s = 0.5 * request.relief_m / (size * request.cell_m) * std::sqrt(channel_cells);
-  for (std::size_t i : order) {
+  for (std::size_t i : tree.order) {
     if (receiver[i] >= n) continue;
     const std::size_t j = receiver[i];
     const int dc = int(i % std::size_t(cols)) - int(j % std::size_t(cols)), dr = int(i / std::size_t(cols)) - int(j / std::size_t(cols));
@@ -240,29 +290,7 @@ GeneratedTerrain generate_tectonic(const GenerateRequest& request) {
     out.dem[i] = float(base[i] + w * request.relief_m * folds[i]);
   }
 
-  // The skeleton: river paths from every source down the tree to the ocean or a confluence.
-  std::vector<int> path_of(n, -1);
-  std::vector<std::size_t> index_in(n, 0);
-  std::vector<char> has_upstream(n, 0);
-  for (std::size_t i = 0; i < n; ++i)
-    if (river[i] && receiver[i] < n && river[receiver[i]]) has_upstream[receiver[i]] = 1;
-  std::vector<RiverPath> paths;
-  for (std::size_t k = order.size(); k-- > 0;) {  // sources in a fixed order: upstream first
-    const std::size_t s = order[k];
-    if (!river[s] || has_upstream[s]) continue;
-    RiverPath p;
-    const int id = int(paths.size());
-    std::size_t i = s;
-    for (; i < n && river[i] && path_of[i] < 0; i = receiver[i]) {
-      path_of[i] = id, index_in[i] = p.line.size();
-      p.line.push_back({double(i % std::size_t(cols)), double(i / std::size_t(cols))});
-    }
-    if (i < n) {
-      p.line.push_back({double(i % std::size_t(cols)), double(i / std::size_t(cols))});
-      if (path_of[i] >= 0) p.into = path_of[i], p.at = index_in[i];
-    }
-    if (p.line.size() >= 2) paths.push_back(std::move(p));
-  }
+  std::vector<RiverPath> paths = tree_rivers(tree, river, cols);
   // Wider downstream: log2 of the upstream cells over the channel area, as the flow method does.
   for (auto& p : paths)
     for (const auto& q : p.line)

@@ -172,22 +172,20 @@ LinearRow type2_row(int p1, Point2 a, int p2, Point2 b, Point2 r, double zr, dou
   return {{{p1, 1 - s}, {p2, s}}, zr + bank_slope * distance};
 }
 
-PlanarMap build_planar_map(const BinaryTree& tree, double width_m, double height_m, const PlanarParams& params) {
+namespace {
+
+/// §6.3.1: level k on the half circle of radius r_k around the root; sectors split by the
+/// barycentric rule a_n = θ_i + Δ O_d/(O_d+O_g) with Strahler orders; the right child's sector is
+/// the one of smaller angles. The child of a node at level k stays within acos(r_k/r_k+1) of its
+/// parent's angle, so that the angle at the parent between its partition ray and the edge is < 90°.
+/// r_k linear in k, as the chapter suggests (a concave law, tried to fill more of the grid with the
+/// deep random trees, made narrower facets and fewer D8-consistent rivers). The extra vertex (the
+/// mouth) goes below the root on the root's partition ray.
+void place_tree(const BinaryTree& tree, const std::vector<int>& order, double width_m, double height_m, PlanarMap& map) {
   const int n_tree = tree.size();
-  const std::vector<int> order = strahler_orders(tree);
   std::vector<int> depth(std::size_t(n_tree), 0);
   int max_depth = 0;
   for (int n = 1; n < n_tree; ++n) max_depth = std::max(max_depth, depth[std::size_t(n)] = depth[std::size_t(tree.parent[std::size_t(n)])] + 1);
-  for (int n = 0; n < n_tree; ++n)
-    if (tree.parent[std::size_t(n)] >= 0 && tree.parent[std::size_t(n)] > n) throw Error(ErrorKind::processing, "tree: a child precedes its parent");
-
-  // §6.3.1: level k on the half circle of radius r_k around the root; sectors split by the
-  // barycentric rule a_n = θ_i + Δ O_d/(O_d+O_g) with Strahler orders; the right child's sector is
-  // the one of smaller angles. The child of a node at level k stays within acos(r_k/r_k+1) of its
-  // parent's angle, so that the angle at the parent between its partition ray and the edge is < 90°.
-  // r_k linear in k, as the chapter suggests (a concave law, tried to fill more of the grid with the
-  // deep random trees, made narrower facets and fewer D8-consistent rivers).
-  PlanarMap map;
   const double margin = 0.04 * std::min(width_m, height_m);
   const double reach_m = std::min(width_m / 2 - margin, height_m - 2 * margin);
   const auto radius_of = [&](int k) { return reach_m * double(k) / (max_depth + 1.0); };
@@ -203,8 +201,6 @@ PlanarMap build_planar_map(const BinaryTree& tree, double width_m, double height
     return lo[std::size_t(n)] + (hi[std::size_t(n)] - lo[std::size_t(n)]) * od / (od + og);
   };
   map.p.resize(std::size_t(n_tree) + 1);
-  map.z.assign(std::size_t(n_tree) + 1, 0);
-  map.kind.assign(std::size_t(n_tree) + 1, PlanarMap::Kind::river);
   for (int n = 0; n < n_tree; ++n) {
     const std::size_t i = std::size_t(n);
     if (n > 0) {
@@ -231,19 +227,15 @@ PlanarMap build_planar_map(const BinaryTree& tree, double width_m, double height
       hi[std::size_t(l)] = hi[i];
     }
   }
-  // The extra vertex (the mouth) below the root on the root's partition ray.
   map.mouth = n_tree;
   map.p[std::size_t(n_tree)] = {root.x - r0 * std::cos(angle[0]), root.y + r0 * std::sin(angle[0])};
+}
 
-  // §6.3.4.1: DALT(n) = CRIV / Strahler(n)^a above the parent; the mouth at 0.
-  map.z[std::size_t(n_tree)] = 0;
-  for (int n = 0; n < n_tree; ++n) {
-    const double base = n == 0 ? 0.0 : map.z[std::size_t(tree.parent[std::size_t(n)])];
-    map.z[std::size_t(n)] = base + params.drop_m / std::pow(order[std::size_t(n)], params.drop_exponent);
-  }
-
-  // §6.2.2: breadth-first, right to left, each internal node n on the outer boundary gets its
-  // children n1 (right) and n2 (left) and five edges: n-n1, n-n2, n1-n2, n1-nd, n2-ng.
+/// §6.2.2: breadth-first, right to left, each internal node n on the outer boundary gets its
+/// children n1 (right) and n2 (left) and five edges: n-n1, n-n2, n1-n2, n1-nd, n2-ng. The
+/// triangles, the mouth (vertex tree.size()) closing the boundary.
+std::vector<std::array<int, 3>> coarse_facets(const BinaryTree& tree) {
+  const int n_tree = tree.size();
   std::vector<int> next(std::size_t(n_tree) + 1, -1), prev(std::size_t(n_tree) + 1, -1);  // boundary, right to left
   const int x = n_tree;
   next[std::size_t(x)] = 0;
@@ -269,143 +261,189 @@ PlanarMap build_planar_map(const BinaryTree& tree, double width_m, double height
     queue.push_back(n1);
     queue.push_back(n2);
   }
-  // River edges: the tree's and the root edge.
-  std::map<std::uint64_t, PlanarMap::RiverEdge> river;
-  for (int n = 0; n < n_tree; ++n)
-    river[edge_key(n, n == 0 ? x : tree.parent[std::size_t(n)])] = {n, n == 0 ? x : tree.parent[std::size_t(n)], order[std::size_t(n)]};
+  return coarse;
+}
 
-  // §6.2.4: a ridge vertex in the middle of every non-river edge (§6.3.2.2), then the facets retriangulated.
-  std::map<std::uint64_t, int> ridge_vertex;
-  const auto ridge_on = [&](int a, int b) {
-    auto [it, fresh] = ridge_vertex.emplace(edge_key(a, b), int(map.p.size()));
+/// §6.2.4: a ridge vertex in the middle of every non-river edge (§6.3.2.2), the facets
+/// retriangulated, and the linear constraints on the ridge vertices' altitudes.
+class RidgeFacets {
+ public:
+  RidgeFacets(PlanarMap& map, const std::map<std::uint64_t, PlanarMap::RiverEdge>& river, double bank_slope)
+      : map_(map), river_(river), bank_slope_(bank_slope) {}
+
+  void split(const std::vector<std::array<int, 3>>& coarse, Rng& draw) {
+    for (const auto& f : coarse) {
+      int river_sides = 0;
+      for (int k = 0; k < 3; ++k) river_sides += is_river(f[std::size_t(k)], f[std::size_t((k + 1) % 3)]) ? 1 : 0;
+      // Rotate so that f = (a, b, c) with a-b a river edge (and, for two, a-c the other).
+      std::array<int, 3> t = f;
+      for (int k = 0; k < 3 && !(is_river(t[0], t[1]) && (river_sides == 1 || is_river(t[0], t[2]))); ++k) t = {t[1], t[2], t[0]};
+      const int a = t[0], b = t[1], c = t[2];
+      if (river_sides == 2) {  // a junction: one ridge vertex on b-c, where the ridge between the two branches starts
+        const int p = ridge_on(b, c);
+        type1(a, b, p);
+        type1(a, c, p);
+      } else if (river_sides == 1) {  // one river edge a-b: ridge vertices on b-c and c-a, joined by a ridge edge
+        const int p = ridge_on(b, c), q = ridge_on(c, a);
+        type2(c, p, q);
+        if (draw.uniform() < 0.5) {
+          type1(a, b, p);
+          type2(a, p, q);
+        } else {
+          type1(a, b, q);
+          type2(b, p, q);
+        }
+      } else {
+        throw Error(ErrorKind::processing, "planar map: a facet without a river edge (the construction of §6.2.2 never makes one)");
+      }
+    }
+    // A ridge vertex stands above both ends of its edge (our bound; it keeps each LP bounded).
+    for (const auto& [key, p] : ridge_vertex_) {
+      const int a = int(key >> 32), b = int(key & 0xffffffffu);
+      const double half = 0.5 * norm(map_.p[std::size_t(a)] - map_.p[std::size_t(b)]);
+      rows_.push_back({{{p, 1.0}}, std::max(map_.z[std::size_t(a)], map_.z[std::size_t(b)]) + bank_slope_ * half});
+    }
+  }
+
+  /// §6.3.4.2.2: one LP per ridge line (connected ridge vertices), minimising the sum of altitudes.
+  void solve_altitudes() {
+    Components comp(map_.p.size());
+    for (auto [p, q] : ridge_edges_) comp.join(p, q);
+    std::map<int, std::vector<int>> variables;
+    std::map<int, std::vector<LinearRow>> problems;
+    for (const auto& [key, p] : ridge_vertex_) variables[comp.find(p)].push_back(p);
+    for (const LinearRow& row : rows_) problems[comp.find(row.terms[0].first)].push_back(row);
+    for (auto& [root_id, vars] : variables) {
+      std::sort(vars.begin(), vars.end());
+      const std::vector<double> z = solve_min_sum(vars, problems[root_id]);
+      for (std::size_t i = 0; i < vars.size(); ++i) map_.z[std::size_t(vars[i])] = z[i];
+      map_.lp_variables += vars.size();
+      map_.lp_constraints += problems[root_id].size();
+      ++map_.lp_problems;
+    }
+  }
+
+  const std::vector<std::pair<int, int>>& ridge_edges() const { return ridge_edges_; }
+
+ private:
+  bool is_river(int a, int b) const { return river_.count(edge_key(a, b)) > 0; }
+  int ridge_on(int a, int b) {
+    auto [it, fresh] = ridge_vertex_.emplace(edge_key(a, b), int(map_.p.size()));
     if (fresh) {
-      map.p.push_back(0.5 * (map.p[std::size_t(a)] + map.p[std::size_t(b)]));
-      map.z.push_back(0);
-      map.kind.push_back(PlanarMap::Kind::ridge);
+      map_.p.push_back(0.5 * (map_.p[std::size_t(a)] + map_.p[std::size_t(b)]));
+      map_.z.push_back(0);
+      map_.kind.push_back(PlanarMap::Kind::ridge);
     }
     return it->second;
-  };
-  Rng draw(params.seed);
-  std::vector<LinearRow> rows;
-  std::vector<std::pair<int, int>> ridge_edges;
-  const auto type1 = [&](int r1, int r2, int p) {
-    map.facets.push_back({r1, r2, p});
-    rows.push_back(type1_row(map.p[std::size_t(r1)], map.z[std::size_t(r1)], map.p[std::size_t(r2)], map.z[std::size_t(r2)], p,
-                             map.p[std::size_t(p)], params.bank_slope));
-  };
-  const auto type2 = [&](int r, int p1, int p2) {
-    map.facets.push_back({r, p1, p2});
-    rows.push_back(type2_row(p1, map.p[std::size_t(p1)], p2, map.p[std::size_t(p2)], map.p[std::size_t(r)], map.z[std::size_t(r)],
-                             params.bank_slope));
-    ridge_edges.emplace_back(p1, p2);
-  };
-  for (const auto& f : coarse) {
-    int river_sides = 0;
-    for (int k = 0; k < 3; ++k) river_sides += river.count(edge_key(f[std::size_t(k)], f[std::size_t((k + 1) % 3)])) ? 1 : 0;
-    // Rotate so that f = (a, b, c) with a-b a river edge (and, for two, a-c the other).
-    std::array<int, 3> t = f;
-    for (int k = 0; k < 3 && !(river.count(edge_key(t[0], t[1])) && (river_sides == 1 || river.count(edge_key(t[0], t[2])))); ++k)
-      t = {t[1], t[2], t[0]};
-    const int a = t[0], b = t[1], c = t[2];
-    if (river_sides == 2) {  // a junction: one ridge vertex on b-c, where the ridge between the two branches starts
-      const int p = ridge_on(b, c);
-      type1(a, b, p);
-      type1(a, c, p);
-    } else if (river_sides == 1) {  // one river edge a-b: ridge vertices on b-c and c-a, joined by a ridge edge
-      const int p = ridge_on(b, c), q = ridge_on(c, a);
-      type2(c, p, q);
-      if (draw.uniform() < 0.5) {
-        type1(a, b, p);
-        type2(a, p, q);
-      } else {
-        type1(a, b, q);
-        type2(b, p, q);
-      }
-    } else {
-      throw Error(ErrorKind::processing, "planar map: a facet without a river edge (the construction of §6.2.2 never makes one)");
-    }
   }
-  // A ridge vertex stands above both ends of its edge (our bound; it keeps each LP bounded).
-  for (const auto& [key, p] : ridge_vertex) {
+  void type1(int r1, int r2, int p) {
+    map_.facets.push_back({r1, r2, p});
+    rows_.push_back(type1_row(map_.p[std::size_t(r1)], map_.z[std::size_t(r1)], map_.p[std::size_t(r2)], map_.z[std::size_t(r2)], p,
+                              map_.p[std::size_t(p)], bank_slope_));
+  }
+  void type2(int r, int p1, int p2) {
+    map_.facets.push_back({r, p1, p2});
+    rows_.push_back(type2_row(p1, map_.p[std::size_t(p1)], p2, map_.p[std::size_t(p2)], map_.p[std::size_t(r)], map_.z[std::size_t(r)],
+                              bank_slope_));
+    ridge_edges_.emplace_back(p1, p2);
+  }
+
+  PlanarMap& map_;
+  const std::map<std::uint64_t, PlanarMap::RiverEdge>& river_;
+  const double bank_slope_;
+  std::map<std::uint64_t, int> ridge_vertex_;
+  std::vector<LinearRow> rows_;
+  std::vector<std::pair<int, int>> ridge_edges_;
+};
+
+/// §6.2.5 global fractalisations: every facet into four; a new river vertex is pulled towards the
+/// centre of one adjacent facet (weight C_PONDERAL against 1 and 1 for the edge ends, §6.3.2.2),
+/// which keeps it inside that facet and below its midline, so the map stays planar; its altitude is
+/// the mean of the ends (the river still descends). Other new vertices rise by up to roughness × length.
+void fractalise(PlanarMap& map, const PlanarParams& params, Rng& draw) {
+  std::map<std::uint64_t, std::vector<int>> faces_of;
+  for (std::size_t f = 0; f < map.facets.size(); ++f)
+    for (int k = 0; k < 3; ++k) faces_of[edge_key(map.facets[f][std::size_t(k)], map.facets[f][std::size_t((k + 1) % 3)])].push_back(int(f));
+  std::map<std::uint64_t, PlanarMap::RiverEdge> river_now;
+  for (const auto& e : map.rivers) river_now[edge_key(e.up, e.down)] = e;
+  std::map<std::uint64_t, int> middle;
+  std::vector<PlanarMap::RiverEdge> rivers;
+  std::vector<std::pair<int, int>> ridges;
+  std::map<std::uint64_t, bool> ridge_now;
+  for (auto [a, b] : map.ridges) ridge_now[edge_key(a, b)] = true;
+  for (const auto& [key, faces] : faces_of) {
     const int a = int(key >> 32), b = int(key & 0xffffffffu);
-    const double half = 0.5 * norm(map.p[std::size_t(a)] - map.p[std::size_t(b)]);
-    rows.push_back({{{p, 1.0}}, std::max(map.z[std::size_t(a)], map.z[std::size_t(b)]) + params.bank_slope * half});
+    const Point2 pa = map.p[std::size_t(a)], pb = map.p[std::size_t(b)];
+    Point2 m = 0.5 * (pa + pb);
+    double z = 0.5 * (map.z[std::size_t(a)] + map.z[std::size_t(b)]);
+    PlanarMap::Kind kind = PlanarMap::Kind::other;
+    const auto r = river_now.find(key);
+    if (r != river_now.end()) {
+      const auto& f = map.facets[std::size_t(faces[std::size_t(integer(draw, 0, int(faces.size()) - 1))])];
+      const Point2 g = (1.0 / 3) * (map.p[std::size_t(f[0])] + map.p[std::size_t(f[1])] + map.p[std::size_t(f[2])]);
+      m = (1.0 / (2 + params.meander)) * (pa + pb + params.meander * g);
+      kind = PlanarMap::Kind::river;
+    } else {
+      z += params.roughness * norm(pb - pa) * draw.uniform();
+      if (ridge_now.count(key)) kind = PlanarMap::Kind::ridge;
+    }
+    middle[key] = int(map.p.size());
+    map.p.push_back(m);
+    map.z.push_back(z);
+    map.kind.push_back(kind);
+    if (r != river_now.end()) {
+      rivers.push_back({r->second.up, int(map.p.size() - 1), r->second.strahler});
+      rivers.push_back({int(map.p.size() - 1), r->second.down, r->second.strahler});
+    } else if (kind == PlanarMap::Kind::ridge) {
+      ridges.emplace_back(a, int(map.p.size() - 1));
+      ridges.emplace_back(int(map.p.size() - 1), b);
+    }
+  }
+  std::vector<std::array<int, 3>> facets;
+  facets.reserve(map.facets.size() * 4);
+  for (const auto& f : map.facets) {
+    const int ab = middle[edge_key(f[0], f[1])], bc = middle[edge_key(f[1], f[2])], ca = middle[edge_key(f[2], f[0])];
+    facets.push_back({f[0], ab, ca});
+    facets.push_back({ab, f[1], bc});
+    facets.push_back({ca, bc, f[2]});
+    facets.push_back({ab, bc, ca});
+  }
+  map.facets = std::move(facets);
+  map.rivers = std::move(rivers);
+  map.ridges = std::move(ridges);
+}
+
+}  // namespace
+
+PlanarMap build_planar_map(const BinaryTree& tree, double width_m, double height_m, const PlanarParams& params) {
+  const int n_tree = tree.size();
+  const std::vector<int> order = strahler_orders(tree);
+  for (int n = 0; n < n_tree; ++n)
+    if (tree.parent[std::size_t(n)] >= 0 && tree.parent[std::size_t(n)] > n) throw Error(ErrorKind::processing, "tree: a child precedes its parent");
+  PlanarMap map;
+  place_tree(tree, order, width_m, height_m, map);
+  map.kind.assign(std::size_t(n_tree) + 1, PlanarMap::Kind::river);
+
+  // §6.3.4.1: DALT(n) = CRIV / Strahler(n)^a above the parent; the mouth at 0.
+  map.z.assign(std::size_t(n_tree) + 1, 0);
+  for (int n = 0; n < n_tree; ++n) {
+    const double base = n == 0 ? 0.0 : map.z[std::size_t(tree.parent[std::size_t(n)])];
+    map.z[std::size_t(n)] = base + params.drop_m / std::pow(order[std::size_t(n)], params.drop_exponent);
   }
 
-  // §6.3.4.2.2: one LP per ridge line (connected ridge vertices), minimising the sum of altitudes.
-  Components comp(map.p.size());
-  for (auto [p, q] : ridge_edges) comp.join(p, q);
-  std::map<int, std::vector<int>> variables;
-  std::map<int, std::vector<LinearRow>> problems;
-  for (const auto& [key, p] : ridge_vertex) variables[comp.find(p)].push_back(p);
-  for (const LinearRow& row : rows) problems[comp.find(row.terms[0].first)].push_back(row);
-  for (auto& [root_id, vars] : variables) {
-    std::sort(vars.begin(), vars.end());
-    const std::vector<double> z = solve_min_sum(vars, problems[root_id]);
-    for (std::size_t i = 0; i < vars.size(); ++i) map.z[std::size_t(vars[i])] = z[i];
-    map.lp_variables += vars.size();
-    map.lp_constraints += problems[root_id].size();
-    ++map.lp_problems;
-  }
+  const std::vector<std::array<int, 3>> coarse = coarse_facets(tree);
+  // River edges: the tree's and the root edge (to the mouth).
+  std::map<std::uint64_t, PlanarMap::RiverEdge> river;
+  for (int n = 0; n < n_tree; ++n)
+    river[edge_key(n, n == 0 ? n_tree : tree.parent[std::size_t(n)])] = {n, n == 0 ? n_tree : tree.parent[std::size_t(n)], order[std::size_t(n)]};
+
+  Rng draw(params.seed);
+  RidgeFacets ridges(map, river, params.bank_slope);
+  ridges.split(coarse, draw);
+  ridges.solve_altitudes();
   for (auto [key, e] : river) map.rivers.push_back(e);
-  map.ridges = ridge_edges;
-
-  // §6.2.5 global fractalisations: every facet into four; a new river vertex is pulled towards the
-  // centre of one adjacent facet (weight C_PONDERAL against 1 and 1 for the edge ends, §6.3.2.2),
-  // which keeps it inside that facet and below its midline, so the map stays planar; its altitude is
-  // the mean of the ends (the river still descends). Other new vertices rise by up to roughness × length.
-  for (int pass = 0; pass < params.fractalisations; ++pass) {
-    std::map<std::uint64_t, std::vector<int>> faces_of;
-    for (std::size_t f = 0; f < map.facets.size(); ++f)
-      for (int k = 0; k < 3; ++k) faces_of[edge_key(map.facets[f][std::size_t(k)], map.facets[f][std::size_t((k + 1) % 3)])].push_back(int(f));
-    std::map<std::uint64_t, PlanarMap::RiverEdge> river_now;
-    for (const auto& e : map.rivers) river_now[edge_key(e.up, e.down)] = e;
-    std::map<std::uint64_t, int> middle;
-    std::vector<PlanarMap::RiverEdge> rivers;
-    std::vector<std::pair<int, int>> ridges;
-    std::map<std::uint64_t, bool> ridge_now;
-    for (auto [a, b] : map.ridges) ridge_now[edge_key(a, b)] = true;
-    for (const auto& [key, faces] : faces_of) {
-      const int a = int(key >> 32), b = int(key & 0xffffffffu);
-      const Point2 pa = map.p[std::size_t(a)], pb = map.p[std::size_t(b)];
-      Point2 m = 0.5 * (pa + pb);
-      double z = 0.5 * (map.z[std::size_t(a)] + map.z[std::size_t(b)]);
-      PlanarMap::Kind kind = PlanarMap::Kind::other;
-      const auto r = river_now.find(key);
-      if (r != river_now.end()) {
-        const auto& f = map.facets[std::size_t(faces[std::size_t(integer(draw, 0, int(faces.size()) - 1))])];
-        const Point2 g = (1.0 / 3) * (map.p[std::size_t(f[0])] + map.p[std::size_t(f[1])] + map.p[std::size_t(f[2])]);
-        m = (1.0 / (2 + params.meander)) * (pa + pb + params.meander * g);
-        kind = PlanarMap::Kind::river;
-      } else {
-        z += params.roughness * norm(pb - pa) * draw.uniform();
-        if (ridge_now.count(key)) kind = PlanarMap::Kind::ridge;
-      }
-      middle[key] = int(map.p.size());
-      map.p.push_back(m);
-      map.z.push_back(z);
-      map.kind.push_back(kind);
-      if (r != river_now.end()) {
-        rivers.push_back({r->second.up, int(map.p.size() - 1), r->second.strahler});
-        rivers.push_back({int(map.p.size() - 1), r->second.down, r->second.strahler});
-      } else if (kind == PlanarMap::Kind::ridge) {
-        ridges.emplace_back(a, int(map.p.size() - 1));
-        ridges.emplace_back(int(map.p.size() - 1), b);
-      }
-    }
-    std::vector<std::array<int, 3>> facets;
-    facets.reserve(map.facets.size() * 4);
-    for (const auto& f : map.facets) {
-      const int ab = middle[edge_key(f[0], f[1])], bc = middle[edge_key(f[1], f[2])], ca = middle[edge_key(f[2], f[0])];
-      facets.push_back({f[0], ab, ca});
-      facets.push_back({ab, f[1], bc});
-      facets.push_back({ca, bc, f[2]});
-      facets.push_back({ab, bc, ca});
-    }
-    map.facets = std::move(facets);
-    map.rivers = std::move(rivers);
-    map.ridges = std::move(ridges);
-  }
+  map.ridges = ridges.ridge_edges();
+  for (int pass = 0; pass < params.fractalisations; ++pass) fractalise(map, params, draw);
   return map;
 }
 

@@ -362,6 +362,211 @@ void refine_courses(std::vector<RiverNode>& nodes, const CoastParams& params) {
   }
 }
 
+/// Cells whose centre lies inside the coast polygons (plan metres of `cell` a side).
+std::vector<std::uint8_t> land_cells(const Raster<float>& grid, const std::vector<std::vector<Point2>>& coast, double cell) {
+  std::vector<std::uint8_t> land(grid.size(), 0);
+  for (int r = 0; r < grid.rows(); ++r) {
+    const std::vector<double> xs = row_crossings(coast, (r + 0.5) * cell);
+    for (std::size_t k = 0; k + 1 < xs.size(); k += 2)
+      for (int c = std::max(0, int(std::ceil(xs[k] / cell - 0.5))); c < grid.cols() && (c + 0.5) * cell < xs[k + 1]; ++c)
+        land[grid.index(c, r)] = 1;
+  }
+  return land;
+}
+
+/// Each node's drained area: its Voronoi block on the grid (the land cells nearest to it) and
+/// the blocks upstream. Returns the land's area, km².
+double drained_areas(std::vector<RiverNode>& nodes, const Raster<float>& grid, const std::vector<std::uint8_t>& land, double cell,
+                     double width, double height, double edge_m) {
+  SpatialBins node_bins(width, height, edge_m);
+  for (std::size_t i = 0; i < nodes.size(); ++i) node_bins.insert(int(i), nodes[i].p.x, nodes[i].p.y, nodes[i].p.x, nodes[i].p.y);
+  std::vector<double> block_km2(nodes.size(), 0);
+  const double cell_km2 = cell * cell * 1e-6;
+  double land_km2 = 0;
+  for (int r = 0; r < grid.rows(); ++r)
+    for (int c = 0; c < grid.cols(); ++c) {
+      if (!land[grid.index(c, r)]) continue;
+      const Point2 p{(c + 0.5) * cell, (r + 0.5) * cell};
+      int best = -1;
+      double bd = std::numeric_limits<double>::infinity();
+      for (double reach = edge_m; best < 0 && reach < 4 * (width + height); reach *= 2)
+        node_bins.visit(p.x - reach, p.y - reach, p.x + reach, p.y + reach, [&](int id) {
+          const double d = norm(p - nodes[std::size_t(id)].p);
+          if (d < bd || (d == bd && id < best)) {
+            bd = d;
+            best = id;
+          }
+        });
+      block_km2[std::size_t(best)] += cell_km2;
+      land_km2 += cell_km2;
+    }
+  for (std::size_t i = 0; i < nodes.size(); ++i) nodes[i].area_km2 = block_km2[i];
+  for (std::size_t i = nodes.size(); i-- > 0;)
+    if (nodes[i].parent >= 0) nodes[std::size_t(nodes[i].parent)].area_km2 += nodes[i].area_km2;
+  return land_km2;
+}
+
+/// Discharge and types (§5.1-5.2) with the project's rules of `hydro --classify`.
+void classify_nodes(std::vector<RiverNode>& nodes) {
+  const hydro::RiverTypeOptions types;
+  std::vector<double> to_mouth_km(nodes.size(), 0);
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    RiverNode& n = nodes[i];
+    n.discharge_m3s = hydro::paper_discharge_m3s(n.area_km2);
+    if (n.parent < 0) {
+      n.type = hydro::RiverType::delta;
+      continue;
+    }
+    const RiverNode& down = nodes[std::size_t(n.parent)];
+    const double length = norm(n.p - down.p);
+    to_mouth_km[i] = to_mouth_km[std::size_t(n.parent)] + length / 1000;
+    hydro::ReachMeasures m;
+    m.discharge_m3s = n.discharge_m3s;
+    m.slope = (n.z - down.z) / length;
+    m.sinuosity = types.e_min_sinuosity;  // the trajectory is drawn from the type: a gentle reach may meander
+    m.to_mouth_km = to_mouth_km[std::size_t(n.parent)];
+    m.mouth = down.parent < 0;
+    n.type = hydro::classify_reach(m, types);
+  }
+}
+
+/// The ridges between the rivers: the Voronoi edges of the river graph inside the domain.
+std::vector<RidgeSegment> graph_ridges(const std::vector<RiverNode>& nodes, const RiverGraph& graph, const CoastParams& params) {
+  std::vector<Point2> points;
+  std::vector<double> z;
+  std::vector<std::pair<int, int>> edges;
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    points.push_back(nodes[i].p);
+    z.push_back(nodes[i].z);
+    if (nodes[i].parent >= 0) edges.emplace_back(int(i), nodes[i].parent);
+  }
+  const auto lambda_at = [&](Point2 q) { return params.lambda * std::min(1.0, graph.coast_distance(q) / (5 * params.edge_m)); };
+  std::vector<RidgeSegment> ridges;
+  for (const RidgeSegment& s : voronoi_ridges(points, z, edges, lambda_at))
+    if (graph.inside(s.a) && graph.inside(s.b)) ridges.push_back(s);
+  return ridges;
+}
+
+/// §6: the terrain A = C(B(T_i), U(R_i)) of river primitives R_i (one per piece of a river's
+/// course) and terrain primitives T_i, evaluated at a point.
+class CoastPrimitives {
+ public:
+  CoastPrimitives(const std::vector<RiverNode>& nodes, const std::vector<RidgeSegment>& ridges, const RiverGraph& domain, double cell,
+                  double width, double height, const CoastParams& params, CoastTerrain& out)
+      : ridges_(ridges), params_(params), piece_bins_(width, height, params.edge_m / 2), ridge_bins_(width, height, params.edge_m),
+        radius_(1.5 * params.primitive_spacing_m), primitive_bins_(width, height, radius_) {
+    add_rivers(nodes, cell, out);
+    for (std::size_t i = 0; i < ridges.size(); ++i) {
+      const RidgeSegment& s = ridges[i];
+      ridge_bins_.insert(int(i), std::min(s.a.x, s.b.x), std::min(s.a.y, s.b.y), std::max(s.a.x, s.b.x), std::max(s.a.y, s.b.y));
+    }
+    add_terrain(domain, width, height);
+    out.terrain_primitives = primitives_.size();
+  }
+
+  /// The height at plan point p.
+  double height_at(Point2 p) const {
+    const double radius = radius_, spacing = params_.primitive_spacing_m;
+    // B(T_i): h = Σ w h / Σ w with h = c_z + n(p) and w = (1 - d²/r²)².
+    double hw = 0, ws = 0;
+    primitive_bins_.visit(p.x - radius, p.y - radius, p.x + radius, p.y + radius, [&](int id) {
+      const Primitive& t = primitives_[std::size_t(id)];
+      const double d2 = dot(p - t.c, p - t.c);
+      if (d2 >= radius * radius) return;
+      const double w = (1 - d2 / (radius * radius)) * (1 - d2 / (radius * radius));
+      hw += w * (t.z + params_.noise * t.relief * value_noise(noise_seed_, p, 4 * spacing));
+      ws += w;
+    });
+    // U(R_i) then C(A, U): the nearest river primitive replaces the terrain where it weighs.
+    const Nearest near = nearest_segment(piece_bins_, p, max_radius_, [&](int id) { return piece_ends(id); });
+    double h = ws > 0 ? hw / ws : 0;
+    if (near.index >= 0) {
+      const Piece& s = pieces_[std::size_t(near.index)];
+      if (near.distance < s.radius) {
+        const double u = near.distance / s.radius, w = (1 - u * u) * (1 - u * u);
+        const double x = near.distance / s.half_width;
+        const double hr = s.za + near.t * (s.zb - s.za) - (x < 1 ? s.depth * (1 - x * x) : 0.0);  // δ(d): the bed
+        if (ws == 0) h = hr;
+        h = (1 - w) * std::max(h, hr) + w * hr;
+      }
+    }
+    return h;
+  }
+
+ private:
+  struct Piece {
+    Point2 a, b;
+    double za, zb, radius, half_width, depth;
+  };
+  struct Primitive {
+    Point2 c;
+    double z, relief;
+  };
+
+  std::pair<Point2, Point2> piece_ends(int id) const { return {pieces_[std::size_t(id)].a, pieces_[std::size_t(id)].b}; }
+
+  void add_rivers(const std::vector<RiverNode>& nodes, double cell, CoastTerrain& out) {
+    for (const RiverNode& n : nodes) {
+      if (n.course.size() < 2) continue;
+      ++out.river_primitives;
+      // Hydraulic geometry (Leopold & Maddock 1953): width ∝ Q^0.5, depth ∝ Q^0.4; the valley floor
+      // a few channel widths, at least 2 cells so that the grid resolves it.
+      const double q = std::max(n.discharge_m3s, 0.01);
+      const double half_width = std::max(0.5 * 2.5 * std::sqrt(q), 0.6 * cell), depth = 0.3 * std::pow(q, 0.4) + 0.5;
+      const double radius = std::max(3 * cell, 120 + 40 * std::sqrt(q));
+      max_radius_ = std::max(max_radius_, radius);
+      for (std::size_t k = 0; k + 1 < n.course.size(); ++k) {
+        pieces_.push_back({n.course[k], n.course[k + 1], n.course_z[k], n.course_z[k + 1], radius, half_width, depth});
+        out.river_km += norm(n.course[k + 1] - n.course[k]) / 1000;
+      }
+    }
+    for (std::size_t i = 0; i < pieces_.size(); ++i) {
+      const Piece& s = pieces_[i];
+      piece_bins_.insert(int(i), std::min(s.a.x, s.b.x), std::min(s.a.y, s.b.y), std::max(s.a.x, s.b.x), std::max(s.a.y, s.b.y));
+    }
+  }
+
+  // Terrain primitives T_i = (c, r): one per square of the spacing at a jittered position (a Poisson-like
+  // stratified draw in place of the paper's aperiodic tiling [LD05]); r = 1.5 spacing covers Ω.
+  void add_terrain(const RiverGraph& domain, double width, double height) {
+    const auto ridge_at = [&](int id) { return std::pair{ridges_[std::size_t(id)].a, ridges_[std::size_t(id)].b}; };
+    const double spacing = params_.primitive_spacing_m;
+    const int pc = int(std::ceil(width / spacing)), pr = int(std::ceil(height / spacing));
+    for (int j = 0; j < pr; ++j)
+      for (int i = 0; i < pc; ++i) {
+        const Point2 c{(i + 0.5 + 0.5 * position_noise(params_.seed ^ 0x7E11ull, i, 2 * j)) * spacing,
+                       (j + 0.5 + 0.5 * position_noise(params_.seed ^ 0x7E11ull, i, 2 * j + 1)) * spacing};
+        if (!domain.inside(c)) continue;
+        // c_z = d_a/(d_a+d_b) b_z + d_b/(d_a+d_b) a_z (§7.2): a on the rivers, b on the ridges.
+        const Nearest a = nearest_anywhere(piece_bins_, c, width + height, [&](int id) { return piece_ends(id); });
+        double az = 0, bz = 0, da = a.distance, db = std::numeric_limits<double>::infinity();
+        if (a.index >= 0) az = pieces_[std::size_t(a.index)].za + a.t * (pieces_[std::size_t(a.index)].zb - pieces_[std::size_t(a.index)].za);
+        if (!ridges_.empty()) {
+          const Nearest b = nearest_anywhere(ridge_bins_, c, width + height, ridge_at);
+          db = b.distance;
+          const RidgeSegment& s = ridges_[std::size_t(b.index)];
+          bz = s.za + b.t * (s.zb - s.za);
+        }
+        if (a.index < 0) continue;
+        double z = az;
+        if (std::isfinite(db) && da + db > 0) z = da / (da + db) * bz + db / (da + db) * az;
+        primitives_.push_back({c, z, std::max(0.0, bz - az) * (std::isfinite(db) ? da / (da + db) : 0.0)});
+      }
+    for (std::size_t i = 0; i < primitives_.size(); ++i)
+      primitive_bins_.insert(int(i), primitives_[i].c.x, primitives_[i].c.y, primitives_[i].c.x, primitives_[i].c.y);
+  }
+
+  const std::vector<RidgeSegment>& ridges_;
+  const CoastParams& params_;
+  const std::uint64_t noise_seed_ = params_.seed ^ 0xA0153ull;
+  std::vector<Piece> pieces_;
+  double max_radius_ = 0;
+  SpatialBins piece_bins_, ridge_bins_;
+  std::vector<Primitive> primitives_;
+  const double radius_;
+  SpatialBins primitive_bins_;
+};
+
 }  // namespace
 
 CoastTerrain generate_coast_terrain(Raster<float>& grid, const std::vector<std::vector<Point2>>& coast, const CoastParams& params,
@@ -389,177 +594,20 @@ CoastTerrain generate_coast_terrain(Raster<float>& grid, const std::vector<std::
 
   // 2. Analysis: Voronoi blocks on the grid (nearest node of each land cell), areas, discharge, types, ridges.
   t0 = Clock::now();
-  SpatialBins node_bins(width, height, params.edge_m);
-  for (std::size_t i = 0; i < nodes.size(); ++i) node_bins.insert(int(i), nodes[i].p.x, nodes[i].p.y, nodes[i].p.x, nodes[i].p.y);
-  std::vector<std::uint8_t> land(grid.size(), 0);
-  for (int r = 0; r < grid.rows(); ++r) {
-    const std::vector<double> xs = row_crossings(coast, (r + 0.5) * cell);
-    for (std::size_t k = 0; k + 1 < xs.size(); k += 2)
-      for (int c = std::max(0, int(std::ceil(xs[k] / cell - 0.5))); c < grid.cols() && (c + 0.5) * cell < xs[k + 1]; ++c)
-        land[grid.index(c, r)] = 1;
-  }
-  std::vector<double> block_km2(nodes.size(), 0);
-  const double cell_km2 = cell * cell * 1e-6;
-  for (int r = 0; r < grid.rows(); ++r)
-    for (int c = 0; c < grid.cols(); ++c) {
-      if (!land[grid.index(c, r)]) continue;
-      const Point2 p{(c + 0.5) * cell, (r + 0.5) * cell};
-      int best = -1;
-      double bd = std::numeric_limits<double>::infinity();
-      for (double reach = params.edge_m; best < 0 && reach < 4 * (width + height); reach *= 2)
-        node_bins.visit(p.x - reach, p.y - reach, p.x + reach, p.y + reach, [&](int id) {
-          const double d = norm(p - nodes[std::size_t(id)].p);
-          if (d < bd || (d == bd && id < best)) {
-            bd = d;
-            best = id;
-          }
-        });
-      block_km2[std::size_t(best)] += cell_km2;
-      out.land_km2 += cell_km2;
-    }
-  for (std::size_t i = 0; i < nodes.size(); ++i) nodes[i].area_km2 = block_km2[i];
-  for (std::size_t i = nodes.size(); i-- > 0;)
-    if (nodes[i].parent >= 0) nodes[std::size_t(nodes[i].parent)].area_km2 += nodes[i].area_km2;
-  // Discharge and types (§5.1-5.2) with the project's rules of `hydro --classify`.
-  const hydro::RiverTypeOptions types;
-  std::vector<double> to_mouth_km(nodes.size(), 0);
-  for (std::size_t i = 0; i < nodes.size(); ++i) {
-    RiverNode& n = nodes[i];
-    n.discharge_m3s = hydro::paper_discharge_m3s(n.area_km2);
-    if (n.parent < 0) {
-      n.type = hydro::RiverType::delta;
-      continue;
-    }
-    const RiverNode& down = nodes[std::size_t(n.parent)];
-    const double length = norm(n.p - down.p);
-    to_mouth_km[i] = to_mouth_km[std::size_t(n.parent)] + length / 1000;
-    hydro::ReachMeasures m;
-    m.discharge_m3s = n.discharge_m3s;
-    m.slope = (n.z - down.z) / length;
-    m.sinuosity = types.e_min_sinuosity;  // the trajectory is drawn from the type: a gentle reach may meander
-    m.to_mouth_km = to_mouth_km[std::size_t(n.parent)];
-    m.mouth = down.parent < 0;
-    n.type = hydro::classify_reach(m, types);
-  }
+  const std::vector<std::uint8_t> land = land_cells(grid, coast, cell);
+  out.land_km2 = drained_areas(nodes, grid, land, cell, width, height, params.edge_m);
+  classify_nodes(nodes);
   refine_courses(nodes, params);
-  {
-    std::vector<Point2> points;
-    std::vector<double> z;
-    std::vector<std::pair<int, int>> edges;
-    for (std::size_t i = 0; i < nodes.size(); ++i) {
-      points.push_back(nodes[i].p);
-      z.push_back(nodes[i].z);
-      if (nodes[i].parent >= 0) edges.emplace_back(int(i), nodes[i].parent);
-    }
-    const auto lambda_at = [&](Point2 q) { return params.lambda * std::min(1.0, graph.coast_distance(q) / (5 * params.edge_m)); };
-    for (const RidgeSegment& s : voronoi_ridges(points, z, edges, lambda_at))
-      if (graph.inside(s.a) && graph.inside(s.b)) out.ridges.push_back(s);
-  }
+  out.ridges = graph_ridges(nodes, graph, params);
   out.analysis_s = seconds_since(t0);
 
   // 3. Terrain: A = C(B(T_i), U(R_i)) of §6, rasterised.
   t0 = Clock::now();
   if (progress) progress->begin("generate: terrain primitives");
-  struct Piece {
-    Point2 a, b;
-    double za, zb, radius, half_width, depth;
-  };
-  std::vector<Piece> pieces;
-  double max_radius = 0;
-  for (const RiverNode& n : nodes) {
-    if (n.course.size() < 2) continue;
-    ++out.river_primitives;
-    // Hydraulic geometry (Leopold & Maddock 1953): width ∝ Q^0.5, depth ∝ Q^0.4; the valley floor
-    // a few channel widths, at least 2 cells so that the grid resolves it.
-    const double q = std::max(n.discharge_m3s, 0.01);
-    const double half_width = std::max(0.5 * 2.5 * std::sqrt(q), 0.6 * cell), depth = 0.3 * std::pow(q, 0.4) + 0.5;
-    const double radius = std::max(3 * cell, 120 + 40 * std::sqrt(q));
-    max_radius = std::max(max_radius, radius);
-    for (std::size_t k = 0; k + 1 < n.course.size(); ++k) {
-      pieces.push_back({n.course[k], n.course[k + 1], n.course_z[k], n.course_z[k + 1], radius, half_width, depth});
-      out.river_km += norm(n.course[k + 1] - n.course[k]) / 1000;
-    }
-  }
-  SpatialBins piece_bins(width, height, params.edge_m / 2);
-  for (std::size_t i = 0; i < pieces.size(); ++i) {
-    const Piece& s = pieces[i];
-    piece_bins.insert(int(i), std::min(s.a.x, s.b.x), std::min(s.a.y, s.b.y), std::max(s.a.x, s.b.x), std::max(s.a.y, s.b.y));
-  }
-  SpatialBins ridge_bins(width, height, params.edge_m);
-  for (std::size_t i = 0; i < out.ridges.size(); ++i) {
-    const RidgeSegment& s = out.ridges[i];
-    ridge_bins.insert(int(i), std::min(s.a.x, s.b.x), std::min(s.a.y, s.b.y), std::max(s.a.x, s.b.x), std::max(s.a.y, s.b.y));
-  }
-  const auto piece_at = [&](int id) { return std::pair{pieces[std::size_t(id)].a, pieces[std::size_t(id)].b}; };
-  const auto ridge_at = [&](int id) { return std::pair{out.ridges[std::size_t(id)].a, out.ridges[std::size_t(id)].b}; };
-  // Terrain primitives T_i = (c, r): one per square of the spacing at a jittered position (a Poisson-like
-  // stratified draw in place of the paper's aperiodic tiling [LD05]); r = 1.5 spacing covers Ω.
-  struct Primitive {
-    Point2 c;
-    double z, relief;
-  };
-  std::vector<Primitive> primitives;
-  const double spacing = params.primitive_spacing_m, radius = 1.5 * spacing;
-  const int pc = int(std::ceil(width / spacing)), pr = int(std::ceil(height / spacing));
-  RiverGraph& domain = graph;
-  for (int j = 0; j < pr; ++j)
-    for (int i = 0; i < pc; ++i) {
-      const Point2 c{(i + 0.5 + 0.5 * position_noise(params.seed ^ 0x7E11ull, i, 2 * j)) * spacing,
-                     (j + 0.5 + 0.5 * position_noise(params.seed ^ 0x7E11ull, i, 2 * j + 1)) * spacing};
-      if (!domain.inside(c)) continue;
-      // c_z = d_a/(d_a+d_b) b_z + d_b/(d_a+d_b) a_z (§7.2): a on the rivers, b on the ridges.
-      const Nearest a = nearest_anywhere(piece_bins, c, width + height, piece_at);
-      double az = 0, bz = 0, da = a.distance, db = std::numeric_limits<double>::infinity();
-      if (a.index >= 0) az = pieces[std::size_t(a.index)].za + a.t * (pieces[std::size_t(a.index)].zb - pieces[std::size_t(a.index)].za);
-      if (!out.ridges.empty()) {
-        const Nearest b = nearest_anywhere(ridge_bins, c, width + height, ridge_at);
-        db = b.distance;
-        const RidgeSegment& s = out.ridges[std::size_t(b.index)];
-        bz = s.za + b.t * (s.zb - s.za);
-      }
-      if (a.index < 0) continue;
-      double z = az;
-      if (std::isfinite(db) && da + db > 0) z = da / (da + db) * bz + db / (da + db) * az;
-      primitives.push_back({c, z, std::max(0.0, bz - az) * (std::isfinite(db) ? da / (da + db) : 0.0)});
-    }
-  out.terrain_primitives = primitives.size();
-  SpatialBins primitive_bins(width, height, radius);
-  for (std::size_t i = 0; i < primitives.size(); ++i) primitive_bins.insert(int(i), primitives[i].c.x, primitives[i].c.y, primitives[i].c.x, primitives[i].c.y);
-
-  const std::uint64_t noise_seed = params.seed ^ 0xA0153ull;
+  const CoastPrimitives terrain(nodes, out.ridges, graph, cell, width, height, params, out);
   for (int r = 0; r < grid.rows(); ++r) {
-    for (int c = 0; c < grid.cols(); ++c) {
-      float& cell_z = grid(c, r);
-      if (!land[grid.index(c, r)]) {
-        cell_z = std::numeric_limits<float>::quiet_NaN();
-        continue;
-      }
-      const Point2 p{(c + 0.5) * cell, (r + 0.5) * cell};
-      // B(T_i): h = Σ w h / Σ w with h = c_z + n(p) and w = (1 - d²/r²)².
-      double hw = 0, ws = 0;
-      primitive_bins.visit(p.x - radius, p.y - radius, p.x + radius, p.y + radius, [&](int id) {
-        const Primitive& t = primitives[std::size_t(id)];
-        const double d2 = dot(p - t.c, p - t.c);
-        if (d2 >= radius * radius) return;
-        const double w = (1 - d2 / (radius * radius)) * (1 - d2 / (radius * radius));
-        hw += w * (t.z + params.noise * t.relief * value_noise(noise_seed, p, 4 * spacing));
-        ws += w;
-      });
-      // U(R_i) then C(A, U): the nearest river primitive replaces the terrain where it weighs.
-      const Nearest near = nearest_segment(piece_bins, p, max_radius, piece_at);
-      double h = ws > 0 ? hw / ws : 0;
-      if (near.index >= 0) {
-        const Piece& s = pieces[std::size_t(near.index)];
-        if (near.distance < s.radius) {
-          const double u = near.distance / s.radius, w = (1 - u * u) * (1 - u * u);
-          const double x = near.distance / s.half_width;
-          const double hr = s.za + near.t * (s.zb - s.za) - (x < 1 ? s.depth * (1 - x * x) : 0.0);  // δ(d): the bed
-          if (ws == 0) h = hr;
-          h = (1 - w) * std::max(h, hr) + w * hr;
-        }
-      }
-      cell_z = float(h);
-    }
+    for (int c = 0; c < grid.cols(); ++c)
+      grid(c, r) = land[grid.index(c, r)] ? float(terrain.height_at({(c + 0.5) * cell, (r + 0.5) * cell})) : std::numeric_limits<float>::quiet_NaN();
     if (progress && r % 64 == 0 && !progress->update(double(r) / grid.rows())) throw Error(ErrorKind::cancelled, "generate: interrupted");
   }
   if (progress) progress->end();
