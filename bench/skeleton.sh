@@ -6,8 +6,8 @@
 # gdal_fillnodata.py, GRASS r.surf.idw and v.surf.rst (its spline, default tension and smoothing),
 # in the same run. The `lines` rows are the thesis's literal form (every line cell, no lattice:
 # --lattice 0 --line-step 1), `random@l` random cells at its share. Prints the share kept, the RMSE
-# against the original (over all valid cells, the thesis's "écart-type", and over the hidden cells)
-# and times on the first file of a row: median of REPEAT whole-process runs for terrapolis and GDAL,
+# against the original (over all valid cells, the thesis's "écart-type", over the hidden cells and
+# over the hidden cells of the thesis's lines) and times on the first file of a row: median of REPEAT whole-process runs for terrapolis and GDAL,
 # the module's own time (one run) for GRASS.
 # Usage: bench/skeleton.sh [DEM...]   (default: the six DEMs of docs/benchmarks.md and N47E009)
 # Env: TERRAPOLIS_BIN (default build/src/cli/terrapolis), REPEAT (default 3), CROP (default 600:
@@ -34,7 +34,8 @@ command -v grass >/dev/null || { GRASS=0; echo "GRASS not found: its rows are sk
 cat >"$WORK/sk.py" <<'EOF'
 # random KEPT DEM SEED OUT: as many random valid cells as KEPT holds;
 # lattice KEPT DEM OUT: a regular lattice of valid cells of about the same share (spacing 1/sqrt(share));
-# score TRUTH SPARSE OUT: RMSE over the valid cells and over the hidden ones.
+# score TRUTH SPARSE OUT LINES: RMSE over the valid cells, over the hidden ones and over the hidden
+# cells of the thesis's lines (LINES: its sparse raster), where a surface through even cells errs most.
 import sys
 import numpy as np
 from osgeo import gdal
@@ -67,16 +68,16 @@ if what in ("random", "lattice"):
     write(ds, z, mask, sys.argv[-1])
     print("%.2f" % (100 * mask.sum() / valid.sum()))
 else:
-    _, t = read(sys.argv[2]); _, s = read(sys.argv[3])
+    _, t = read(sys.argv[2]); _, s = read(sys.argv[3]); _, lines = read(sys.argv[5])
     try:
         _, o = read(sys.argv[4])
     except Exception:
-        print("nan nan"); sys.exit()
-    valid = np.isfinite(t); hidden = valid & np.isnan(s)
-    e_all = o[valid] - t[valid]; e_hid = o[hidden] - t[hidden]
-    if np.isnan(e_all).any():  # cells a tool left empty: not scored
-        print("unfilled unfilled"); sys.exit()
-    print(f"{np.sqrt(np.mean(e_all ** 2)):.2f} {np.sqrt(np.mean(e_hid ** 2)):.2f}")
+        print("nan nan nan"); sys.exit()
+    valid = np.isfinite(t); hidden = valid & np.isnan(s); on_lines = hidden & np.isfinite(lines)
+    if np.isnan(o[valid]).any():  # cells a tool left empty: not scored
+        print("unfilled unfilled unfilled"); sys.exit()
+    rmse = lambda m: "%.2f" % np.sqrt(np.mean((o[m] - t[m]) ** 2)) if m.any() else "-"
+    print(rmse(valid), rmse(hidden), rmse(on_lines))
 EOF
 
 timed() {  # median wall time (s) of REPEAT runs of "$@"
@@ -114,8 +115,8 @@ EOF
 
 median() { printf '%s\n' "$@" | sort -g | sed -n "$(( ($# + 1) / 2 ))p"; }
 
-fmt='%-24s %7s %-8s %6s %-26s %9s %11s %8s\n'
-printf "$fmt" dem cells samples kept% tool rmse_all rmse_hidden time_s
+fmt='%-24s %7s %-8s %6s %-26s %9s %11s %10s %8s\n'
+printf "$fmt" dem cells samples kept% tool rmse_all rmse_hidden rmse_lines time_s
 for dem in "${DEMS[@]}"; do
   name=$(basename "$dem"); name=${name%.*}
   d="$WORK/$name"; mkdir -p "$d"
@@ -129,7 +130,7 @@ for dem in "${DEMS[@]}"; do
   "$BIN" -q skeleton "$dem" "$d/lines" --lattice 0 --line-step 1 --overwrite
   read -r cells < <($PY -c "import json,sys; print(json.load(open(sys.argv[1]))['valid_cells'])" "$d/sk/skeleton.json")
   share() { $PY -c "import json,sys; print('%.2f' % (100*json.load(open(sys.argv[1]))['kept_share']))" "$1"; }
-  printf "$fmt" "$name" "$cells" - "$(share "$d/sk/skeleton.json")" "terrapolis skeleton" - - "$t_skel"
+  printf "$fmt" "$name" "$cells" - "$(share "$d/sk/skeleton.json")" "terrapolis skeleton" - - - "$t_skel"
   # Sample sets: name, the kept cells whose share they match, files (several: random seeds, median RMSE).
   cp "$d/sk/skeleton.tif" "$d/skeleton.tif"; cp "$d/lines/skeleton.tif" "$d/lines.tif"
   for seed in 1 2 3; do
@@ -146,7 +147,7 @@ for dem in "${DEMS[@]}"; do
     [ "$GRASS" = 1 ] && tools+=("r.surf.idw 12 points" "v.surf.rst defaults")
     [ "$GRASS" = 1 ] && [ "$FILLNULLS_TIMEOUT" -gt 0 ] && tools+=("r.fillnulls bilinear")
     for tool in "${tools[@]}"; do
-      alls=(); hids=(); t=""
+      alls=(); hids=(); lns=(); t=""
       for f in ${SETS[$set]}; do
         in="$d/$f.tif"; o="$d/${f}_out.tif"; rm -f "$o"
         first=$([ -z "$t" ] && echo 1 || echo 0)
@@ -159,10 +160,10 @@ for dem in "${DEMS[@]}"; do
           v.surf*) tt=$(grass_fill v.surf.rst "$in" "$o"); [ "$first" = 1 ] && t=$tt ;;
           r.fill*) tt=$(grass_fill r.fillnulls "$in" "$o"); [ "$first" = 1 ] && t=$tt ;;
         esac
-        read -r a hd < <($PY "$WORK/sk.py" score "$dem" "$in" "$o")
-        alls+=("$a"); hids+=("$hd")
+        read -r a hd ln < <($PY "$WORK/sk.py" score "$dem" "$in" "$o" "$d/lines.tif")
+        alls+=("$a"); hids+=("$hd"); lns+=("$ln")
       done
-      printf "$fmt" "$name" "$cells" "$set" "${SHARE[$set]}" "$tool" "$(median "${alls[@]}")" "$(median "${hids[@]}")" "$t"
+      printf "$fmt" "$name" "$cells" "$set" "${SHARE[$set]}" "$tool" "$(median "${alls[@]}")" "$(median "${hids[@]}")" "$(median "${lns[@]}")" "$t"
     done
   done
   unset SETS SHARE
