@@ -32,7 +32,7 @@ class SkeletonCommand final : public Command {
 
   void setup(CLI::App& app) override {
     dem_.add_to(app);
-    file_kind(app.add_option("OUTDIR", out_dir_, "Output folder: ridges.geojson, valleys.geojson (+ QGIS .qml styles), skeleton.tif, form_index.tif, skeleton.json (its parent must exist)")
+    file_kind(app.add_option("OUTDIR", out_dir_, "Output folder: ridges.geojson, valleys.geojson (+ QGIS .qml styles), skeleton.tif (the kept cells), form_index.tif, skeleton.json (its parent must exist)")
                   ->required(),
               FileKind::folder_out);
     schema_.setup(app, name());
@@ -74,12 +74,15 @@ class SkeletonCommand final : public Command {
     const nlohmann::ordered_json report = {
         {"terrapolis_version", version}, {"dem", source}, {"options", scenario.resolved["skeleton"]},
         {"valid_cells", s.valid_cells}, {"kept_cells", s.kept_cells}, {"kept_share", share},
+        {"line_cells", s.line_cells}, {"lattice_cells", s.lattice_cells},
         {"ridges", s.ridges}, {"valleys", s.valleys}, {"ridge_km", ridge_km}, {"valley_km", valley_km}, {"seconds", seconds}};
     write_text_file((dir / "skeleton.json").string(), report.dump(2) + "\n", false);
     outputs.commit();
-    char line[256];
-    std::snprintf(line, sizeof line, "skeleton: %zu ridges (%.1f km), %zu valleys (%.1f km), %.1f %% of the cells kept, %.2f s; wrote ",
-                  s.ridges, ridge_km, s.valleys, valley_km, 100 * share, seconds);
+    char line[320];
+    std::snprintf(line, sizeof line,
+                  "skeleton: %zu ridges (%.1f km), %zu valleys (%.1f km), %.1f %% of the cells kept (%.1f %% on the lines, %.1f %% on the lattice), %.2f s; wrote ",
+                  s.ridges, ridge_km, s.valleys, valley_km, 100 * share, 100.0 * double(s.line_cells) / double(s.valid_cells),
+                  100.0 * double(s.lattice_cells) / double(s.valid_cells), seconds);
     context.log.info(line + out_dir_);
   }
 

@@ -181,6 +181,8 @@ skeleton::SkeletonOptions skeleton_options(const Scenario& scenario) {
   o.tolerance = k["tolerance"].get<double>();
   o.seed_share = k["seed_share"].get<double>();
   o.min_cells = k["min_cells"].get<int>();
+  o.lattice = k["lattice"].get<int>();
+  o.line_step = k["line_step"].get<int>();
   return o;
 }
 

@@ -22,6 +22,13 @@ struct SkeletonOptions {
   double seed_share = 0.05;  ///< share of the valid cells, most extreme form index first, a line may start from (each sign)
   int min_cells = 3;         ///< shorter lines are dropped
   Lines lines = Lines::both; ///< the thesis's "creux" (valleys) or "creux et crêtes" (both)
+  /// Also keep every `lattice`-th cell of every `lattice`-th row (from lattice / 2), so that slopes,
+  /// plateaus and the DEM's edges hold samples too; 0 keeps the lines' cells only (the thesis's
+  /// literal form). docs/skeleton.md: the lines alone lose to random cells at the same share.
+  int lattice = 6;
+  /// Keep every `line_step`-th cell along a line (and its last): neighbours on a line add little that
+  /// a surface through every third does not (docs/skeleton.md); 1 keeps them all (the thesis's form).
+  int line_step = 3;
 };
 
 /// Belhadj's form index (§5.2.2, footnote 14): the mean of the vertical components of the unit
@@ -44,16 +51,27 @@ struct Line {
 struct Skeleton {
   Raster<float> index;       ///< the form index
   std::vector<Line> lines;   ///< ridges and valleys, in the order they were traced
-  Raster<float> kept;        ///< the DEM's heights on the lines' cells, NaN elsewhere
+  Raster<float> kept;        ///< the DEM's heights on the lines' and the lattice's cells, NaN elsewhere
   std::size_t kept_cells = 0, valid_cells = 0, ridges = 0, valleys = 0;
+  std::size_t line_cells = 0;     ///< cells kept from the lines (every line_step-th of each)
+  std::size_t lattice_cells = 0;  ///< valid lattice cells (some of them on a line too)
 };
 
 /// Traces the lines: from the most extreme unvisited seed cell (the `seed_share` highest form
 /// indices for ridges, lowest for valleys), a path is followed both ways through 8-neighbours whose
 /// form index lies within ± tolerance of the previous cell's, turning by at most 45° a step and
 /// taking the most extreme such neighbour; it stops where no neighbour qualifies or on a cell of an
-/// earlier line. Nodata is never entered. Deterministic.
+/// earlier line. Nodata is never entered. Every `line_step`-th cell of a line is kept, then the
+/// valid cells of the lattice (`lattice` > 0) too. Deterministic.
 Skeleton extract_skeleton(const Dem& dem, const CellMetrics& metrics, const SkeletonOptions& options, Progress& progress);
+
+/// Whether the j-th of a line's n cells is kept: every `step`-th from the first, and the last.
+inline bool kept_on_line(std::size_t j, std::size_t n, int step) { return j % std::size_t(step) == 0 || j + 1 == n; }
+
+/// Whether cell (col, row) is on the supplementary lattice of spacing `lattice` (never when 0).
+inline bool on_lattice(int col, int row, int lattice) {
+  return lattice > 0 && col % lattice == lattice / 2 && row % lattice == lattice / 2;
+}
 
 /// One kind of line as LineStrings through the cell centres in the DEM's CRS, with fields `id`,
 /// `kind`, `cells`, `length_m`, `relief_m` and `form_index` (of the seed).

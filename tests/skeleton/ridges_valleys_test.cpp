@@ -37,9 +37,12 @@ bool corner(const Dem& d, std::size_t i) {
 /// The vertical component of the unit vector of a step of `d` metres and drop `dz` (footnote 14).
 double vertical(double dz, double d) { return dz / std::hypot(d, dz); }
 
+/// The thesis's literal form: lines only, no lattice.
 SkeletonOptions only(Lines lines) {
   SkeletonOptions o;
   o.lines = lines;
+  o.lattice = 0;
+  o.line_step = 1;
   return o;
 }
 
@@ -115,6 +118,17 @@ TEST(Skeleton, VeeAxisIsTheOneValleyLineAndARoofTheOneRidge) {
     const Skeleton none = extract_skeleton(dem, cell_metrics(dem.georef(), 9, 12), only(sign > 0 ? Lines::ridges : Lines::valleys), p);
     EXPECT_TRUE(none.lines.empty());
     EXPECT_EQ(none.kept_cells, 0u);
+    // A lattice of spacing 4 adds the cells of columns 2, 6 and rows 2, 6, 10: (2, r) and (6, r) are
+    // off the axis (column 4), so 2 x 3 = 6 cells more, the same lines.
+    SkeletonOptions lattice = only(Lines::both);
+    lattice.lattice = 4;
+    const Skeleton more = extract_skeleton(dem, cell_metrics(dem.georef(), 9, 12), lattice, p);
+    ASSERT_EQ(more.lines.size(), 1u);
+    EXPECT_EQ(more.line_cells, 10u);
+    EXPECT_EQ(more.lattice_cells, 6u);
+    EXPECT_EQ(more.kept_cells, 16u);
+    EXPECT_EQ(more.kept(6, 10), dem(6, 10));
+    EXPECT_TRUE(std::isnan(more.kept(6, 9)));
   }
 }
 
@@ -157,10 +171,13 @@ TEST(Skeleton, InvariantsOnRoughTerrainWithNodata) {
     int previous_k = -1;
     for (std::size_t j = 0; j < line.cells.size(); ++j) {
       const std::size_t cell = line.cells[j];
-      on_lines.insert(cell);
       EXPECT_FALSE(std::isnan(dem[cell]));
       EXPECT_GT(sign * s.index[cell], 0);  // ridge cells have a positive index, valley cells a negative one
-      EXPECT_EQ(s.kept[cell], dem[cell]);  // lines lie on kept cells, with the DEM's heights
+      // Every third cell of a line from its first, and its last, is kept with the DEM's height.
+      if (j % 3 == 0 || j + 1 == line.cells.size()) {
+        on_lines.insert(cell);
+        EXPECT_EQ(s.kept[cell], dem[cell]);
+      }
       if (j == 0) continue;
       const std::size_t a = line.cells[j - 1];
       const int dc = int(cell % cols) - int(a % cols), dr = int(cell / cols) - int(a / cols);
@@ -179,14 +196,25 @@ TEST(Skeleton, InvariantsOnRoughTerrainWithNodata) {
     }
     EXPECT_NEAR(line.length_m, length, 1e-6);
   }
-  // Kept cells are exactly the lines' cells.
-  std::size_t kept = 0;
-  for (std::size_t i = 0; i < s.kept.size(); ++i)
+  // Kept cells are exactly the lines' kept cells and the valid cells of the default lattice (every 6th).
+  ASSERT_EQ(o.lattice, 6);
+  ASSERT_EQ(o.line_step, 3);
+  std::size_t kept = 0, lattice = 0, both = 0;
+  for (std::size_t i = 0; i < s.kept.size(); ++i) {
+    const int c = int(i % cols), r = int(i / cols);
+    const bool on = c % 6 == 3 && r % 6 == 3 && !std::isnan(dem[i]);
+    lattice += on ? 1 : 0;
+    both += on && on_lines.count(i) ? 1 : 0;
     if (!std::isnan(s.kept[i])) {
       ++kept;
-      EXPECT_TRUE(on_lines.count(i)) << i;
+      EXPECT_TRUE(on_lines.count(i) || on) << i;
+      EXPECT_EQ(s.kept[i], dem[i]);
     }
-  EXPECT_EQ(kept, on_lines.size());
+  }
+  EXPECT_EQ(lattice, 20u * 15u - 6u);  // 20 x 15 lattice cells, 6 of them in the hole
+  EXPECT_EQ(s.lattice_cells, lattice);
+  EXPECT_EQ(s.line_cells, on_lines.size());
+  EXPECT_EQ(kept, on_lines.size() + lattice - both);
   EXPECT_EQ(kept, s.kept_cells);
   // The same lines on one thread.
   tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
