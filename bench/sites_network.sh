@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Benchmarks of `terrapolis sites` and `terrapolis network`: wall time and peak memory, medians of RUNS.
-#   bash bench/sites_network.sh [TERRAPOLIS] [DEMS_DIR] [RUNS]
+#   bench/sites_network.sh [TERRAPOLIS] [DEMS_DIR] [RUNS]
 # Scenarios: the SRTM tiles S46W066.hgt (3601x3601, 1") and N47E009.hgt (1201x1201, 3") with a
 # density model synthesised from the DEM (buildable = land below 1000 m, density = exp(-z / 400 m));
 # and 100 000 random cities (60 % roots, 40 % suburbs inside them) for the network alone.

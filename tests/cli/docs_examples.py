@@ -1,12 +1,20 @@
 """The examples of docs/*.md run as written, and print what the docs show.
 
-Two kinds of fenced blocks are tested (the info string after the language marks them):
-- ```sh test      the block is a shell script, run with bash -euo pipefail;
-- ```console test a transcript: each `$ command` line (with its `\\` continuation lines) is run,
-                  and the lines shown under it must appear, in order, in what it printed (stdout
-                  then stderr); it must fail exactly when it shows `terrapolis: error:`. Timings (`0.28 s`, `(12 s left)`) are masked on both sides.
-Blocks of one page run in order in one scratch folder holding links to sample_dems/ and tests/data/,
-so a page's later examples read what its earlier ones wrote. `terrapolis` is the binary under test.
+Every fenced block holding a `terrapolis ...` command says what it is in its info string:
+- ```sh test      an example, run as a bash -euo pipefail script;
+- ```console test an example as a transcript: each `$ command` line (with its `\\` continuation
+                  lines) is run, and the lines shown under it must appear, in order, in what it
+                  printed (stdout then stderr); it must fail exactly when it shows
+                  `terrapolis: error:`. Timings (`0.28 s`, `(12 s left)`) are masked on both sides,
+                  and a line `...` stands for printed lines left out of the page;
+- ```text         a usage synopsis (DEM, OUTDIR, [--option] placeholders): not run;
+- ```sh bench     a benchmark (bench/*: minutes, peer tools, ../shared/dems): not run here, but every
+                  bench/ script it names must exist, and be executable where it is the command.
+A `terrapolis` command in any other block (```, ```sh, ```console) fails the test: a real example
+either runs or is marked as a synopsis.
+Blocks of one page run in order in one scratch folder holding links to sample_dems/, tests/, src/,
+plugins/ and the build folder (build/, from TERRAPOLIS_BUILD_DIR), so a page's later examples read
+what its earlier ones wrote. `terrapolis` is the binary under test.
 Usage: docs_examples.py TERRAPOLIS SOURCE_DIR
 """
 import os
@@ -17,18 +25,22 @@ import sys
 import tempfile
 from pathlib import Path
 
-FENCE = re.compile(r"^```(sh|console) test\s*$")
+TESTED = re.compile(r"^(sh|console) test$")
+SHELL_INFO = {"", "sh", "bash", "shell", "console"}  # fences whose `terrapolis` lines must be tested
+COMMAND = re.compile(r"(^|[\s;&|(])terrapolis\s+[-\w]")  # `terrapolis hydro ...`, not `terrapolis:`
+BENCH_SCRIPT = re.compile(r"(?<![\w./])bench/[\w./-]+")
+ASSIGNMENT = re.compile(r"^(\w+=\S*\s+)*")
 TIMING = re.compile(r"\d+(\.\d+)? s\b")
+ELISION = "..."
 
 
-def blocks(page):
-    """(line number, kind, lines) of every tested block of a page."""
+def fences(page):
+    """(line number, info string, lines) of every fenced block of a page."""
     found, current = [], None
     for number, line in enumerate(page.read_text().splitlines(), 1):
         if current is None:
-            match = FENCE.match(line)
-            if match:
-                current = (number, match.group(1), [])
+            if line.startswith("```"):
+                current = (number, line[3:].strip(), [])
         elif line.startswith("```"):
             found.append(current)
             current = None
@@ -37,6 +49,30 @@ def blocks(page):
     if current is not None:
         sys.exit(f"FAIL: {page.name}:{current[0]}: unclosed block")
     return found
+
+
+def untested_command(info, lines):
+    """The first `terrapolis` command line of a block that is neither tested nor marked, or None."""
+    if info not in SHELL_INFO:
+        return None
+    for line in lines:
+        if not line.lstrip().startswith("#") and COMMAND.search(line):
+            return line
+    return None
+
+
+def bench_problems(source, lines):
+    """What is wrong with the bench/ scripts a ```sh bench block names (missing, not executable)."""
+    problems = []
+    for line in lines:
+        command = line.split(" #")[0].strip()
+        for name in BENCH_SCRIPT.findall(command):
+            script = source / name
+            if not script.is_file():
+                problems.append(f"{name} does not exist")
+            elif ASSIGNMENT.sub("", command).split()[0] == name and not os.access(script, os.X_OK):
+                problems.append(f"{name} is run as a command but is not executable")
+    return problems
 
 
 def transcript(lines):
@@ -59,10 +95,12 @@ def masked(line):
 
 
 def shows(expected, printed):
-    """True when the expected lines appear in order in the printed ones (masked)."""
+    """The first expected line not printed in order (masked), or None when they all were."""
     printed = [masked(line) for line in printed]
     at = 0
     for line in expected:
+        if line.strip() == ELISION:
+            continue
         want = masked(line)
         while at < len(printed) and printed[at] != want:
             at += 1
@@ -72,8 +110,20 @@ def shows(expected, printed):
     return None
 
 
+def scratch_folder(work, source, build):
+    """A page's folder: links to what its examples read (samples, test data, headers, plugins, build)."""
+    work.mkdir(parents=True)
+    for name in ("sample_dems", "tests", "src", "plugins"):
+        os.symlink(source / name, work / name)
+    if build is not None:
+        os.symlink(build, work / "build")
+
+
 def main():
     terrapolis, source = Path(sys.argv[1]).resolve(), Path(sys.argv[2]).resolve()
+    build = os.environ.get("TERRAPOLIS_BUILD_DIR")
+    if build is None and (terrapolis.parents[2] / "CMakeCache.txt").is_file():
+        build = terrapolis.parents[2]  # build/src/cli/terrapolis
     scratch = Path(tempfile.mkdtemp(prefix="tp-docs-"))
     bin_dir = str(scratch / "bin")
     os.mkdir(bin_dir)
@@ -82,13 +132,20 @@ def main():
     tested = 0
     failures = []
     for page in sorted((source / "docs").glob("*.md")):
-        page_blocks = blocks(page)
+        page_blocks = []
+        for number, info, lines in fences(page):
+            where = f"docs/{page.name}:{number}"
+            if TESTED.match(info):
+                page_blocks.append((number, info.split()[0], lines))
+            elif info == "sh bench":
+                failures += [f"{where}: {problem}" for problem in bench_problems(source, lines)]
+            elif (line := untested_command(info, lines)) is not None:
+                failures.append(f"{where}: `{line.strip()}` is in a ```{info} block: fence a real example "
+                                "```sh test or ```console test, a synopsis ```text, a benchmark ```sh bench")
         if not page_blocks:
             continue
         work = scratch / page.stem
-        (work / "tests").mkdir(parents=True)
-        os.symlink(source / "sample_dems", work / "sample_dems")
-        os.symlink(source / "tests" / "data", work / "tests" / "data")
+        scratch_folder(work, source, build)
         for number, kind, lines in page_blocks:
             where = f"docs/{page.name}:{number}"
             if kind == "sh":
