@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <set>
+#include <utility>
 
 #include "terrain/river_grammar.hpp"
 
@@ -41,9 +42,13 @@ std::vector<RidgeSegment> voronoi_ridges(const std::vector<Point2>& points, cons
   };
   std::vector<std::pair<std::pair<int, int>, RidgeSegment>> keyed;
   for (auto e = dt.finite_edges_begin(); e != dt.finite_edges_end(); ++e) {
-    const Delaunay::Face_handle f = e->first, g = f->neighbor(e->second);
+    Delaunay::Face_handle f = e->first, g = f->neighbor(e->second);
     if (dt.is_infinite(f) || dt.is_infinite(g)) continue;  // hull edges: the ridge runs off to infinity
     const int a = f->vertex(f->cw(e->second))->info(), b = f->vertex(f->ccw(e->second))->info();
+    // The iterator reports an edge from either of its faces, in an order that follows memory
+    // addresses: orient every ridge from the same side of its edge (node a < b) so that the
+    // segments, not only their set, are the same from run to run.
+    if (a > b) std::swap(f, g);
     const std::pair<int, int> key{std::min(a, b), std::max(a, b)};
     if (rivers.count(key)) continue;  // a river crosses this Voronoi edge: an inlet or the outlet of a block
     RidgeSegment s;
