@@ -74,7 +74,8 @@ class GenerateCommand final : public Command {
   void setup(CLI::App& app) override {
     app_ = &app;
     file_kind(app.add_option("OUT", output_, "Output GeoTIFF (float32 heights in metres)")->required(), FileKind::raster_out);
-    grid_.add(app, true);
+    grid_.add(app, true, "dmmc: an unreferenced grid with its corner at 0,0; the other methods: ETRS89-LAEA Europe, "
+                         "EPSG:3035, the grid centred on 52N 10E");
     app.add_option("--method", method_, "Generator: " + method_names() + " (see docs/terrain.md)")->capture_default_str();
     app.add_option("--relief", relief_m_, "flow, tectonic: height (m) of the highest crest above the outlets")
         ->capture_default_str()->check(CLI::PositiveNumber);

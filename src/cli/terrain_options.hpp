@@ -85,12 +85,13 @@ struct GridOptions {
   double cell_m = 0;
   bool default_crs = false;  ///< crs and origin were chosen by the command, not given: errors name --size and --cell only
 
-  void add(CLI::App& app, bool required) {
+  /// `defaults`: what the command does without --crs and --origin, for their help.
+  void add(CLI::App& app, bool required, const std::string& defaults = "an unreferenced grid with its corner at 0,0") {
     auto* s = app.add_option("--size", size, "Grid size in cells, WxH (e.g. 513x513)");
     auto* c = app.add_option("--cell", cell_m, "Cell size in metres")->check(CLI::PositiveNumber);
     if (required) { s->required(); c->required(); }
-    app.add_option("--crs", crs, "Projected CRS of the grid, e.g. EPSG:32632 (default: an unreferenced local grid)");
-    app.add_option("--origin", origin, "CRS coordinates X,Y of the grid's north-west corner (default 0,0)");
+    app.add_option("--crs", crs, "Projected CRS of the grid, e.g. EPSG:32632 (default: " + defaults + ")");
+    app.add_option("--origin", origin, "CRS coordinates X,Y of the grid's north-west corner (default: see --crs)");
   }
   bool given() const { return !size.empty(); }
 
