@@ -1,19 +1,23 @@
 // SPDX-License-Identifier: MIT
 #include "io/output_set.hpp"
 
+#include <fcntl.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
-#include <csignal>
+#include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <set>
 
 #include <nlohmann/json.hpp>
 
 #include "core/error.hpp"
 #include "core/interrupt.hpp"
+#include "core/progress.hpp"
 #include "io/text_io.hpp"
 #include "terrapolis/version.hpp"
 
@@ -89,12 +93,12 @@ std::vector<std::pair<std::string, std::string>>& staging_names() {
   return names;
 }
 
-bool process_gone(long pid) { return ::kill(pid_t(pid), 0) != 0 && errno == ESRCH; }
-
-/// Removes "<name>.tmp-<pid>" staging folders beside `path` left by dead processes of this user.
+/// Removes the "<name>.tmp-<pid>" staging folders beside `path` (holding our marker, of this user)
+/// of commands that died: the caller holds the output's lock, so no live command is writing them.
 void remove_stale_staging(const fs::path& path) {
   const std::string prefix = path.filename().string() + ".tmp-";
   std::error_code ec;
+  std::vector<fs::path> stale;
   for (const auto& entry : fs::directory_iterator(path.parent_path(), ec)) {
     const std::string name = entry.path().filename().string();
     if (name.rfind(prefix, 0) != 0) continue;
@@ -102,9 +106,32 @@ void remove_stale_staging(const fs::path& path) {
     if (digits.empty() || !std::all_of(digits.begin(), digits.end(), [](unsigned char c) { return std::isdigit(c); })) continue;
     struct stat marker {};
     if (::stat((entry.path() / kStagingMarker).c_str(), &marker) != 0 || marker.st_uid != ::getuid()) continue;
-    const long pid = std::atol(digits.c_str());
-    if (pid != long(::getpid()) && process_gone(pid)) fs::remove_all(entry.path(), ec);
+    if (std::atol(digits.c_str()) != long(::getpid())) stale.push_back(entry.path());
   }
+  std::sort(stale.begin(), stale.end());
+  for (const auto& dir : stale) {
+    fs::remove_all(dir, ec);
+    Log().warn("removed " + dir.string() + ", the temporary folder of a terrapolis command that was killed before it finished");
+  }
+}
+
+/// The lock file that reserves the output `abs`, beside it.
+fs::path lock_path(const fs::path& abs) { return abs.parent_path() / ("." + abs.filename().string() + ".terrapolis-lock"); }
+
+/// rename(2) that never replaces an existing `to` (renameat2's RENAME_NOREPLACE; where the file
+/// system lacks it, a plain rename after a check: our lock keeps other terrapolis commands out).
+void move_new(const fs::path& from, const fs::path& to, const std::string& name) {
+  std::error_code ec;
+  if (fs::is_directory(to, ec) && fs::is_empty(to, ec)) fs::remove(to, ec);  // an empty folder counts as new
+  int rc = ::renameat2(AT_FDCWD, from.c_str(), AT_FDCWD, to.c_str(), RENAME_NOREPLACE);
+  if (rc != 0 && (errno == EINVAL || errno == ENOSYS)) {
+    if (fs::exists(to, ec)) errno = EEXIST;
+    else rc = ::rename(from.c_str(), to.c_str());
+  }
+  if (rc == 0) return;
+  if (errno == EEXIST || errno == ENOTEMPTY)
+    throw bad_input(name + ": appeared while this command ran (not written by terrapolis); nothing replaced, this command's output is discarded");
+  throw processing_error(to.string() + ": cannot move the new output in place (" + std::strerror(errno) + ")");
 }
 
 std::vector<std::string> entries(const fs::path& dir) {
@@ -129,12 +156,42 @@ OutputSet::OutputSet(std::string command, std::vector<std::string> inputs, bool 
 }
 
 OutputSet::~OutputSet() {
-  if (committed_) return;
   std::error_code ec;
-  for (const auto& t : targets_) fs::remove_all(t.staging, ec);
+  if (!committed_)
+    for (const auto& t : targets_) fs::remove_all(t.staging, ec);
+  for (const auto& lock : locks_) {
+    ::unlink(lock.path.c_str());  // before the unlock: a command waiting on this file retries on a new one
+    ::close(lock.fd);
+  }
 }
 
-void OutputSet::check_target(const fs::path& path, bool is_folder) const {
+void OutputSet::reserve(const fs::path& abs, const std::string& name) {
+  const fs::path path = lock_path(abs);
+  for (;;) {
+    const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd < 0) throw processing_error(path.string() + ": cannot create the output's lock file (" + std::strerror(errno) + ")");
+    if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+      // The holder writes its pid just after it takes the lock: give it a few milliseconds.
+      char pid[32] = {};
+      ssize_t n = 0;
+      for (int tries = 0; tries < 50 && (n = ::pread(fd, pid, sizeof pid - 1, 0)) <= 0; ++tries) ::usleep(2000);
+      ::close(fd);
+      const std::string holder = n > 0 ? " (pid " + std::string(pid, std::size_t(n)) + ")" : std::string();
+      throw bad_input(name + ": another terrapolis command" + holder + " is writing this output; wait until it ends or choose another output");
+    }
+    struct stat held {}, now {};
+    if (::fstat(fd, &held) == 0 && ::stat(path.c_str(), &now) == 0 && held.st_ino == now.st_ino && held.st_dev == now.st_dev) {
+      // Our pid, for the message of a command refused meanwhile; a full disk leaves it empty (the lock holds all the same).
+      const std::string pid = std::to_string(::getpid());
+      if (::ftruncate(fd, 0) == 0 && ::pwrite(fd, pid.data(), pid.size(), 0) != ssize_t(pid.size())) (void)::ftruncate(fd, 0);
+      locks_.push_back({path, fd});
+      return;
+    }
+    ::close(fd);  // its holder removed it as we opened it: take the new one
+  }
+}
+
+void OutputSet::check_target(const fs::path& path, bool is_folder) {
   const std::string name = path.string();
   if (name.empty()) throw bad_input("output: the path is empty");
   const fs::path abs = absolute_path(name);
@@ -151,6 +208,8 @@ void OutputSet::check_target(const fs::path& path, bool is_folder) const {
     if (abs == in) throw bad_input(name + ": is an input of this command; refusing to write over it");
     if (within(abs, in)) throw bad_input(name + ": holds the input " + in.string() + "; refusing to write over it");
   }
+  reserve(abs, name);  // from here to the end no other terrapolis command writes this output
+  remove_stale_staging(abs);
   if (!fs::exists(abs, ec)) return;
   if (is_folder) {
     if (!fs::is_directory(abs, ec)) throw bad_input(name + ": exists and is not a folder");
@@ -170,7 +229,6 @@ void OutputSet::check_target(const fs::path& path, bool is_folder) const {
 
 fs::path OutputSet::make_staging(const fs::path& path) {
   const fs::path abs = absolute_path(path.string());
-  remove_stale_staging(abs);
   const fs::path staging = abs.parent_path() / (abs.filename().string() + ".tmp-" + std::to_string(::getpid()));
   staging_names().emplace_back(staging.string(), path.string());  // before anything can fail in it
   std::error_code ec;
@@ -233,7 +291,7 @@ void OutputSet::commit_folder(const Target& t) const {
   for (const auto& f : entries(t.staging)) now.files.insert(f);
   if (!fs::exists(t.final_path, ec) || fs::is_empty(t.final_path, ec)) {
     write_manifest(t.staging, now);
-    move(t.staging, t.final_path);  // rename(2) replaces an empty folder
+    move_new(t.staging, t.final_path, t.final_path.string());
     return;
   }
   // Record old and new files first: an interrupted commit leaves every file of ours recorded.
@@ -258,7 +316,8 @@ void OutputSet::commit_file(const Target& t) const {
     Manifest m = read_manifest(t.final_path.parent_path());
     m.files.insert(t.final_path.filename().string());
     write_manifest(t.final_path.parent_path(), m);
-    move(written, t.final_path);
+    if (fs::exists(t.final_path, ec)) move(written, t.final_path);  // one we wrote (checked at declaration)
+    else move_new(written, t.final_path, t.final_path.string());
   }
   fs::remove_all(t.staging, ec);
 }

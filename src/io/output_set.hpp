@@ -18,8 +18,12 @@ namespace terrapolis {
 ///   no temporary file behind (the destructor removes the staging folders);
 /// - commit() replaces only the files the manifest records (the previous command's) and records the
 ///   new ones; files a user added to an output folder stay;
-/// - staging folders of the same outputs left by dead processes of this user (SIGKILL, power loss)
-///   are removed at declaration.
+/// - reserved at declaration: each output has a lock file beside it, ".<name>.terrapolis-lock",
+///   held (flock) until the command ends, so that of two commands writing the same output the
+///   second is refused at once (bad_input, naming the output and the first command's pid); a new
+///   output is moved in place by a rename that never replaces what appeared meanwhile;
+/// - staging folders of the same output left by commands that died (SIGKILL, power loss: their
+///   lock is free) are removed at declaration, with a warning naming them.
 class OutputSet {
  public:
   /// `inputs`: every file or folder the command reads; `overwrite`: --overwrite was given.
@@ -44,7 +48,13 @@ class OutputSet {
     std::filesystem::path final_path, staging;
     bool is_folder = false;
   };
-  void check_target(const std::filesystem::path& path, bool is_folder) const;
+  /// A held reservation of one output: the lock file and its descriptor.
+  struct Lock {
+    std::filesystem::path path;
+    int fd = -1;
+  };
+  void reserve(const std::filesystem::path& abs, const std::string& name);
+  void check_target(const std::filesystem::path& path, bool is_folder);
   std::filesystem::path make_staging(const std::filesystem::path& path);
   void commit_folder(const Target& t) const;
   void commit_file(const Target& t) const;
@@ -53,6 +63,7 @@ class OutputSet {
   std::vector<std::filesystem::path> inputs_;  ///< absolute, canonical
   bool overwrite_;
   std::vector<Target> targets_;
+  std::vector<Lock> locks_;
   bool committed_ = false;
 };
 

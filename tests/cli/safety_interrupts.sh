@@ -43,13 +43,23 @@ start_and_signal KILL h3 "$TP" -q hydro "$dem" h3 "${long[@]}"
 [[ $rc -eq 137 ]] || fail "SIGKILL: exit $rc"
 stale=$(ls -d h3.tmp-*)
 [[ -d $stale ]] || fail "expected the killed command's staging folder"
-# A folder of that name whose process is alive, or without our marker, is left alone.
-sleep 60 & alive=$!
-mkdir "h3.tmp-$alive" "h3.tmp-999999999"
-cp "$stale/.terrapolis-staging" "h3.tmp-$alive/"
-"$TP" -q hydro "$dem" h3 --outputs filled
+# A folder of that name without our marker is left alone.
+mkdir "h3.tmp-999999999"
+"$TP" -q hydro "$dem" h3 --outputs filled 2> stderr
 [[ ! -e $stale ]] || fail "the next run did not remove $stale"
-[[ -d h3.tmp-$alive && -d h3.tmp-999999999 ]] || fail "removed a staging folder that is not a dead one of ours"
-kill "$alive"
+grep -q "warning: removed .*$stale, the temporary folder of a terrapolis command that was killed" stderr || fail "no line about $stale ($(cat stderr))"
+[[ -d h3.tmp-999999999 ]] || fail "removed a folder without the staging marker"
 [[ -f h3/filled.tif ]] || fail "the next run did not write h3"
+[[ -z $(find "$WORK" -name '.*terrapolis-lock') ]] || fail "a lock file stayed: $(find "$WORK" -name '.*terrapolis-lock')"
+
+# A live command's staging folder is never touched: a second command writing the same output is
+# refused at once, names the live command, and the live one ends as if alone.
+"$TP" -q hydro "$dem" h4 "${long[@]}" 2> /dev/null & live=$!
+for _ in $(seq 100); do [[ -e h4.tmp-$live ]] && break; sleep 0.1; done
+rc=0; "$TP" -q hydro "$dem" h4 --outputs filled 2> stderr || rc=$?
+[[ $rc -eq 2 ]] || fail "a second command on a live output: exit $rc, expected 2"
+grep -q "h4: another terrapolis command (pid $live) is writing this output" stderr || fail "refusal does not name the live command: $(cat stderr)"
+[[ $(wc -l < stderr) -eq 1 ]] || fail "the refusal is not one line: $(cat stderr)"
+[[ -d h4.tmp-$live && -f h4.tmp-$live/.terrapolis-staging ]] || fail "the refused command touched the live staging folder"
+kill -INT "$live"; wait "$live" || true
 echo "safety_interrupts: ok"
