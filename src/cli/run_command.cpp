@@ -3,9 +3,11 @@
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
+#include <filesystem>
 
 #include "cli/command.hpp"
 #include "cli/commands_list.hpp"
+#include "cli/run_batch.hpp"
 #include "cli/schema_options.hpp"
 #include "pipeline/runner.hpp"
 #include "pipeline/scenario.hpp"
@@ -20,12 +22,17 @@ class RunCommand final : public Command {
     return "Run a scenario (JSON) from DEM to roads; without a file, the default scenario on the bundled Corsica DEM";
   }
   void setup(CLI::App& app) override {
-    file_kind(app.add_option("SCENARIO", file_, "Scenario file (JSON, see schemas/scenario.schema.json); default: the embedded scenario"), FileKind::file_in);
+    file_kind(app.add_option("SCENARIO", files_,
+                             "Scenario file (JSON, see schemas/scenario.schema.json); default: the embedded scenario. Several "
+                             "files, or a folder of them, run as a batch: one run folder each, --jobs at once, a table at the end"),
+              FileKind::file_in);
+    app.add_option("--jobs", jobs_, "Batch: runs at once (each a process of its own, sharing --threads)")->check(CLI::PositiveNumber);
     app.add_option("--set", sets_, "Override a field: stage.field=value (repeatable), e.g. --set density.weights=[1,1,0,0]");
     // The schema's range (a JSON-safe integer): a negative or larger seed is refused, never replaced.
     app.add_option("--seed", seed_, "Seed of the run, 0 .. 2^53-1 (overrides the scenario's)")
         ->check(CLI::Range(std::uint64_t(0), std::uint64_t(9007199254740991)));
-    file_kind(app.add_option("-o,--output", output_, "Run folder (overrides the scenario's)"), FileKind::folder_out);
+    file_kind(app.add_option("-o,--output", output_, "Run folder (overrides the scenario's); batch: the folder holding a run folder per scenario, named by its file"),
+              FileKind::folder_out);
     app.add_flag("--overwrite", overwrite_, "Replace the run folder if it exists");
     const std::vector<std::string> stages = pipeline::stage_names();
     app.add_option("--from", from_, "Rerun from this stage on, reading the earlier stages' results back from the run")
@@ -37,9 +44,17 @@ class RunCommand final : public Command {
     app.add_flag("--print-scenario", print_, "Print the resolved scenario (defaults filled) and exit");
   }
   void run(Context& context) override {
+    if (is_batch(files_)) {
+      if (print_) throw bad_input("--print-scenario: takes one scenario, not a batch");
+      run_batch({files_, sets_, seed_, output_, overwrite_, from_, until_, only_, jobs_, context.threads}, context.log);
+      return;
+    }
+    const std::string file = files_.empty() ? std::string() : files_[0];
     // As a JSON string (quotes and backslashes escaped); an empty one is the schema's to refuse.
-    if (output_) sets_.push_back("output=" + nlohmann::json(*output_).dump());
-    const pipeline::Scenario scenario = pipeline::load_scenario(file_, sets_, seed_);
+    // A command-line path is relative to the working folder (the scenario's own paths to its file's).
+    const bool elsewhere = !files_.empty() && !std::filesystem::path(files_[0]).parent_path().empty();
+    if (output_) sets_.push_back("output=" + nlohmann::json(elsewhere && !output_->empty() ? std::filesystem::absolute(*output_).string() : *output_).dump());
+    const pipeline::Scenario scenario = pipeline::load_scenario(file, sets_, seed_);
     if (print_) {
       std::printf("%s\n", scenario.resolved.dump(2).c_str());
       return;
@@ -57,7 +72,9 @@ class RunCommand final : public Command {
   }
 
  private:
-  std::string file_, from_, until_;
+  std::vector<std::string> files_;
+  std::string from_, until_;
+  int jobs_ = 1;
   std::optional<std::string> output_;
   std::vector<std::string> sets_, only_;
   std::optional<std::uint64_t> seed_;
