@@ -8,6 +8,8 @@
 #include <nlohmann/json.hpp>
 #include <algorithm>
 #include <cctype>
+#include <map>
+#include <regex>
 #include <sstream>
 
 #include "cli/command.hpp"
@@ -49,6 +51,20 @@ std::vector<std::array<double, 2>> parse_linestring(const std::string& text) {
   return points;
 }
 
+/// `message` with the lake module's field pointers ("/level_m: ...") named by this command's flags.
+std::string with_lake_flags(const std::string& message) {
+  static const std::regex field(R"((^|[\s(])/(at|level_m|depth_m|dam|crest_m)(?=[:,\s)]|$))");
+  static const std::map<std::string, std::string> flag = {
+      {"at", "--at"}, {"level_m", "--level"}, {"depth_m", "--depth"}, {"dam", "--dam"}, {"crest_m", "--crest"}};
+  std::string out;
+  auto last = message.cbegin();
+  for (std::sregex_iterator m(message.begin(), message.end(), field), end; m != end; ++m) {
+    out.append(last, (*m)[0].first).append((*m)[1].str()).append(flag.at((*m)[2].str()));
+    last = (*m)[0].second;
+  }
+  return out.append(last, message.cend());
+}
+
 std::string fixed(double v, int digits) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.*f", digits, v);
@@ -74,6 +90,15 @@ class LakeCommand final : public Command {
   }
 
   void run(Context& context) override {
+    try {
+      flood_and_write(context);
+    } catch (const Error& e) {
+      throw Error(e.kind(), with_lake_flags(e.what()));
+    }
+  }
+
+ private:
+  void flood_and_write(Context& context) {
     lake::LakeSpec spec;
     const auto at = parse_pair("--at", at_);
     spec.lon = at[0];
@@ -128,7 +153,7 @@ class LakeCommand final : public Command {
                      " million m3, max depth " + fixed(lake.max_depth_m, 2) + " m" + extra + "; wrote " + out_dir_);
   }
 
- private:
+
   DemInput dem_;
   std::string out_dir_, at_, dam_, run_dir_;
   double level_ = NAN, depth_ = NAN, crest_ = NAN;

@@ -61,37 +61,18 @@ void divide_land_by_max(Raster<float>& r, const std::vector<std::uint8_t>& kind,
 }
 
 void check_options(const Dem& dem, const Raster<float>& hydrometry, const DensityOptions& o) {
+  std::vector<double> factor_weights;
+  for (const auto& f : o.factors) factor_weights.push_back(f.weight);
+  check_settings(o, factor_weights);
   if (hydrometry.cols() != dem.cols() || hydrometry.rows() != dem.rows())
     throw bad_input("hydrometry: grid is " + std::to_string(hydrometry.cols()) + "x" + std::to_string(hydrometry.rows()) +
                     ", the DEM's is " + std::to_string(dem.cols()) + "x" + std::to_string(dem.rows()));
-  if (!(o.r_min_m > 0) || !std::isfinite(o.r_min_m)) throw bad_input("--r-min: must be a positive number of metres");
-  if (!(o.r_max_m > o.r_min_m) || !std::isfinite(o.r_max_m)) throw bad_input("--r-max: must be larger than --r-min (metres)");
-  if (!(o.plateau_max_m >= o.plateau_min_m)) throw bad_input("plateau: maximum altitude is below the minimum");
-  if (!(o.plain_max_variation_m > 0)) throw bad_input("plain: maximum variation must be positive (metres)");
-  if (std::isnan(o.sea_level_m)) throw bad_input("--sea-level: not a number");
-  if (std::isnan(o.max_altitude_m)) throw bad_input("--max-altitude: not a number");
-  if (o.max_slope_deg && !(*o.max_slope_deg > 0 && *o.max_slope_deg <= 90)) throw bad_input("--max-slope: must be in (0, 90] degrees");
-  if (o.river_bed_cap && !std::isfinite(*o.river_bed_cap)) throw bad_input("--river-bed-cap: not a number");
-  if (o.ring_bands < 1) throw bad_input("ring bands: must be at least 1");
-  bool any = false;
-  for (double w : o.weights) {
-    if (!std::isfinite(w)) throw bad_input("--weights: weights must be finite numbers");
-    any = any || w != 0;
-  }
-  for (double w : o.terrain_weights) {
-    if (!std::isfinite(w)) throw bad_input("density: terrain weights must be finite numbers");
-    any = any || w != 0;
-  }
-  for (const auto& f : o.factors) {
-    if (!std::isfinite(f.weight)) throw bad_input(f.name + ": weight must be a finite number");
+  for (const auto& f : o.factors)
     if (f.values.cols() != dem.cols() || f.values.rows() != dem.rows()) throw bad_input(f.name + ": factor is not on the DEM's grid");
-    any = any || f.weight != 0;
-  }
   for (const auto& m : o.exclusion_masks)
     if (m.cols() != dem.cols() || m.rows() != dem.rows()) throw bad_input("exclusion mask: not on the DEM's grid");
   if (o.water_mask.size() && (o.water_mask.cols() != dem.cols() || o.water_mask.rows() != dem.rows()))
     throw bad_input("water mask: not on the DEM's grid");
-  if (!any) throw bad_input("--weights: every weight is 0, the density would be undefined");
 }
 
 /// Slope in degrees from central differences in metres (one-sided at edges and next to nodata).
@@ -163,6 +144,34 @@ void to_land_rank(Raster<float>& r) {
 
 }  // namespace
 
+void check_settings(const DensityOptions& o, const std::vector<double>& layer_weights) {
+  if (!(o.r_min_m > 0) || !std::isfinite(o.r_min_m)) throw bad_input("/density/r_min_m: must be a positive number of metres");
+  if (!(o.r_max_m > o.r_min_m) || !std::isfinite(o.r_max_m)) throw bad_input("/density/r_max_m: must be larger than /density/r_min_m (metres)");
+  if (!(o.plateau_max_m >= o.plateau_min_m))
+    throw bad_input("/density/plateau_max_m: lies below /density/plateau_min_m (" + std::to_string(int(o.plateau_max_m)) + " < " +
+                    std::to_string(int(o.plateau_min_m)) + " m)");
+  if (!(o.plain_max_variation_m > 0)) throw bad_input("/density/plain_max_variation_m: must be positive (metres)");
+  if (std::isnan(o.sea_level_m)) throw bad_input("/water/sea_level_m: not a number");
+  if (std::isnan(o.max_altitude_m)) throw bad_input("/density/max_altitude_m: not a number");
+  if (o.max_slope_deg && !(*o.max_slope_deg > 0 && *o.max_slope_deg <= 90)) throw bad_input("/density/max_slope_deg: must be in (0, 90] degrees");
+  if (o.river_bed_cap && !std::isfinite(*o.river_bed_cap)) throw bad_input("/density/river_bed_cap: not a number");
+  if (o.ring_bands < 1) throw bad_input("ring bands: must be at least 1");
+  bool any = false;
+  for (double w : o.weights) {
+    if (!std::isfinite(w)) throw bad_input("/density/weights: weights must be finite numbers");
+    any = any || w != 0;
+  }
+  for (double w : o.terrain_weights) {
+    if (!std::isfinite(w)) throw bad_input("/density/weights: weights must be finite numbers");
+    any = any || w != 0;
+  }
+  for (std::size_t i = 0; i < layer_weights.size(); ++i) {
+    if (!std::isfinite(layer_weights[i])) throw bad_input("/density/layers/" + std::to_string(i) + "/weight: must be a finite number");
+    any = any || layer_weights[i] != 0;
+  }
+  if (!any) throw bad_input("/density/weights: every weight is 0 (and every layer's), the density would be undefined");
+}
+
 std::vector<float> distance_to_m(const std::vector<std::uint8_t>& feature, const CellMetrics& metrics, int cols, int rows) {
   const std::size_t n = std::size_t(cols) * std::size_t(rows);
   std::vector<double> row_d2(n);
@@ -203,7 +212,7 @@ double combine(const double* weights, const double* values, std::size_t n) {
     total += std::abs(weights[i]);
     if (weights[i] < 0) negative += weights[i];
   }
-  if (total == 0) throw bad_input("--weights: every weight is 0, the density would be undefined");
+  if (total == 0) throw bad_input("/density/weights: every weight is 0, the density would be undefined");
   return std::clamp((sum - negative) / total, 0.0, 1.0);
 }
 

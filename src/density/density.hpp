@@ -67,6 +67,7 @@ struct DensityOptions {
   // ---- combination ---------------------------------------------------------------------------
   /// Weights of (coast, hydrometry, plateau, plain): negative repulsive, 0 neutral, positive attractive.
   std::array<double, 4> weights{1, 1, 1.5, 0};
+
   /// Weights of the terrain terms (kTerrainTerms, in that order), combined with the four
   /// characteristics: 0 leaves them out (the thesis's model).
   std::array<double, kTerrainCount> terrain_weights{};
@@ -90,6 +91,11 @@ struct DensityOptions {
   /// Exclusion masks (user rasters, plugins): non-zero cells are uninhabitable.
   std::vector<Raster<std::uint8_t>> exclusion_masks;
 };
+
+/// The checks of the settings alone, before any raster is read: throws bad_input naming the
+/// setting by its scenario pointer ("/density/plateau_max_m: ..."; the density command names its
+/// flags instead). `layer_weights`: the weights of the user's layers, whose rasters come later.
+void check_settings(const DensityOptions& options, const std::vector<double>& layer_weights);
 
 /// Figures for the calibration report.
 struct DensityStats {

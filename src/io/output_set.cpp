@@ -118,6 +118,10 @@ void remove_stale_staging(const fs::path& path) {
 /// The lock file that reserves the output `abs`, beside it.
 fs::path lock_path(const fs::path& abs) { return abs.parent_path() / ("." + abs.filename().string() + ".terrapolis-lock"); }
 
+Error appeared_meanwhile(const std::string& name) {
+  return bad_input(name + ": appeared while this command ran (not written by terrapolis); nothing replaced, this command's output is discarded");
+}
+
 /// rename(2) that never replaces an existing `to` (renameat2's RENAME_NOREPLACE; where the file
 /// system lacks it, a plain rename after a check: our lock keeps other terrapolis commands out).
 void move_new(const fs::path& from, const fs::path& to, const std::string& name) {
@@ -130,7 +134,7 @@ void move_new(const fs::path& from, const fs::path& to, const std::string& name)
   }
   if (rc == 0) return;
   if (errno == EEXIST || errno == ENOTEMPTY)
-    throw bad_input(name + ": appeared while this command ran (not written by terrapolis); nothing replaced, this command's output is discarded");
+    throw appeared_meanwhile(name);
   throw processing_error(to.string() + ": cannot move the new output in place (" + std::strerror(errno) + ")");
 }
 
@@ -276,6 +280,8 @@ void OutputSet::commit() {
   for (const auto& t : targets_) {
     if (!t.is_folder || !fs::exists(t.final_path, ec) || fs::is_empty(t.final_path, ec)) continue;
     const Manifest old = read_manifest(t.final_path);
+    if (old.written_by.empty())  // it was new or ours at declaration: something else made it meanwhile
+      throw appeared_meanwhile(t.final_path.string());
     for (const auto& f : entries(t.staging))
       if (f != kStagingMarker && fs::exists(t.final_path / f, ec) && !old.files.count(f))
         throw bad_input((t.final_path / f).string() + ": exists and was not written by terrapolis; move it away and rerun");

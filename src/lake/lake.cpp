@@ -58,8 +58,8 @@ std::vector<std::size_t> line_cells(const Georef& georef, int cols, int rows, co
 }
 
 Lake flood(const Dem& dem, const CellMetrics& metrics, int seed_col, int seed_row, double level_m, const Dam* dam, Progress& progress) {
-  if (!std::isfinite(level_m)) throw bad_input("--level: must be a finite elevation in metres");
-  if (!dem.inside(seed_col, seed_row)) throw bad_input("--at: the point lies outside the DEM");
+  if (!std::isfinite(level_m)) throw bad_input("/level_m: must be a finite elevation in metres");
+  if (!dem.inside(seed_col, seed_row)) throw bad_input("/at: the point lies outside the DEM");
   const int cols = dem.cols(), rows = dem.rows();
   Lake lake;
   lake.level_m = level_m;
@@ -72,17 +72,17 @@ Lake flood(const Dem& dem, const CellMetrics& metrics, int seed_col, int seed_ro
   // The dam raises its cells to the crest (never lowers them).
   std::vector<std::uint8_t> is_dam;
   if (dam) {
-    if (!std::isfinite(dam->crest_m)) throw bad_input("--crest: must be a finite elevation in metres");
+    if (!std::isfinite(dam->crest_m)) throw bad_input("/crest_m: must be a finite elevation in metres");
     is_dam.assign(dem.size(), 0);
     for (std::size_t i : line_cells(dem.georef(), cols, rows, dam->line)) is_dam[i] = 1, ++lake.dam_cells;
-    if (lake.dam_cells == 0) throw bad_input("--dam: the line does not cross the DEM");
+    if (lake.dam_cells == 0) throw bad_input("/dam: the line does not cross the DEM");
   }
   auto ground = [&](std::size_t i) { return is_dam.empty() || !is_dam[i] ? double(dem[i]) : std::max(double(dem[i]), dam->crest_m); };
   const std::size_t seed = dem.index(seed_col, seed_row);
-  if (dem.is_nodata(seed)) throw bad_input("--at: the point lies on the DEM's nodata");
+  if (dem.is_nodata(seed)) throw bad_input("/at: the point lies on the DEM's nodata");
   if (!(ground(seed) < level_m)) {
     char msg[160];
-    std::snprintf(msg, sizeof msg, "--at: the ground there (%.2f m) is not below the water level (%.2f m)", ground(seed), level_m);
+    std::snprintf(msg, sizeof msg, "/at: the ground there (%.2f m) is not below the water level (%.2f m)", ground(seed), level_m);
     throw bad_input(msg);
   }
   ProgressStep step(progress, "lake");
@@ -116,36 +116,46 @@ Lake flood(const Dem& dem, const CellMetrics& metrics, int seed_col, int seed_ro
   return lake;
 }
 
+void check_spec(const LakeSpec& spec) {
+  if (!(std::abs(spec.lat) <= 90) || !(std::abs(spec.lon) <= 360)) throw bad_input("/at: not a lon,lat pair in degrees");
+  for (const auto& q : spec.dam_lonlat)
+    if (!(std::abs(q[1]) <= 90) || !(std::abs(q[0]) <= 360)) throw bad_input("/dam: not lon,lat pairs in degrees");
+  if (!spec.dam_lonlat.empty()) {
+    if (spec.dam_lonlat.size() < 2) throw bad_input("/dam: a line needs at least two points");
+    if (!spec.crest_m) throw bad_input("/dam: needs /crest_m (the crest elevation, m)");
+  } else if (spec.crest_m) {
+    throw bad_input("/crest_m: only with /dam");
+  }
+  if (spec.crest_m && !std::isfinite(*spec.crest_m)) throw bad_input("/crest_m: must be a finite elevation in metres");
+  if (spec.level_m && spec.depth_m) throw bad_input("/level_m, /depth_m: give one, not both");
+  if (spec.level_m && !std::isfinite(*spec.level_m)) throw bad_input("/level_m: must be a finite elevation in metres");
+  if (spec.depth_m && !(*spec.depth_m > 0 && std::isfinite(*spec.depth_m))) throw bad_input("/depth_m: must be a positive number of metres");
+  if (!spec.level_m && !spec.depth_m && spec.dam_lonlat.empty())
+    throw bad_input("/level_m or /depth_m: the water level is required (or /dam with /crest_m)");
+}
+
 Lake flood(const Dem& dem, const CellMetrics& metrics, const LakeSpec& spec, Progress& progress) {
+  check_spec(spec);
   const GridLocator locator(dem.georef());
-  auto to_cell = [&](double lon, double lat, const char* option) {
-    if (!(std::abs(lat) <= 90) || !(std::abs(lon) <= 360)) throw bad_input(std::string(option) + ": not a lon,lat pair in degrees");
+  auto to_cell = [&](double lon, double lat, const char* pointer) {
     const auto xy = locator.lonlat_to_crs(lon, lat);
-    if (!std::isfinite(xy[0]) || !std::isfinite(xy[1])) throw bad_input(std::string(option) + ": cannot be transformed to the DEM's CRS");
+    if (!std::isfinite(xy[0]) || !std::isfinite(xy[1])) throw bad_input(std::string(pointer) + ": cannot be transformed to the DEM's CRS");
     return xy;
   };
-  const auto seed_xy = to_cell(spec.lon, spec.lat, "--at");
+  const auto seed_xy = to_cell(spec.lon, spec.lat, "/at");
   const auto p = to_pixel(dem.georef().transform, seed_xy[0], seed_xy[1]);
   const int col = int(std::floor(p[0])), row = int(std::floor(p[1]));
-  if (!dem.inside(col, row)) throw bad_input("--at: the point lies outside the DEM");
+  if (!dem.inside(col, row)) throw bad_input("/at: the point lies outside the DEM");
   Dam dam;
   const bool with_dam = !spec.dam_lonlat.empty();
   if (with_dam) {
-    if (spec.dam_lonlat.size() < 2) throw bad_input("--dam: a line needs at least two points");
-    if (!spec.crest_m) throw bad_input("--dam: needs --crest (the crest elevation, m)");
-    for (const auto& q : spec.dam_lonlat) dam.line.push_back(to_cell(q[0], q[1], "--dam"));
+    for (const auto& q : spec.dam_lonlat) dam.line.push_back(to_cell(q[0], q[1], "/dam"));
     dam.crest_m = *spec.crest_m;
-  } else if (spec.crest_m) {
-    throw bad_input("--crest: only with --dam");
   }
-  if (spec.level_m && spec.depth_m) throw bad_input("--level, --depth: give one, not both");
-  if (spec.depth_m && !(*spec.depth_m > 0)) throw bad_input("--depth: must be a positive number of metres");
-  double level = 0;
+  double level = dam.crest_m;
   if (spec.level_m) level = *spec.level_m;
-  else if (spec.depth_m) level = double(dem(col, row)) + *spec.depth_m;  // NaN on nodata: refused by flood
-  else if (with_dam) level = dam.crest_m;
-  else throw bad_input("--level or --depth: the water level is required (or --dam with --crest)");
-  if (spec.depth_m && dem.is_nodata(dem.index(col, row))) throw bad_input("--at: the point lies on the DEM's nodata");
+  else if (spec.depth_m) level = double(dem(col, row)) + *spec.depth_m;  // NaN on nodata: refused below
+  if (spec.depth_m && dem.is_nodata(dem.index(col, row))) throw bad_input("/at: the point lies on the DEM's nodata");
   return flood(dem, metrics, col, row, level, with_dam ? &dam : nullptr, progress);
 }
 

@@ -53,7 +53,12 @@ struct LakeSpec {
   std::optional<double> crest_m;                       ///< required with a dam
 };
 
-/// Floods `dem` as `spec` says. Throws bad_input naming the option at fault.
+/// The checks of a spec alone, before any DEM is read: throws bad_input naming the field at fault by
+/// its pointer within the spec ("/at", "/level_m", "/depth_m", "/dam", "/crest_m"; the scenario's
+/// water.reservoirs items have these fields, the lake command maps them to its flags).
+void check_spec(const LakeSpec& spec);
+
+/// Floods `dem` as `spec` says (check_spec first). Throws bad_input naming the field at fault as check_spec does.
 Lake flood(const Dem& dem, const CellMetrics& metrics, const LakeSpec& spec, Progress& progress);
 
 /// The shoreline: polygons of the flooded cells with `level_m`, `area_km2`, `volume_m3` (of the whole lake).

@@ -64,6 +64,11 @@ std::vector<lake::LakeSpec> reservoir_specs(const Scenario& scenario) {
     if (r.contains("crest_m")) spec.crest_m = r["crest_m"].get<double>();
     if (r.contains("dam"))
       for (const json& p : r["dam"]) spec.dam_lonlat.push_back({p[0].get<double>(), p[1].get<double>()});
+    try {
+      lake::check_spec(spec);
+    } catch (const Error& e) {
+      throw Error(e.kind(), "/water/reservoirs/" + std::to_string(out.size()) + e.what());
+    }
     out.push_back(std::move(spec));
   }
   return out;
@@ -96,7 +101,6 @@ density::DensityOptions density_options(const Scenario& scenario) {
   if (const double cap = d["river_bed_cap"].get<double>(); cap < 1) o.river_bed_cap = cap;
   o.r_min_m = d["r_min_m"].get<double>();
   o.r_max_m = d["r_max_m"].get<double>();
-  if (!(o.r_max_m > o.r_min_m)) throw bad_input("/density/r_max_m: must be larger than /density/r_min_m (metres)");
   o.plateau_min_m = d["plateau_min_m"].get<double>();
   o.plateau_max_m = d["plateau_max_m"].get<double>();
   o.plain_max_variation_m = d["plain_max_variation_m"].get<double>();
@@ -104,6 +108,9 @@ density::DensityOptions density_options(const Scenario& scenario) {
   o.weights = {weights["coast"].get<double>(), weights["hydrometry"].get<double>(), weights["plateau"].get<double>(),
                weights["plain"].get<double>()};
   for (std::size_t k = 0; k < density::kTerrainTerms.size(); ++k) o.terrain_weights[k] = weights[density::kTerrainTerms[k]].get<double>();
+  std::vector<double> layer_weights;
+  for (const auto& layer : d["layers"]) layer_weights.push_back(layer["weight"].get<double>());
+  density::check_settings(o, layer_weights);
   return o;
 }
 
@@ -163,6 +170,7 @@ sites::SitesOptions sites_options(const Scenario& scenario) {
   o.area_exponent = s["area_exponent"].get<double>();
   o.town_density_per_km2 = s["town_density_per_km2"].get<double>();
   o.influence_factor = s["influence_factor"].get<double>();
+  sites::check_settings(o);
   return o;
 }
 

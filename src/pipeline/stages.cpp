@@ -72,11 +72,11 @@ void write_inland_water(RunState& s, Progress& progress, const Log& log) {
       try {
         l = lake::flood(s.dem, metrics, specs[k], progress);
       } catch (const Error& e) {
-        throw bad_input("water.reservoirs[" + std::to_string(k) + "]: " + e.what());
+        throw bad_input("/water/reservoirs/" + std::to_string(k) + e.what());
       }
       for (std::size_t i = 0; i < l.mask.size(); ++i)
         if (l.mask[i] == 1) water[i] = 1;
-      if (l.spills) log.warn("water.reservoirs[" + std::to_string(k) + "]: the water reaches the DEM's edge or nodata");
+      if (l.spills) log.warn("/water/reservoirs/" + std::to_string(k) + ": the water reaches the DEM's edge or nodata");
       reservoirs.push_back({{"level_m", round_to(l.level_m, 0.01)}, {"area_km2", round_to(l.area_km2, 1e-4)},
                             {"volume_m3", std::round(l.volume_m3)}, {"max_depth_m", round_to(l.max_depth_m, 0.01)}});
     }

@@ -141,13 +141,9 @@ QuotaTable rank_size_table(const Raster<float>& density, const Raster<std::uint8
         if (buildable(c, r) == 1) m2 += metrics.area_m2[std::size_t(r)];
     land_km2 = m2 * 1e-6;
   }
-  if (!(std::isfinite(options.people_per_km2) && options.people_per_km2 >= 0)) throw bad_input("sites: people_per_km2 must be >= 0");
-  if (!(std::isfinite(options.influence_factor) && options.influence_factor >= 0)) throw bad_input("sites: influence_factor must be >= 0");
   result.population_assumed = !(options.population > 0);
   result.land_area_km2 = land_km2;
   result.target_population = result.population_assumed ? std::round(options.people_per_km2 * land_km2) : options.population;
-  if (!(std::isfinite(options.urban_share) && options.urban_share > 0 && options.urban_share <= 1))
-    throw bad_input("sites: urban_share must lie in (0, 1]");
   result.settled_population = std::round(options.urban_share * result.target_population);
   result.sizes_exponent = options.zipf_exponent;
   const std::size_t room = settleable_count(land_km2, options);
@@ -182,9 +178,6 @@ QuotaTable rank_size_table(const Raster<float>& density, const Raster<std::uint8
     }
   }
   QuotaTable table = rank_size_quotas(cell_size, sizes, options);
-  if (options.refill_rounds < 0 || options.candidates < 0) throw bad_input("sites: candidates and refill rounds must be >= 0");
-  if (options.r_min_m > 0 || options.r_max_m > 0)
-    throw bad_input("sites: r_min and r_max set the classes of the belhadj2007 quotas; with rank_size the radii come from the populations");
   return table;
 }
 
@@ -311,6 +304,7 @@ class Growth {
 
 SitesResult place_sites(const Raster<float>& density, const Raster<std::uint8_t>& buildable, const SitesOptions& options,
                         Progress& progress) {
+  check_settings(options);
   const int cols = density.cols(), rows = density.rows();
   if (buildable.cols() != cols || buildable.rows() != rows)
     throw bad_input("sites: the buildable mask and the density model are not on the same grid");

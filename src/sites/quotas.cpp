@@ -16,22 +16,6 @@ std::string metres(double v) {
   return buf;
 }
 
-void check_options(const SitesOptions& o) {
-  auto positive = [](double v, const char* name) {
-    if (!(std::isfinite(v) && v > 0)) throw bad_input(std::string("sites: ") + name + " must be a positive number");
-  };
-  positive(o.dr_min_m, "dr_min_m");
-  positive(o.x_max, "x_max");
-  positive(o.p, "p");
-  positive(o.people_per_m, "people_per_m");
-  positive(o.quota_scale, "quota_scale");
-  if (!(std::isfinite(o.u_min) && o.u_min >= 0)) throw bad_input("sites: u_min must be >= 0");
-  if (!(std::isfinite(o.u_max) && o.u_max >= o.u_min)) throw bad_input("sites: u_max must be >= u_min");
-  if (!(std::isfinite(o.r_min_m) && o.r_min_m >= 0)) throw bad_input("sites: r_min must be >= 0 metres (0: automatic)");
-  if (!(std::isfinite(o.r_max_m) && o.r_max_m >= 0)) throw bad_input("sites: r_max must be >= 0 metres (0: automatic)");
-  if (o.candidates < 0) throw bad_input("sites: candidates must be >= 0 (0: automatic)");
-  if (o.refill_rounds < 0) throw bad_input("sites: refill rounds must be >= 0");
-}
 
 }  // namespace
 
@@ -48,8 +32,39 @@ double units_for_people(double people, const SitesOptions& o) {
 
 double class_step_m(double cell_size_m, const SitesOptions& o) { return std::max(o.dr_min_m, std::floor(cell_size_m)); }
 
+void check_settings(const SitesOptions& o) {
+  auto positive = [](double v, const char* name) {
+    if (!(std::isfinite(v) && v > 0)) throw bad_input(std::string("/sites/") + name + ": must be a positive number");
+  };
+  positive(o.dr_min_m, "dr_min_m");
+  positive(o.x_max, "x_max");
+  positive(o.p, "p");
+  positive(o.people_per_m, "people_per_m");
+  positive(o.quota_scale, "quota_scale");
+  positive(o.town_density_per_km2, "town_density_per_km2");
+  positive(o.zipf_exponent, "zipf_exponent");
+  if (!(std::isfinite(o.u_min) && o.u_min >= 0)) throw bad_input("/sites/u_min: must be >= 0");
+  if (!(std::isfinite(o.u_max) && o.u_max >= o.u_min)) throw bad_input("/sites/u_max: must be >= /sites/u_min");
+  if (!(std::isfinite(o.r_min_m) && o.r_min_m >= 0)) throw bad_input("/sites/r_min_m: must be >= 0 metres (0: automatic)");
+  if (!(std::isfinite(o.r_max_m) && o.r_max_m >= 0)) throw bad_input("/sites/r_max_m: must be >= 0 metres (0: automatic)");
+  if (o.candidates < 0) throw bad_input("/sites/candidates: must be >= 0 (0: automatic)");
+  if (o.refill_rounds < 0) throw bad_input("/sites/refill_rounds: must be >= 0");
+  if (o.quotas == SitesOptions::Quotas::belhadj2007) return;
+  if (o.r_min_m > 0 || o.r_max_m > 0)
+    throw bad_input(std::string(o.r_min_m > 0 ? "/sites/r_min_m" : "/sites/r_max_m") +
+                    ": sets the classes of /sites/quotas belhadj2007; with rank_size the radii come from the populations");
+  if (!(std::isfinite(o.population) && o.population >= 0)) throw bad_input("/sites/population: must be a number of people >= 0");
+  if (!(std::isfinite(o.people_per_km2) && o.people_per_km2 >= 0)) throw bad_input("/sites/people_per_km2: must be >= 0");
+  if (!(std::isfinite(o.influence_factor) && o.influence_factor >= 0)) throw bad_input("/sites/influence_factor: must be >= 0");
+  if (!(std::isfinite(o.urban_share) && o.urban_share > 0 && o.urban_share <= 1)) throw bad_input("/sites/urban_share: must lie in (0, 1]");
+  if (!(std::isfinite(o.min_population) && o.min_population >= 1)) throw bad_input("/sites/min_population: must be at least 1 person");
+  if (!(std::isfinite(o.spacing_km) && o.spacing_km >= 0)) throw bad_input("/sites/spacing_km: must be >= 0 (0: no limit)");
+  if (!(std::isfinite(o.area_exponent) && o.area_exponent > 0 && o.area_exponent <= 1.5))
+    throw bad_input("/sites/area_exponent: must lie in (0, 1.5]");
+}
+
 QuotaTable compute_quotas(double cell_size_m, const SitesOptions& o) {
-  check_options(o);
+  check_settings(o);
   QuotaTable table;
   table.dr_m = class_step_m(cell_size_m, o);
   table.r_min_m = o.r_min_m > 0 ? o.r_min_m : table.dr_m;

@@ -104,6 +104,11 @@ struct SitesOptions {
   int refill_rounds = 8;
 };
 
+/// The checks of the settings alone, before any grid is read (cross-field rules included): throws
+/// bad_input naming the setting by its scenario pointer ("/sites/u_max: ..."; the sites command
+/// names its flags instead). place_sites and compute_quotas start with it.
+void check_settings(const SitesOptions& options);
+
 /// One radius class of the quota table (Algorithm 13).
 struct QuotaClass {
   double radius_m = 0;  ///< class radius, metres

@@ -29,7 +29,12 @@ import json; r = json.load(open('lake/lake.json'))
 assert r['flooded_road_km'] >= 0 and isinstance(r['cities_touched'], list), r
 assert abs(r['area_km2'] - 2.06) < 0.01, r" || fail "lake --run"
 # A reservoir the scenario cannot hold is refused, naming it.
-expect_fail 2 "water.reservoirs\[0\]: --at: the ground" "$TP" --quiet run -o bad --set outputs.preview_width=200 \
+expect_fail 2 "/water/reservoirs/0/at: the ground" "$TP" --quiet run -o bad --set outputs.preview_width=200 \
   --set 'water.reservoirs=[{"at": [9.4187, 42.5187], "level_m": 10}]'
+[[ ! -e bad ]] || fail "a refused run left its folder"
+# A reservoir without a level is refused before any stage runs (no hydrology line on stderr).
+expect_fail 2 "^terrapolis: error: \(default scenario\): /water/reservoirs/0/level_m or /depth_m: the water level is required" \
+  "$TP" run -o bad --set 'water.reservoirs=[{"at": [9.4, 42.9]}]'
+! grep -q "hydro\|fill" "$WORK/stderr" || fail "the run started before refusing the reservoir: $(cat "$WORK/stderr")"
 [[ ! -e bad ]] || fail "a refused run left its folder"
 echo ok

@@ -63,7 +63,8 @@ refuse "$T/x1" "no such folder" "$T/missing"
 mkdir "$T/half"
 cp "$T/in/density.tif" "$T/half/"
 refuse "$T/x2" "buildable.tif" "$T/half"
-refuse "$T/x3" "r_max" "$T/in" --r-min 3000 --r-max 3100
+refuse "$T/x3" "r_max" "$T/in" --quotas belhadj2007 --r-min 3000 --r-max 3100
+refuse "$T/x3" "--r-min: sets the classes of --quotas belhadj2007" "$T/in" --r-min 3000 --r-max 3100
 refuse "$T/x5" "seed" "$T/in" --seed 18446744073709551615
 gdal_calc.py --quiet -A "$DEM" --outfile "$T/half/buildable.tif" --type Byte --calc "A*0"
 refuse "$T/x4" "no buildable cell" "$T/half"

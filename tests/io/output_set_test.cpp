@@ -1,4 +1,4 @@
-// OutputSet: what --overwrite may replace, staging and commit, stale staging of dead processes.
+// OutputSet: what --overwrite may replace, staging and commit, the lock held while a command runs, stale staging of killed ones.
 // SPDX-License-Identifier: MIT
 #include <gtest/gtest.h>
 
@@ -127,24 +127,51 @@ TEST(OutputSet, FileIsReplacedOnlyWhenRecorded) {
   EXPECT_EQ(get(f), "two");
 }
 
-TEST(OutputSet, RemovesStagingOfDeadProcessesOnly) {
+TEST(OutputSet, RemovesStagingOfEndedCommandsOnly) {
   TempDir dir;
   const fs::path out = dir.path() / "out";
-  const pid_t child = fork();
-  if (child == 0) _exit(0);
-  waitpid(child, nullptr, 0);  // a pid whose process is gone
-  const fs::path dead = dir.path() / ("out.tmp-" + std::to_string(child));
-  const fs::path unmarked = dir.path() / "out.tmp-1";  // pid 1 is alive, and this one has no marker
-  const fs::path alive = dir.path() / ("out.tmp-" + std::to_string(getppid()));
-  for (const auto& p : {dead, unmarked, alive}) fs::create_directory(p);
+  const fs::path dead = dir.path() / "out.tmp-999999";      // marked, and no command holds out's lock
+  const fs::path unmarked = dir.path() / "out.tmp-1";       // no marker: not ours
+  for (const auto& p : {dead, unmarked}) fs::create_directory(p);
   put(dead / ".terrapolis-staging", "test\n");
-  put(alive / ".terrapolis-staging", "test\n");
   {
-    OutputSet outputs("test", {}, false);
-    put(outputs.folder(out.string()) / "a.txt", "a");
-    outputs.commit();
+    OutputSet live("test", {}, false);
+    const fs::path staging = live.folder(out.string());
+    EXPECT_FALSE(fs::exists(dead));
+    EXPECT_TRUE(fs::exists(unmarked));
+    // A second command on the same output, while the first holds it: refused, its staging untouched.
+    OutputSet second("test", {}, false);
+    try {
+      second.folder(out.string());
+      ADD_FAILURE() << "a second command on a held output was not refused";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.exit_code(), 2);
+      EXPECT_NE(std::string(e.what()).find("another terrapolis command (pid " + std::to_string(getpid()) + ") is writing this output"),
+                std::string::npos)
+          << e.what();
+    }
+    EXPECT_TRUE(fs::exists(staging / ".terrapolis-staging"));
+    put(staging / "a.txt", "a");
+    live.commit();
   }
-  EXPECT_FALSE(fs::exists(dead));
-  EXPECT_TRUE(fs::exists(unmarked));
-  EXPECT_TRUE(fs::exists(alive));
+  EXPECT_EQ(get(out / "a.txt"), "a");
+  EXPECT_FALSE(fs::exists(dir.path() / ".out.terrapolis-lock"));  // released and removed
+  {
+    OutputSet next("test", {}, true);  // the output is free again
+    put(next.folder(out.string()) / "a.txt", "b");
+    next.commit();
+  }
+  EXPECT_EQ(get(out / "a.txt"), "b");
+}
+
+TEST(OutputSet, NewOutputNeverReplacesOneThatAppeared) {
+  TempDir dir;
+  const fs::path out = dir.path() / "out";
+  OutputSet outputs("test", {}, false);
+  put(outputs.folder(out.string()) / "a.txt", "ours");
+  fs::create_directory(out);
+  put(out / "theirs.txt", "theirs");  // made by something else while the command ran
+  EXPECT_EQ(exit_code_of([&] { outputs.commit(); }), 2);
+  EXPECT_EQ(get(out / "theirs.txt"), "theirs");
+  EXPECT_FALSE(fs::exists(out / "a.txt"));
 }
