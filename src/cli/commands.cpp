@@ -18,6 +18,7 @@ std::vector<std::unique_ptr<Command>> all_commands() {
   commands.push_back(make_network_command());
   commands.push_back(make_path_command());
   commands.push_back(make_roads_command());
+  commands.push_back(make_access_command());
   commands.push_back(make_fill_command());
   commands.push_back(make_reconstruct_command());
   commands.push_back(make_skeleton_command());

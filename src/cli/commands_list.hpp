@@ -24,5 +24,6 @@ std::unique_ptr<Command> make_fill_command();
 std::unique_ptr<Command> make_reconstruct_command();
 std::unique_ptr<Command> make_generate_command();
 std::unique_ptr<Command> make_calibrate_command();
+std::unique_ptr<Command> make_access_command();
 
 }  // namespace terrapolis::cli

@@ -140,7 +140,7 @@ int draw_rank(Style s) {
     case Style::elevation: return 1;
     case Style::flow_direction: case Style::accumulation: case Style::unit_ramp: return 2;
     case Style::mask: case Style::water: return 3;
-    case Style::density: return 4;
+    case Style::density: case Style::access_minutes: return 4;
     case Style::city_extents: return 5;
     case Style::streams: return 6;
     case Style::network: return 7;
@@ -236,6 +236,10 @@ std::string qgis_style_body(const OutputFile& o, const RunState& state) {
                                        {"ferry", "ferry", line("3", "#a6cee3", 0.6, "dot")}});
     case Style::junctions: return single(marker("0", "#252525", 1.6));
     case Style::corridors: return roads::corridors_renderer();
+    case Style::access_minutes:
+      return pseudocolor({{15, "#1a9850", "15 min or less"}, {30, "#91cf60", "15-30 min"}, {60, "#fee08b", "30-60 min"},
+                          {120, "#fc8d59", "1-2 h"}, {1e9, "#d73027", "over 2 h"}},
+                         "DISCRETE", 0.7);
   }
   return "";
 }
@@ -260,7 +264,8 @@ void write_qgis_styles_and_project(const RunState& state) {
     for (auto* o : by_stage[stage]) {
       // Only the most useful layers are shown at first; the rest are one click away.
       const bool visible = o->style != Style::elevation && o->style != Style::flow_direction && o->style != Style::accumulation &&
-                           o->style != Style::unit_ramp && o->style != Style::mask && o->style != Style::network;
+                           o->style != Style::unit_ramp && o->style != Style::mask && o->style != Style::network &&
+                           o->style != Style::access_minutes;
       tree << "<layer-tree-layer id=\"" << layer_id(*o) << "\" name=\"" << escape(stem(o->name)) << "\" source=\"./" << o->name
            << "\" providerKey=\"" << (o->raster ? "gdal" : "ogr") << "\" checked=\"" << (visible ? "Qt::Checked" : "Qt::Unchecked")
            << "\" expanded=\"0\"><customproperties/></layer-tree-layer>";

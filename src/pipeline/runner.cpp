@@ -282,6 +282,17 @@ std::string format_summary(const json& manifest) {
            r.value("junctions", 0));
     for (const auto& [cls, km] : r["length_km"].items()) line("           %-13s %9.1f km\n", cls.c_str(), km.get<double>());
   }
+  if (sum.contains("access")) {
+    const json& a = sum["access"];
+    line("  access   of %.0f people, within reach of\n", a["people"].get<double>());
+    for (const auto& [level, v] : a["levels"].items()) {
+      const std::string whom = level == "all" ? "any settlement" : "settlements of " + level + "+";
+      line("           %-22s (%3d)", whom.c_str(), v["destinations"].get<int>());
+      for (const auto& [minutes, share] : v["share_within"].items())
+        line(" %5.1f%% in %s", 100 * share.get<double>(), minutes.substr(0, minutes.find('_')).c_str());
+      line(" min; mean %.1f min, p90 %.1f min\n", v["mean_minutes"].get<double>(), v["p90_minutes"].get<double>());
+    }
+  }
   out += "  timings ";
   for (const auto& t : manifest["timings"])
     line(" %s %.2f s%s", t["stage"].get<std::string>().c_str(), t["seconds"].get<double>(), t.value("reused", false) ? " (saved)" : "");

@@ -2,6 +2,7 @@
 // SPDX-License-Identifier: MIT
 #include "pipeline/stage_options.hpp"
 
+#include <algorithm>
 #include <filesystem>
 #include <functional>
 #include <iterator>
@@ -275,6 +276,25 @@ void check_file(const std::string& pointer, const std::string& path) {
 
 }  // namespace
 
+AccessSettings access_settings(const Scenario& scenario) {
+  const json& a = scenario.resolved["access"];
+  AccessSettings s;
+  s.enabled = a["enabled"].get<bool>();
+  s.options.walk_factor = a["walk_factor"].get<double>();
+  s.options.knight_moves = a["knight_moves"].get<bool>();
+  for (std::size_t k = 0; k < roads::kRoadClasses.size(); ++k)
+    s.options.road_kmh[k] = a["road_kmh"][std::string(roads::kRoadClasses[k].name)].get<double>();
+  s.thresholds_minutes = a["thresholds_minutes"].get<std::vector<double>>();
+  s.levels_population = a["levels_population"].get<std::vector<double>>();
+  std::sort(s.thresholds_minutes.begin(), s.thresholds_minutes.end());
+  std::sort(s.levels_population.begin(), s.levels_population.end());
+  if (std::adjacent_find(s.thresholds_minutes.begin(), s.thresholds_minutes.end()) != s.thresholds_minutes.end())
+    throw bad_input("/access/thresholds_minutes: a threshold is given twice");
+  if (std::adjacent_find(s.levels_population.begin(), s.levels_population.end()) != s.levels_population.end())
+    throw bad_input("/access/levels_population: a level is given twice");
+  return s;
+}
+
 StageSettings prepare_stages(const Scenario& scenario) {
   try {
     StageSettings s;
@@ -292,6 +312,7 @@ StageSettings prepare_stages(const Scenario& scenario) {
     s.network = network_options(scenario);
     s.roads = at("/roads/costs", [&] { return roads_settings(scenario); });
     s.corridor = corridor_settings(scenario);
+    s.access = access_settings(scenario);
     check_file("/roads/corridor/side_angles", s.corridor.side_angles);
     check_file("/water/water_mask", scenario.path("/water/water_mask"));
     check_file("/roads/vegetation", s.roads.vegetation);

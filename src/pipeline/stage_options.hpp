@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "access/access.hpp"
 #include "density/density.hpp"
 #include "hydro/hydro.hpp"
 #include "hydro/river_types.hpp"
@@ -85,6 +86,15 @@ hydro::FlatWaterOptions flat_water_options(const Scenario& scenario);
 
 /// Every stage's typed settings, built once before the first stage runs (as PDAL prepares every
 /// stage before executing any): the commands build theirs with the same functions.
+/// access.*: the friction surface and what is measured.
+struct AccessSettings {
+  bool enabled = true;
+  access::AccessOptions options;
+  std::vector<double> thresholds_minutes;  ///< increasing
+  std::vector<double> levels_population;   ///< increasing, distinct
+};
+AccessSettings access_settings(const Scenario& scenario);
+
 struct StageSettings {
   hydro::FlatWaterOptions flat_water;
   std::vector<lake::LakeSpec> reservoirs;
@@ -96,6 +106,7 @@ struct StageSettings {
   network::NetworkOptions network;
   RoadsSettings roads;
   CorridorSettings corridor;
+  AccessSettings access;
 };
 /// Builds every stage's settings, loads the cost model and checks that every file the scenario
 /// names exists. Throws bad_input as "SCENARIO: /json/pointer: problem".

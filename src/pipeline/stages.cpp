@@ -284,13 +284,20 @@ json corridor_hook(RunState& s, const roads::TerrainField& terrain, const std::v
   return out;
 }
 
-void roads_run(RunState& s, Progress& progress, const Log& log) {
+/// The roads' terrain: the DEM with the sea (below water.sea_level_m, and nodata) and the run's
+/// inland water (inland_water.tif: flattened lakes, water.water_mask, the reservoirs).
+roads::TerrainField road_terrain(const RunState& s) {
   const RoadsSettings& settings = s.settings.roads;
   const Raster<float> water = read_resampled(saved(s, kInlandWater), s.dem.georef(), s.dem.cols(), s.dem.rows(), Resampling::nearest);
   Raster<std::uint8_t> lakes = s.dem.like<std::uint8_t>(0);
   for (std::size_t i = 0; i < water.size(); ++i) lakes[i] = water[i] == 1;
-  roads::TerrainField terrain(s.dem, s.scenario.resolved["water"]["sea_level_m"].get<double>(), settings.model.unknown_water_depth_m,
-                              settings.model.road_radius_m, &lakes);
+  return roads::TerrainField(s.dem, s.scenario.resolved["water"]["sea_level_m"].get<double>(), settings.model.unknown_water_depth_m,
+                             settings.model.road_radius_m, &lakes);
+}
+
+void roads_run(RunState& s, Progress& progress, const Log& log) {
+  const RoadsSettings& settings = s.settings.roads;
+  roads::TerrainField terrain = road_terrain(s);
   if (!settings.vegetation.empty())
     terrain.set_vegetation(read_resampled(settings.vegetation, s.dem.georef(), s.dem.cols(), s.dem.rows(), Resampling::bilinear));
   plugin::add_to_terrain(plugin::road_terms(s.plugins, s.dem, progress, log), terrain);
@@ -338,7 +345,73 @@ void roads_run(RunState& s, Progress& progress, const Log& log) {
   if (!corridor.is_null()) s.summary["roads"]["corridor"] = corridor;
 }
 
-void roads_load(RunState&) {}  // nothing downstream
+void roads_load(RunState&) {}  // the access stage reads the saved layers
+
+// ---- access (Tobler 1993; Weiss et al. 2018; docs/access.md) ---------------------------------
+
+/// The run's road sections with their road's class (roads.geojson) and structure: bridges and
+/// ferries cross the water, tunnels are entered at their portals only.
+VectorLayer classed_sections(const RunState& s) {
+  const Crs& crs = s.dem.georef().crs;
+  const VectorLayer roads = read_vector(saved(s, "roads.geojson"), crs);
+  VectorLayer sections = read_vector(saved(s, "road_sections.geojson"), crs);
+  std::map<std::int64_t, std::string> class_of;
+  const int class_field = roads.field_index("class");
+  for (std::size_t k = 0; class_field >= 0 && k < roads.features.size(); ++k)  // a section's `road` is its road's index
+    if (const auto* c = std::get_if<std::string>(&roads.features[k].values[std::size_t(class_field)])) class_of[std::int64_t(k)] = *c;
+  const int road = sections.field_index("road");
+  sections.fields.push_back({"class", FieldType::string});
+  for (auto& f : sections.features) {
+    const auto* k = road >= 0 ? std::get_if<std::int64_t>(&f.values[std::size_t(road)]) : nullptr;
+    f.values.push_back(k && class_of.count(*k) ? FieldValue(class_of[*k]) : FieldValue(std::monostate{}));
+  }
+  return sections;
+}
+
+void access_run(RunState& s, Progress& progress, const Log& log) {
+  const AccessSettings& a = s.settings.access;
+  if (!a.enabled) return;
+  const roads::TerrainField terrain = road_terrain(s);
+  Raster<std::uint8_t> land = s.dem.like<std::uint8_t>(0);
+  for (int r = 0; r < s.dem.rows(); ++r)
+    for (int c = 0; c < s.dem.cols(); ++c) land(c, r) = !terrain.water(c, r) && !std::isnan(s.dem(c, r));
+  const access::RoadCells road_cells = access::road_cells(classed_sections(s), s.dem, a.options);
+  // The region's people over the land by the density model (as the sites' catchments count them).
+  double total = 0;
+  for (const auto& site : s.sites) total += double(site.population);
+  if (s.summary["sites"].contains("target_population")) total = s.summary["sites"]["target_population"].get<double>();
+  const Raster<float> people = sites::people_on_land(*s.density, *s.buildable, total);
+  json levels = json::object();
+  for (const double level : a.levels_population) {
+    std::vector<access::Destination> to;
+    for (const auto& site : s.sites)
+      if (double(site.population) >= level) to.push_back({site.col, site.row, site.id});
+    if (to.empty()) continue;
+    const access::AccessResult r = access::travel_time(s.dem, land, road_cells, to, a.options, progress);
+    const std::string suffix = level > 0 ? "_" + std::to_string(std::llround(level)) : "";
+    const std::string whom = level > 0 ? "a settlement of " + std::to_string(std::llround(level)) + " people or more" : "the nearest settlement";
+    s.write("access", "access_minutes" + suffix + ".tif", r.minutes, "travel time to " + whom + ", minutes (on foot off the roads, by road on them)",
+            Style::access_minutes, {{"UNIT", "min"}});
+    if (level == 0)
+      s.write("access", "access_nearest.tif", r.nearest, "id of the settlement nearest in time (cities.geojson), -1 where none is reached",
+              Style::unit_ramp);
+    const access::Coverage c = access::coverage(r.minutes, people, a.thresholds_minutes);
+    json within = json::object();
+    for (std::size_t k = 0; k < a.thresholds_minutes.size(); ++k) {
+      char key[32];
+      std::snprintf(key, sizeof key, "%g_min", a.thresholds_minutes[k]);
+      within[key] = c.total_people > 0 ? std::round(c.within_people[k] / c.total_people * 1e4) / 1e4 : 0.0;
+    }
+    levels[level > 0 ? std::to_string(std::llround(level)) : "all"] = {
+        {"destinations", to.size()}, {"share_within", within}, {"mean_minutes", std::round(c.mean_minutes * 10) / 10},
+        {"p90_minutes", std::round(c.p90_minutes * 10) / 10}, {"unreachable_people", std::llround(c.unreachable_people)}};
+    if (level == 0 && r.unreachable_land > 0)
+      log.warn(std::to_string(r.unreachable_land) + " land cells reach no settlement (islands or enclosed land without a road)");
+  }
+  s.summary["access"] = {{"people", std::llround(total)}, {"levels", levels}};
+}
+
+void access_load(RunState&) {}  // nothing downstream
 
 }  // namespace
 
@@ -350,6 +423,7 @@ const std::vector<StageDef>& stages() {
       {"sites", {"sites", "seed"}, sites_run, sites_load},
       {"network", {"network"}, network_run, network_load},
       {"roads", {"roads"}, roads_run, roads_load},
+      {"access", {"access"}, access_run, access_load},
   };
   return list;
 }

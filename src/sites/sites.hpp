@@ -172,6 +172,10 @@ std::vector<std::int64_t> rank_size_split(double total, double q, std::size_t co
 std::vector<double> catchment_people(const Raster<float>& density, const Raster<std::uint8_t>& buildable, const std::vector<Site>& sites,
                                      double total);
 
+/// `total` people spread over the habitable cells as catchment_people spreads them (in proportion
+/// to density x cell area), per cell; 0 elsewhere.
+Raster<float> people_on_land(const Raster<float>& density, const Raster<std::uint8_t>& buildable, double total);
+
 /// The most settlements of min_population people `land_area_km2` holds at options.spacing_km
 /// apart on a hexagonal lattice (at least 1; unlimited when spacing_km is 0).
 std::size_t settleable_count(double land_area_km2, const SitesOptions& options);

@@ -18,7 +18,7 @@ done
 /usr/bin/python3 - run1/run.json <<'PY' || fail "run.json figures"
 import json, sys
 m = json.load(open(sys.argv[1]))
-assert [t["stage"] for t in m["timings"]] == ["terrain", "hydro", "density", "sites", "network", "roads"], m["timings"]
+assert [t["stage"] for t in m["timings"]] == ["terrain", "hydro", "density", "sites", "network", "roads", "access"], m["timings"]
 s = m["summary"]
 assert s["hydro"]["stream_reaches"] > 0 and s["sites"]["cities"] > 0, s
 assert sum(c["cities"] for c in s["sites"]["per_class"].values()) == s["sites"]["cities"], s["sites"]
@@ -60,7 +60,7 @@ cp -r run1 rerun
 /usr/bin/python3 - run1/run.json rerun/run.json <<'PY' || fail "--from network"
 import json, sys
 old, m = (json.load(open(f)) for f in sys.argv[1:3])
-assert m["rerun"] == {"ran": ["network", "roads"], "reused": ["terrain", "hydro", "density", "sites"], "stale": []}, m["rerun"]
+assert m["rerun"] == {"ran": ["network", "roads", "access"], "reused": ["terrain", "hydro", "density", "sites"], "stale": []}, m["rerun"]
 assert m["scenario"]["network"]["k"] == 1.3
 # The same candidates as the full run (the cities read back are the same); a smaller detour
 # factor removes fewer links (fewer detours are short enough).
@@ -70,7 +70,7 @@ assert m["summary"]["sites"] == old["summary"]["sites"]
 PY
 cmp -s run1/cities.geojson rerun/cities.geojson || fail "--from network rewrote the cities"
 "$TP" --quiet run -o rerun --only density --set density.weights.plain=1
-/usr/bin/python3 -c "import json; r=json.load(open('rerun/run.json'))['rerun']; assert r['stale']==['sites','network','roads'], r" || fail "--only"
+/usr/bin/python3 -c "import json; r=json.load(open('rerun/run.json'))['rerun']; assert r['stale']==['sites','network','roads','access'], r" || fail "--only"
 cmp -s run1/density.tif rerun/density.tif && fail "--only density did not change density.tif"
 expect_fail 2 "other 'density' parameters; rerun from density" "$TP" run -o rerun --from sites --set density.r_max_m=6000
 # The flow-direction style follows the run's code convention (GRASS: east is 8).

@@ -1,0 +1,75 @@
+// Accessibility: travel time from every cell to the nearest settlement, off-road on foot and on
+// the roads at their class speeds, and who lives within 15, 30, 60 minutes (docs/access.md).
+// SPDX-License-Identifier: MIT
+#pragma once
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "core/progress.hpp"
+#include "core/raster.hpp"
+#include "io/vector_io.hpp"
+
+namespace terrapolis::access {
+
+/// Speeds of the friction surface.
+struct AccessOptions {
+  /// Off-road walking: Tobler's hiking function (Tobler 1993, "Three presentations on geographical
+  /// analysis and modeling", NCGIA TR 93-1): v = 6 exp(-3.5 |S + 0.05|) km/h on a path, S the
+  /// signed slope dz/dx along the move (5.04 km/h on the flat, fastest 6 km/h at 2.86 degrees
+  /// downhill), times this factor off paths (Tobler: 3/5).
+  double walk_factor = 0.6;
+  /// Road speeds, km/h, per class in roads::kRoadClasses order: motorway, national, departmental,
+  /// local, maritime (a ferry link). Bridges and tunnels carry their road's speed.
+  std::array<double, 5> road_kmh = {110, 80, 60, 40, 20};
+  /// Moves: 8 neighbours, or 16 (adding knight's moves, as r.walk -k): the direction error of a
+  /// straight walk drops from 8 % to under 3 %.
+  bool knight_moves = true;
+};
+
+/// Tobler's hiking function on a path, km/h, at signed slope `dz_dx` (uphill positive).
+double tobler_kmh(double dz_dx);
+
+/// A destination of the search: a settlement's cell and its id (the value of the nearest raster).
+struct Destination {
+  int col = 0, row = 0;
+  std::int32_t id = 0;
+};
+
+struct AccessResult {
+  Raster<float> minutes;            ///< to the nearest destination; NaN: nodata, water, or no way there
+  Raster<std::int32_t> nearest;     ///< id of that destination; -1 where minutes is NaN
+  std::size_t unreachable_land = 0; ///< land cells (not water, not nodata) from which no destination is reached
+};
+
+/// The roads on the grid.
+struct RoadCells {
+  Raster<float> kmh;              ///< speed of the fastest road through the cell, km/h; 0: no road
+  Raster<std::uint8_t> tunnel;    ///< 1: only tunnels pass there (entered and left by road only)
+};
+
+/// Every line of `roads` (in the grid's CRS, as read_vector gives it) drawn onto the grid of
+/// `like` with 8-connected cells: a `class` field naming a roads::kRoadClasses class sets its speed
+/// (lines without one are local roads), a `structure` field "tunnel" marks it underground.
+RoadCells road_cells(const VectorLayer& roads, const Raster<float>& like, const AccessOptions& options);
+
+/// Travel times to the nearest of `destinations` by one multi-source Dijkstra over the grid,
+/// from the destinations outward along reversed moves (a move u -> v is timed from u's side: the
+/// slope is z_v - z_u over the move's geodesic length). `dem`: metres, NaN nodata (impassable);
+/// `passable`: 1 where one may walk (land), 0 water; a road cell is passable whatever the water
+/// (bridges, ferries) and a move between two road cells runs at the slower of their speeds; any
+/// other move walks, and never into or out of a tunnel. Deterministic (equal times pop in a fixed order).
+AccessResult travel_time(const Raster<float>& dem, const Raster<std::uint8_t>& passable, const RoadCells& roads,
+                         const std::vector<Destination>& destinations, const AccessOptions& options, Progress& progress);
+
+/// Who lives how far: `people` per cell (NaN or <= 0: nobody) against `minutes`.
+struct Coverage {
+  double total_people = 0;
+  std::vector<double> within_people;  ///< people within each threshold (minutes <= t), thresholds' order
+  double unreachable_people = 0;      ///< people on cells with no time (no way to any destination)
+  double mean_minutes = 0;            ///< population-weighted, over the reached people
+  double p90_minutes = 0;             ///< population-weighted 90th percentile, over the reached people
+};
+Coverage coverage(const Raster<float>& minutes, const Raster<float>& people, const std::vector<double>& thresholds_minutes);
+
+}  // namespace terrapolis::access

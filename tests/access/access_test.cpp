@@ -1,0 +1,139 @@
+// Accessibility: times against hand-computed walks and drives, water, bridges, tunnels, coverage.
+// SPDX-License-Identifier: MIT
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "access/access.hpp"
+#include "io/crs.hpp"
+
+using namespace terrapolis;
+using namespace terrapolis::access;
+
+namespace {
+
+constexpr double kCell = 100;  // metres
+
+/// A projected grid (UTM 32N) of 100 m cells with elevation z(col, row).
+template <class F>
+Dem grid(int cols, int rows, F z) {
+  Georef g;
+  g.transform = {500000.0, kCell, 0.0, 5000000.0, 0.0, -kCell};
+  g.crs = crs_from_user("EPSG:32632");
+  Dem dem(cols, rows, g, 0.0f);
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c) dem(c, r) = float(z(c, r));
+  return dem;
+}
+
+RoadCells no_roads(const Dem& dem) { return {dem.like<float>(0.0f), dem.like<std::uint8_t>(0)}; }
+Raster<std::uint8_t> all_land(const Dem& dem) { return dem.like<std::uint8_t>(1); }
+
+/// Minutes to walk `metres` at slope s with the default options.
+double walk_minutes(double metres, double s) { return metres / (0.6 * tobler_kmh(s) * 1000 / 60); }
+
+SilentProgress quiet;
+
+}  // namespace
+
+TEST(Access, ToblerHikingFunction) {
+  EXPECT_NEAR(tobler_kmh(0), 5.0366, 1e-3);       // 6 e^-0.175
+  EXPECT_NEAR(tobler_kmh(-0.05), 6.0, 1e-12);     // fastest a little downhill
+  EXPECT_LT(tobler_kmh(0.2), tobler_kmh(-0.2));   // climbing is slower than descending
+}
+
+TEST(Access, FlatGroundIsDistanceOverWalkingSpeed) {
+  const Dem dem = grid(41, 41, [](int, int) { return 100.0; });
+  const AccessResult r = travel_time(dem, all_land(dem), no_roads(dem), {{20, 20, 7}}, AccessOptions{}, quiet);
+  EXPECT_EQ(r.minutes(20, 20), 0.0f);
+  EXPECT_NEAR(r.minutes(30, 20), walk_minutes(1000, 0), 1e-3);   // 10 cells east
+  EXPECT_NEAR(r.minutes(20, 5), walk_minutes(1500, 0), 1e-3);    // 15 cells north
+  EXPECT_NEAR(r.minutes(30, 30), walk_minutes(1000 * std::sqrt(2.0), 0), 1e-3);  // the diagonal
+  EXPECT_NEAR(r.minutes(40, 30), walk_minutes(100 * std::hypot(20.0, 10.0), 0), 1e-3);  // knight's moves
+  // Any direction within 3 % of the straight line (knight's moves), every cell reached, one owner.
+  for (int row = 0; row < 41; ++row)
+    for (int col = 0; col < 41; ++col) {
+      const double straight = walk_minutes(100 * std::hypot(col - 20.0, row - 20.0), 0);
+      EXPECT_GE(r.minutes(col, row), straight - 1e-3);
+      EXPECT_LE(r.minutes(col, row), 1.03 * straight + 1e-3);
+      EXPECT_EQ(r.nearest(col, row), 7);
+    }
+  EXPECT_EQ(r.unreachable_land, 0u);
+  // With 8 neighbours only, a knight's direction is walked as a diagonal and a straight step: slower.
+  AccessOptions eight;
+  eight.knight_moves = false;
+  const AccessResult e = travel_time(dem, all_land(dem), no_roads(dem), {{20, 20, 7}}, eight, quiet);
+  EXPECT_NEAR(e.minutes(40, 30), walk_minutes(1000 + 1000 * std::sqrt(2.0), 0), 1e-3);
+}
+
+TEST(Access, UphillToTheTownIsSlowerThanDownhill) {
+  // A plane rising 5 m per cell eastwards (5 %): the town in the middle.
+  const Dem dem = grid(21, 3, [](int c, int) { return 5.0 * c; });
+  const AccessResult r = travel_time(dem, all_land(dem), no_roads(dem), {{10, 1, 0}}, AccessOptions{}, quiet);
+  // From the west one climbs to the town, from the east one walks down to it.
+  EXPECT_NEAR(r.minutes(0, 1), walk_minutes(1000, 0.05), 1e-3);  // Tobler: horizontal distance over speed
+  EXPECT_NEAR(r.minutes(20, 1), walk_minutes(1000, -0.05), 1e-3);
+  EXPECT_GT(r.minutes(0, 1), r.minutes(20, 1));
+}
+
+TEST(Access, RoadsAtTheirClassSpeedWaterOnlyByBridge) {
+  // Columns 0-9 land, 10-14 a river, 15-29 land; the town on the west bank.
+  const Dem dem = grid(30, 5, [](int, int) { return 10.0; });
+  Raster<std::uint8_t> land = all_land(dem);
+  for (int r = 0; r < 5; ++r)
+    for (int c = 10; c < 15; ++c) land(c, r) = 0;
+  const std::vector<Destination> town = {{0, 2, 1}};
+  const AccessResult walled = travel_time(dem, land, no_roads(dem), town, AccessOptions{}, quiet);
+  EXPECT_TRUE(std::isnan(walled.minutes(20, 2)));  // across the river: no way
+  EXPECT_TRUE(std::isnan(walled.minutes(12, 2)));  // the river itself
+  EXPECT_EQ(walled.nearest(20, 2), -1);
+  EXPECT_EQ(walled.unreachable_land, 15u * 5u);
+  // A departmental road along row 2, bridging the river: 60 km/h = 1000 m/min.
+  VectorLayer road;
+  road.geometry = GeometryType::line_string;
+  road.crs = dem.georef().crs;
+  road.fields = {{"class", FieldType::string}};
+  road.features.push_back({{{dem.georef().cell_centre(0, 2), dem.georef().cell_centre(29, 2)}}, {std::string("departmental")}});
+  const RoadCells cells = road_cells(road, dem, AccessOptions{});
+  EXPECT_EQ(cells.kmh(12, 2), 60.0f);
+  EXPECT_EQ(cells.kmh(12, 1), 0.0f);
+  const AccessResult bridged = travel_time(dem, land, cells, town, AccessOptions{}, quiet);
+  EXPECT_NEAR(bridged.minutes(29, 2), 2900.0 / 1000.0, 1e-4);
+  // Beside the road: the drive to the nearest road cell, then a step on foot.
+  EXPECT_NEAR(bridged.minutes(25, 4), 2500.0 / 1000.0 + walk_minutes(200, 0), 1e-3);
+}
+
+TEST(Access, TunnelsAreEnteredAtTheirPortalsOnly) {
+  // A ridge (columns 8-12, 500 m high) crossed by a tunnel along row 3; the town to the west.
+  const Dem dem = grid(21, 7, [](int c, int) { return c >= 8 && c <= 12 ? 500.0 : 10.0; });
+  VectorLayer road;
+  road.geometry = GeometryType::line_string;
+  road.crs = dem.georef().crs;
+  road.fields = {{"class", FieldType::string}, {"structure", FieldType::string}};
+  const auto& g = dem.georef();
+  road.features.push_back({{{g.cell_centre(0, 3), g.cell_centre(7, 3)}}, {std::string("local"), std::string("road")}});
+  road.features.push_back({{{g.cell_centre(7, 3), g.cell_centre(13, 3)}}, {std::string("local"), std::string("tunnel")}});
+  road.features.push_back({{{g.cell_centre(13, 3), g.cell_centre(20, 3)}}, {std::string("local"), std::string("road")}});
+  const RoadCells cells = road_cells(road, dem, AccessOptions{});
+  EXPECT_EQ(cells.tunnel(10, 3), 1);
+  EXPECT_EQ(cells.tunnel(7, 3), 0);  // the portals carry the surface road too
+  const AccessResult r = travel_time(dem, all_land(dem), cells, {{0, 3, 0}}, AccessOptions{}, quiet);
+  // On the ridge above the tunnel one walks: the climb from the portal, not a step up from the tunnel.
+  EXPECT_NEAR(r.minutes(10, 3), 1000.0 / (40.0 * 1000 / 60), 1e-4);  // in the tunnel: 1 km at 40 km/h
+  EXPECT_GT(r.minutes(10, 2), r.minutes(10, 3) + 5.0);
+}
+
+TEST(Access, CoverageCountsPeopleWithinEachThreshold) {
+  Raster<float> minutes(4, 1, Georef{}, 0.0f), people(4, 1, Georef{}, 0.0f);
+  const float t[4] = {5, 20, 45, NAN};
+  const float p[4] = {100, 300, 600, 50};
+  for (int c = 0; c < 4; ++c) minutes(c, 0) = t[c], people(c, 0) = p[c];
+  const Coverage c = coverage(minutes, people, {15, 30, 60});
+  EXPECT_DOUBLE_EQ(c.total_people, 1050);
+  EXPECT_DOUBLE_EQ(c.within_people[0], 100);
+  EXPECT_DOUBLE_EQ(c.within_people[1], 400);
+  EXPECT_DOUBLE_EQ(c.within_people[2], 1000);
+  EXPECT_DOUBLE_EQ(c.unreachable_people, 50);
+  EXPECT_DOUBLE_EQ(c.mean_minutes, (5 * 100 + 20 * 300 + 45 * 600) / 1000.0);
+  EXPECT_DOUBLE_EQ(c.p90_minutes, 45);
+}

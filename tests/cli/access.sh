@@ -1,0 +1,59 @@
+# `terrapolis access` and the run's access stage on the bundled Cap Corse DEM (docs/access.md):
+# travel-time rasters in the DEM's CRS, the sea unreachable, figures that add up, bad inputs refused.
+source "$(dirname "$0")/lib.sh" "$@"
+cd "$WORK"
+dem=$SAMPLES/gebco2022_15s_north_corsica_capcorse.asc
+"$TP" -q run -o run --set dem="$dem" --set outputs.preview=false --set sites.population=400000
+
+# The run's stage: rasters per level, figures in run.json that grow with the threshold.
+for f in access_minutes.tif access_minutes_10000.tif access_nearest.tif access_minutes.qml; do [[ -f run/$f ]] || fail "run: no $f"; done
+/usr/bin/python3 - <<'PY' || fail "run.json access figures"
+import json
+a = json.load(open("run/run.json"))["summary"]["access"]
+assert a["people"] == 400000, a
+for level, v in a["levels"].items():
+    w = list(v["share_within"].values())
+    assert w == sorted(w) and 0 < w[0] and w[-1] <= 1, (level, w)
+    assert 0 < v["mean_minutes"] <= v["p90_minutes"], v
+assert a["levels"]["all"]["share_within"]["60_min"] >= a["levels"]["10000"]["share_within"]["60_min"], a
+PY
+/usr/bin/python3 - <<'PY' || fail "access rasters"
+from osgeo import gdal
+import math
+m = gdal.Open("run/access_minutes.tif")
+d = gdal.Open("run/elevation.tif")
+assert m.GetProjection() == d.GetProjection() and m.GetGeoTransform() == d.GetGeoTransform()
+t = m.GetRasterBand(1).ReadAsArray()
+z = d.GetRasterBand(1).ReadAsArray()
+assert all(math.isnan(t[i, j]) for i in range(z.shape[0]) for j in range(z.shape[1]) if z[i, j] < -50), "the sea has a travel time"
+assert (t == 0).sum() >= 30, "every settlement's cell is 0 minutes away"
+PY
+grep -q '"access_minutes.tif"' run/.terrapolis-outputs.json || fail "not in the manifest"
+grep -q 'access_minutes.tif' run/project.qgs || fail "not in the QGIS project"
+
+# The command on the run's layers, with the roads and without: the roads bring people closer.
+"$TP" -q access "$dem" with --to run/cities.geojson --roads run/roads.geojson
+"$TP" -q access "$dem" without --to run/cities.geojson
+/usr/bin/python3 - <<'PY' || fail "access.json"
+import json
+w = json.load(open("with/access.json")); o = json.load(open("without/access.json"))
+assert w["unit"] == "land_km2" and abs(w["total"] - o["total"]) < 1e-6, (w["total"], o["total"])
+a, b = w["levels"]["all"], o["levels"]["all"]
+assert a["within"]["60_min"] > b["within"]["60_min"] and a["mean_minutes"] < b["mean_minutes"], (a, b)
+assert w["settlements"] >= 30 and w["outside_the_dem"] == 0, w
+PY
+
+# A people raster on the DEM's grid: the figures are people.
+gdal_calc.py --quiet -A run/density.tif --outfile people.tif --type Float32 --calc "(A>0)*100" --NoDataValue -1
+"$TP" -q access "$dem" counted --to run/cities.geojson --people people.tif
+grep -q '"unit": "people"' counted/access.json || fail "--people: not counted in people"
+
+# Bad inputs: exit 2, one line, nothing written.
+expect_refused bad "run/roads.geojson: --to: the settlements must be points" "$TP" access "$dem" bad --to run/roads.geojson
+expect_refused bad "no/such.geojson" "$TP" access "$dem" bad --to no/such.geojson
+gdal_translate -q -outsize 50% 50% people.tif small.tif
+expect_refused bad "small.tif: --people: is 87x87 cells, the DEM 175x175" "$TP" access "$dem" bad --to run/cities.geojson --people small.tif
+expect_refused bad "--walk-factor" "$TP" access "$dem" bad --to run/cities.geojson --walk-factor 0
+expect_refused bad2 "/access/thresholds_minutes: a threshold is given twice" "$TP" run -o bad2 --set 'access.thresholds_minutes=[15,15]'
+no_leftovers "$WORK"
+echo "access: ok"
