@@ -3,16 +3,22 @@
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
+#include <filesystem>
 
 #include "cli/command.hpp"
 #include "cli/commands_list.hpp"
 #include "cli/schema_options.hpp"
+#include "core/error.hpp"
 #include "io/output_set.hpp"
+#include "io/raster_io.hpp"
 #include "io/text_io.hpp"
 #include "pipeline/compare.hpp"
+#include "terrapolis/version.hpp"
 
 namespace terrapolis::cli {
 namespace {
+
+namespace fs = std::filesystem;
 
 class CompareCommand final : public Command {
  public:
@@ -27,7 +33,9 @@ class CompareCommand final : public Command {
               FileKind::folder_in);
     app.add_flag("--json", json_, "Machine-readable output");
     file_kind(app.add_option("--save", save_, "Also write the comparison to this file (text, or JSON with --json)"), FileKind::file_out);
-    app.add_flag("--overwrite", overwrite_, "Replace the --save file if it exists");
+    file_kind(app.add_option("--changes", changes_, "Also write where the travel times changed (access_minutes*_change.tif: B - A, minutes) into this folder"),
+              FileKind::folder_out);
+    app.add_flag("--overwrite", overwrite_, "Replace the --save file and the --changes folder if they exist");
   }
   void run(Context&) override {
     const auto a = pipeline::load_manifest(a_);
@@ -40,18 +48,33 @@ class CompareCommand final : public Command {
     }
     // One comparison is one object (as it always was); several are an array, in the order given.
     if (json_) text = (others_.size() == 1 ? all[0] : all).dump(2) + "\n";
-    if (!save_.empty()) {
+    if (!save_.empty() || !changes_.empty()) {
       std::vector<std::string> inputs = others_;
       inputs.push_back(a_);
       OutputSet outputs("compare", inputs, overwrite_);
-      write_text_file(outputs.file(save_), text, false);
+      if (!changes_.empty()) {
+        if (others_.size() != 1) throw bad_input("--changes: compares two runs (give RUN_A and one RUN_B)");
+        const fs::path dir = outputs.folder(changes_);
+        const auto changes = pipeline::access_changes(a_, others_[0]);
+        if (changes.empty()) throw bad_input("--changes: " + a_ + " and " + others_[0] + " hold no travel-time raster on the same grid (access_minutes.tif)");
+        for (const auto& [name, raster] : changes) {
+          WriteOptions w;
+          w.description = "Change of the travel time, minutes: B - A (negative: closer in B)";
+          w.metadata = {{"TERRAPOLIS_VERSION", version}, {"TERRAPOLIS_COMMAND", "compare"}, {"UNIT", "min"}, {"RUN_A", a_}, {"RUN_B", others_[0]}};
+          write_raster((dir / name).string(), raster, w);
+          std::size_t closer = 0, farther = 0;
+          for (std::size_t i = 0; i < raster.size(); ++i) closer += raster[i] < -1, farther += raster[i] > 1;
+          if (!json_) text += "\n" + name + ": " + std::to_string(closer) + " cells over a minute closer in B, " + std::to_string(farther) + " over a minute farther\n";
+        }
+      }
+      if (!save_.empty()) write_text_file(outputs.file(save_), text, false);
       outputs.commit();
     }
     std::fputs(text.c_str(), stdout);
   }
 
  private:
-  std::string a_, save_;
+  std::string a_, save_, changes_;
   std::vector<std::string> others_;
   bool json_ = false, overwrite_ = false;
 };

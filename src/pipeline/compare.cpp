@@ -2,6 +2,7 @@
 // SPDX-License-Identifier: MIT
 #include "pipeline/compare.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -11,6 +12,7 @@
 
 #include "core/error.hpp"
 #include "core/json_input.hpp"
+#include "io/raster_io.hpp"
 
 namespace terrapolis::pipeline {
 namespace {
@@ -111,6 +113,26 @@ std::string format_comparison(const json& c) {
     row(f["figure"].get<std::string>(), text(f["a"]), text(f["b"]), change);
   }
   return s.str();
+}
+
+std::vector<std::pair<std::string, Raster<float>>> access_changes(const std::string& run_a, const std::string& run_b) {
+  namespace fs = std::filesystem;
+  std::vector<std::string> names;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(run_a, ec)) {
+    const std::string name = e.path().filename().string();
+    if (name.rfind("access_minutes", 0) == 0 && e.path().extension() == ".tif" && fs::exists(fs::path(run_b) / name, ec)) names.push_back(name);
+  }
+  std::sort(names.begin(), names.end());
+  std::vector<std::pair<std::string, Raster<float>>> out;
+  for (const auto& name : names) {
+    const Dem a = read_dem((fs::path(run_a) / name).string()), b = read_dem((fs::path(run_b) / name).string());
+    if (a.cols() != b.cols() || a.rows() != b.rows() || a.georef().transform != b.georef().transform) continue;
+    Raster<float> change = a.like<float>(NAN);
+    for (std::size_t i = 0; i < a.size(); ++i) change[i] = b[i] - a[i];  // NaN on either side stays NaN
+    out.emplace_back(fs::path(name).stem().string() + "_change.tif", std::move(change));
+  }
+  return out;
 }
 
 }  // namespace terrapolis::pipeline

@@ -48,6 +48,21 @@ gdal_calc.py --quiet -A run/density.tif --outfile people.tif --type Float32 --ca
 "$TP" -q access "$dem" counted --to run/cities.geojson --people people.tif
 grep -q '"unit": "people"' counted/access.json || fail "--people: not counted in people"
 
+# What a scenario changes: more links kept (network.k 1.3) bring some cells closer.
+cp -r run denser
+"$TP" -q run -o denser --from network --set network.k=1.3 --set outputs.preview=false --set dem="$dem" --set sites.population=400000
+"$TP" compare run denser --changes changes > cmp.txt
+grep -Eq "^access_minutes_change.tif: [1-9][0-9]* cells over a minute closer in B" cmp.txt || fail "compare --changes: $(tail -3 cmp.txt)"
+/usr/bin/python3 - <<'PY' || fail "access_minutes_change.tif"
+from osgeo import gdal
+import numpy as np
+a = gdal.Open("run/access_minutes.tif").ReadAsArray(); b = gdal.Open("denser/access_minutes.tif").ReadAsArray()
+c = gdal.Open("changes/access_minutes_change.tif").ReadAsArray()
+ok = ~np.isnan(a) & ~np.isnan(b)
+assert np.allclose(c[ok], (b - a)[ok]) and np.isnan(c[~ok]).all() and (c[ok] < -1).any()
+PY
+expect_refused nochanges "--changes: compares two runs" "$TP" compare run denser run --changes nochanges
+
 # Bad inputs: exit 2, one line, nothing written.
 expect_refused bad "run/roads.geojson: --to: the settlements must be points" "$TP" access "$dem" bad --to run/roads.geojson
 expect_refused bad "no/such.geojson" "$TP" access "$dem" bad --to no/such.geojson
