@@ -18,6 +18,7 @@
 #include "io/output_set.hpp"
 #include "io/raster_io.hpp"
 #include "pipeline/density_folder.hpp"
+#include "pipeline/places.hpp"
 #include "pipeline/stage_options.hpp"
 #include "sites/layers.hpp"
 #include "sites/sites.hpp"
@@ -54,13 +55,19 @@ class SitesCommand final : public Command {
 
   void run(Context& context) override {
     const pipeline::Scenario scenario = schema_.scenario();
-    const sites::SitesOptions options = schema_.settings([&] { return pipeline::sites_options(scenario); });
-    OutputSet outputs("sites", {dir_}, overwrite_);
+    sites::SitesOptions options = schema_.settings([&] { return pipeline::sites_options(scenario); });
+    const std::string existing_file = scenario.path("/sites/existing");
+    OutputSet outputs("sites", {dir_, existing_file}, overwrite_);
     const std::filesystem::path out_dir = outputs.folder(out_);
     const auto t0 = std::chrono::steady_clock::now();
     const bool dem = std::filesystem::is_regular_file(dir_);
     if (!dem && dem_.given()) throw bad_input("--band, --assume-crs: only for a DEM, and " + dir_ + " is a density folder");
     const pipeline::DensityFolder in = dem ? density_from_dem(dem_.read(dir_), context.progress) : pipeline::read_density_folder(dir_);
+    pipeline::ExistingPlaces existing;
+    if (!existing_file.empty()) {
+      existing = pipeline::read_existing_places(existing_file, in.buildable);
+      options.existing = existing.sites;
+    }
     const auto t1 = std::chrono::steady_clock::now();
     const sites::SitesResult result = sites::place_sites(in.density, in.buildable, options, context.progress);
     const auto t2 = std::chrono::steady_clock::now();
@@ -92,6 +99,10 @@ class SitesCommand final : public Command {
     if (result.count_limited)
       std::printf("sites: count held to the %lld settlements the land holds %g km apart (--spacing)\n", static_cast<long long>(result.room),
                   options.spacing_km);
+    if (!existing_file.empty())
+      std::printf("sites: %zu existing places (%.0f people; %d moved to land, %d outside the DEM left out), %zu generated\n",
+                  existing.sites.size(), result.existing_population, existing.moved, existing.outside,
+                  result.sites.size() - existing.sites.size());
     std::printf("sites: %zu cities (%d roots, %zu suburbs) from %d candidates, dr %.0f m, seed %llu\n", result.sites.size(), roots,
                 result.sites.size() - std::size_t(roots), result.candidates, result.dr_m, static_cast<unsigned long long>(result.seed));
   }

@@ -3,6 +3,7 @@
 #include "pipeline/places.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <filesystem>
@@ -94,14 +95,77 @@ std::vector<RawPlace> read_point_layer(const std::string& path, const Crs& targe
   return out;
 }
 
+std::vector<RawPlace> read_raw(const std::string& path, const Crs& crs) {
+  if (!std::filesystem::exists(path)) throw bad_input(path + ": no such file");
+  return lower(std::filesystem::path(path).extension().string()) == ".csv" ? read_csv(path, crs) : read_point_layer(path, crs);
+}
+
+/// The cell holding CRS point (x, y) (inverse geotransform).
+std::array<int, 2> cell_of(const Georef& g, double x, double y) {
+  const GeoTransform& t = g.transform;
+  const double det = t[1] * t[5] - t[2] * t[4], dx = x - t[0], dy = y - t[3];
+  return {int(std::floor((t[5] * dx - t[2] * dy) / det)), int(std::floor((-t[4] * dx + t[1] * dy) / det))};
+}
+
 }  // namespace
 
+void check_existing_places(const std::string& path, const Crs& crs) {
+  const std::vector<RawPlace> raw = read_raw(path, crs);
+  for (std::size_t k = 0; k < raw.size(); ++k)
+    if (!std::isfinite(raw[k].population) || raw[k].population < 0)
+      throw bad_input(path + ": " + (raw[k].name.empty() ? "place " + std::to_string(k + 1) : raw[k].name) +
+                      ": the population must be a number of people >= 0");
+  if (raw.empty()) throw bad_input(path + ": holds no place");
+}
+
+ExistingPlaces read_existing_places(const std::string& path, const Raster<std::uint8_t>& buildable) {
+  ExistingPlaces out;
+  std::vector<std::uint8_t> taken(buildable.size(), 0);
+  std::vector<RawPlace> raw = read_raw(path, buildable.georef().crs);
+  // The largest first: where two places share a cell, the larger keeps it.
+  std::stable_sort(raw.begin(), raw.end(), [](const RawPlace& a, const RawPlace& b) { return a.population > b.population; });
+  for (std::size_t k = 0; k < raw.size(); ++k) {
+    const RawPlace& p = raw[k];
+    const std::string name = p.name.empty() ? "place " + std::to_string(k + 1) : p.name;
+    if (!std::isfinite(p.population) || p.population < 0)
+      throw bad_input(path + ": " + name + ": the population must be a number of people >= 0");
+    if (p.population < 1) {
+      ++out.without_people;
+      continue;
+    }
+    const auto [col, row] = std::isfinite(p.x) && std::isfinite(p.y) ? cell_of(buildable.georef(), p.x, p.y) : std::array<int, 2>{-1, -1};
+    if (!buildable.inside(col, row)) {
+      ++out.outside;
+      continue;
+    }
+    // Its cell, or the nearest free buildable one within two cells (a coastal town on a sea cell of
+    // a coarse grid, a second place in the same cell).
+    int best_c = -1, best_r = -1, best_d = 1 << 30;
+    for (int r = row - 2; r <= row + 2; ++r)
+      for (int c = col - 2; c <= col + 2; ++c) {
+        if (!buildable.inside(c, r) || buildable(c, r) != 1 || taken[buildable.index(c, r)]) continue;
+        const int d = (c - col) * (c - col) + (r - row) * (r - row);
+        if (d < best_d) best_d = d, best_c = c, best_r = r;
+      }
+    if (best_c < 0)
+      throw bad_input(path + ": " + name + ": lies on water, nodata or unbuildable land with no free buildable cell within two cells; move it or leave it out");
+    out.moved += best_d > 0;
+    taken[buildable.index(best_c, best_r)] = 1;
+    sites::Site s;
+    s.col = best_c, s.row = best_r;
+    const auto xy = buildable.georef().cell_centre(best_c, best_r);
+    s.x = xy[0], s.y = xy[1];
+    s.population = std::int64_t(std::llround(p.population));
+    s.existing = true;
+    s.name = p.name;
+    out.sites.push_back(std::move(s));
+  }
+  if (out.sites.empty()) throw bad_input(path + ": no place with people lies on the DEM");
+  return out;
+}
+
 std::vector<density::Place> read_places(const std::string& path, const Dem& dem, const std::vector<std::uint8_t>& land, int& dropped) {
-  const std::string ext = lower(std::filesystem::path(path).extension().string());
-  if (!std::filesystem::exists(path)) throw bad_input(path + ": no such file");
-  const std::vector<RawPlace> raw = ext == ".csv" ? read_csv(path, dem.georef().crs) : read_point_layer(path, dem.georef().crs);
-  const GeoTransform& t = dem.georef().transform;
-  const double det = t[1] * t[5] - t[2] * t[4];
+  const std::vector<RawPlace> raw = read_raw(path, dem.georef().crs);
   dropped = 0;
   std::vector<density::Place> places;
   for (const RawPlace& p : raw) {
@@ -109,9 +173,7 @@ std::vector<density::Place> read_places(const std::string& path, const Dem& dem,
       ++dropped;
       continue;
     }
-    // Inverse geotransform: the cell holding the point.
-    const double dx = p.x - t[0], dy = p.y - t[3];
-    const int col = int(std::floor((t[5] * dx - t[2] * dy) / det)), row = int(std::floor((-t[4] * dx + t[1] * dy) / det));
+    const auto [col, row] = cell_of(dem.georef(), p.x, p.y);
     int best_c = -1, best_r = -1, best_d = 1 << 30;
     for (int r = row - 2; r <= row + 2; ++r)
       for (int c = col - 2; c <= col + 2; ++c) {

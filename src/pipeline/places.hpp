@@ -7,6 +7,7 @@
 
 #include "core/raster.hpp"
 #include "density/calibration.hpp"
+#include "sites/sites.hpp"
 
 namespace terrapolis::pipeline {
 
@@ -16,5 +17,22 @@ namespace terrapolis::pipeline {
 /// of a coarse grid is moved to the nearest land cell). `dropped` counts the others.
 /// Throws bad_input naming `path` when it cannot be read or has no population field.
 std::vector<density::Place> read_places(const std::string& path, const Dem& dem, const std::vector<std::uint8_t>& land, int& dropped);
+
+/// The settlements that exist, for sites.existing: the places of `path` (the formats read_places
+/// reads) with their populations (rounded to whole people), each on the cell holding it or, when
+/// that cell is not buildable or is taken by a larger place, the nearest free buildable cell within
+/// two cells; centres at cell centres, as generated sites. Places outside the grid are counted and
+/// left out, places without people (population 0 or none) likewise.
+struct ExistingPlaces {
+  std::vector<sites::Site> sites;  ///< largest first, existing = true, name set
+  int outside = 0, without_people = 0, moved = 0;
+};
+/// Throws bad_input naming the file and the place when one lies farther than two cells from a free
+/// buildable cell, or its population is negative; and when no place with people lies on the grid.
+ExistingPlaces read_existing_places(const std::string& path, const Raster<std::uint8_t>& buildable);
+
+/// What of those checks needs no grid (the file, its fields, every population a number >= 0), for
+/// a run to refuse a bad file before any stage starts.
+void check_existing_places(const std::string& path, const Crs& crs);
 
 }  // namespace terrapolis::pipeline

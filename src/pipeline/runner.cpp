@@ -16,6 +16,7 @@
 #include "io/text_io.hpp"
 #include "io/raster_io.hpp"
 #include "pipeline/compare.hpp"
+#include "pipeline/places.hpp"
 #include "pipeline/publish.hpp"
 #include "pipeline/run_state.hpp"
 #include "pipeline/stage_options.hpp"
@@ -151,6 +152,13 @@ json run_scenario(const Scenario& scenario, const RunOptions& options, Progress&
   const std::string dem_path = scenario.path("dem");
   const ReadOptions read = read_options(scenario.resolved["input"]["band"].get<int>(), scenario.resolved["input"]["assume_crs"].get<std::string>());
   Dem dem = read_dem(dem_path, read);  // before creating anything: bad input leaves no folder
+  if (const std::string existing = scenario.path("/sites/existing"); !existing.empty()) {
+    try {  // its format and figures now, before any stage (whether each place finds land needs the density)
+      check_existing_places(existing, dem.georef().crs);
+    } catch (const Error& e) {
+      throw Error(e.kind(), scenario.source + ": /sites/existing: " + e.what());
+    }
+  }
   const std::string dem_sha256 = file_sha256(dem_path);
   plugin::PluginSet plugins = plugin::load_plugins(nlohmann::json::parse(scenario.resolved["plugins"].dump()), log,
                                                    scenario.base_dir.string());

@@ -172,6 +172,8 @@ sites::SitesOptions sites_options(const Scenario& scenario) {
   o.town_density_per_km2 = s["town_density_per_km2"].get<double>();
   o.influence_factor = s["influence_factor"].get<double>();
   sites::check_settings(o);
+  if (!s["existing"].get<std::string>().empty() && o.quotas == sites::SitesOptions::Quotas::belhadj2007)
+    throw bad_input("/sites/existing: needs /sites/quotas rank_size (the census table of belhadj2007 has no room for given places)");
   return o;
 }
 
@@ -317,6 +319,7 @@ StageSettings prepare_stages(const Scenario& scenario) {
     check_file("/water/water_mask", scenario.path("/water/water_mask"));
     check_file("/roads/vegetation", s.roads.vegetation);
     check_file("/sites/reference", scenario.path("/sites/reference"));
+    check_file("/sites/existing", scenario.path("/sites/existing"));
     const json& density = scenario.resolved["density"];
     for (std::size_t i = 0; i < density["layers"].size(); ++i)
       check_file("/density/layers/" + std::to_string(i) + "/file", scenario.file(density["layers"][i]["file"].get<std::string>()));

@@ -13,6 +13,7 @@
 #include "network/layers.hpp"
 #include "pipeline/density_folder.hpp"
 #include "pipeline/hillshade.hpp"
+#include "pipeline/places.hpp"
 #include "pipeline/realism.hpp"
 #include "pipeline/stage_options.hpp"
 #include "roads/road_network.hpp"
@@ -183,6 +184,13 @@ void sites_run(RunState& s, Progress& progress, const Log& log) {
   // The land of the density stage (water and nodata excluded), for the default population.
   if (s.summary.contains("density") && s.summary["density"].contains("land_area_km2"))
     options.land_area_km2 = s.summary["density"]["land_area_km2"].get<double>();
+  const std::string existing_file = s.scenario.path("/sites/existing");
+  ExistingPlaces existing;
+  if (!existing_file.empty()) {
+    existing = read_existing_places(existing_file, *s.buildable);
+    options.existing = existing.sites;
+    if (existing.outside > 0) log.warn("sites.existing: " + std::to_string(existing.outside) + " places outside the DEM left out");
+  }
   const sites::SitesResult r = sites::place_sites(*s.density, *s.buildable, options, progress);
   const Crs& crs = s.dem.georef().crs;
   s.cities = sites::cities_layer(r, crs);
@@ -223,6 +231,15 @@ void sites_run(RunState& s, Progress& progress, const Log& log) {
                                                })->population;
   } else {
     summary["quotas"] = "belhadj2007";
+  }
+  if (!existing_file.empty()) {
+    summary["existing"] = {{"places", existing.sites.size()}, {"people", r.existing_population}, {"moved_to_land", existing.moved},
+                           {"outside_dem", existing.outside}, {"without_people", existing.without_people},
+                           {"generated", r.sites.size() - existing.sites.size()},
+                           {"generated_people", population - std::llround(r.existing_population)}};
+    if (r.existing_population >= r.settled_population && r.settled_population > 0)
+      log.warn("sites.existing: the given places hold " + std::to_string(std::llround(r.existing_population)) + " people, the settled share (" +
+               std::to_string(std::llround(r.settled_population)) + ") or more: no settlement generated");
   }
   std::vector<std::string> warnings = settlement_warnings(s, r);
   const std::string reference = s.scenario.path("/sites/reference");
@@ -388,8 +405,10 @@ void access_run(RunState& s, Progress& progress, const Log& log) {
       if (double(site.population) >= level) to.push_back({site.col, site.row, site.id});
     if (to.empty()) continue;
     const access::AccessResult r = access::travel_time(s.dem, land, road_cells, to, a.options, progress);
-    const std::string suffix = level > 0 ? "_" + std::to_string(std::llround(level)) : "";
-    const std::string whom = level > 0 ? "a settlement of " + std::to_string(std::llround(level)) + " people or more" : "the nearest settlement";
+    // Appended, not "_" + to_string(...): GCC 12 reports a false -Wrestrict on that (GCC bug 105651).
+    const std::string people_text = std::to_string(std::llround(level));
+    std::string suffix, whom = "the nearest settlement";
+    if (level > 0) suffix.append("_").append(people_text), whom = std::string("a settlement of ").append(people_text).append(" people or more");
     s.write("access", "access_minutes" + suffix + ".tif", r.minutes, "travel time to " + whom + ", minutes (on foot off the roads, by road on them)",
             Style::access_minutes, {{"UNIT", "min"}});
     if (level == 0)

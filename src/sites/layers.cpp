@@ -5,6 +5,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <optional>
@@ -23,6 +24,9 @@ VectorLayer cities_layer(const SitesResult& result, const Crs& crs) {
   layer.fields = {{"id", FieldType::integer},     {"radius_m", FieldType::real}, {"class", FieldType::integer},
                   {"population", FieldType::integer}, {"density", FieldType::real},  {"parent", FieldType::integer},
                   {"depth", FieldType::integer},  {"seed", FieldType::integer}};
+  // Given places (sites.existing) are told apart, by name; without any the layer is as it was.
+  const bool with_existing = std::any_of(result.sites.begin(), result.sites.end(), [](const Site& s) { return s.existing; });
+  if (with_existing) layer.fields.insert(layer.fields.end(), {{"existing", FieldType::integer}, {"name", FieldType::string}});
   for (const Site& s : result.sites) {
     Feature f;
     f.parts = {{{s.x, s.y}}};
@@ -36,6 +40,10 @@ VectorLayer cities_layer(const SitesResult& result, const Crs& crs) {
     if (s.parent >= 0) f.values[5] = std::int64_t(s.parent);
     f.values[6] = std::int64_t(s.depth);
     f.values[7] = std::int64_t(result.seed);
+    if (with_existing) {
+      f.values[8] = std::int64_t(s.existing);
+      if (s.existing) f.values[9] = s.name;
+    }
     layer.features.push_back(std::move(f));
   }
   return layer;

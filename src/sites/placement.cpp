@@ -146,7 +146,12 @@ QuotaTable rank_size_table(const Raster<float>& density, const Raster<std::uint8
   result.target_population = result.population_assumed ? std::round(options.people_per_km2 * land_km2) : options.population;
   result.settled_population = std::round(options.urban_share * result.target_population);
   result.sizes_exponent = options.zipf_exponent;
-  const std::size_t room = settleable_count(land_km2, options);
+  // Existing settlements hold their people: the law splits the rest over the places still free.
+  for (const Site& e : options.existing) result.existing_population += double(e.population);
+  const double to_place = std::max(0.0, result.settled_population - result.existing_population);
+  const std::size_t full_room = settleable_count(land_km2, options);
+  const std::size_t room = full_room == std::numeric_limits<std::size_t>::max() ? full_room
+                                                                                : full_room - std::min(full_room, options.existing.size());
   std::vector<std::int64_t> sizes;
   if (options.sizes == SitesOptions::Sizes::catchment) {
     // The central places of all the region's people by the law, their catchments on the
@@ -157,6 +162,7 @@ QuotaTable rank_size_table(const Raster<float>& density, const Raster<std::uint8
     pilot.influence_factor = 0;
     pilot.population = result.target_population;
     pilot.land_area_km2 = land_km2;
+    pilot.existing.clear();
     const SitesResult central = place_sites(density, buildable, pilot, progress);
     result.room = central.room;
     result.count_limited = central.count_limited;
@@ -165,11 +171,14 @@ QuotaTable rank_size_table(const Raster<float>& density, const Raster<std::uint8
       if (p >= options.min_population) settled.push_back(p);
     const double q = rank_size_exponent(settled);
     if (std::isfinite(q)) result.sizes_exponent = q;  // fewer than 3 catchments that large: zipf_exponent
-    sizes = rank_size_split(result.settled_population, result.sizes_exponent, central.sites.size());
+    const std::size_t free = central.sites.size() - std::min(central.sites.size(), options.existing.size());
+    if (options.existing.empty()) sizes = rank_size_split(to_place, result.sizes_exponent, free);
+    else if (to_place > 0)  // the rest over the free places, none below min_population
+      sizes = rank_size_populations(to_place, result.sizes_exponent, options.min_population, free);
     sizes.erase(std::find(sizes.begin(), sizes.end(), 0), sizes.end());  // more places than settled people
   } else {
     const auto law = [&](std::size_t max_count) {
-      return rank_size_populations(result.settled_population, options.zipf_exponent, options.min_population, max_count);
+      return rank_size_populations(to_place, options.zipf_exponent, options.min_population, max_count);
     };
     sizes = law(room);
     if (room != std::numeric_limits<std::size_t>::max()) {
@@ -335,10 +344,14 @@ SitesResult place_sites(const Raster<float>& density, const Raster<std::uint8_t>
   result.candidates = int(pool.size());
   Growth growth(density, habitable, std::move(pool), std::move(radius), options, distance);
 
+  // Existing settlements occupy their built-up discs: no generated centre falls in one.
+  std::vector<Site> existing = options.existing;
+  for (Site& e : existing) e.radius_m = urban_radius_m(double(e.population), options);
+  const std::vector<std::uint8_t> occupied = existing.empty() ? std::vector<std::uint8_t>() : covered_cells(existing, distance, cols, rows);
   std::vector<Site> placed;
   {
     ProgressStep step(progress, "sites: growth");
-    growth.grow(nullptr, quota, table, placed, step);
+    growth.grow(existing.empty() ? nullptr : &occupied, quota, table, placed, step);
   }
   {
     ProgressStep step(progress, "sites: inclusions");
@@ -355,7 +368,8 @@ SitesResult place_sites(const Raster<float>& density, const Raster<std::uint8_t>
     for (int i = 0; i < n; ++i) quota[std::size_t(i)] = table.classes[std::size_t(n - 1 - i)].quota - kept[std::size_t(i)];
     if (std::accumulate(quota.begin(), quota.end(), 0) == 0) break;
     ProgressStep step(progress, "sites: refill " + std::to_string(round + 1));
-    const std::vector<std::uint8_t> covered = covered_cells(result.sites, distance, cols, rows);
+    std::vector<std::uint8_t> covered = covered_cells(result.sites, distance, cols, rows);
+    for (std::size_t i = 0; i < occupied.size(); ++i) covered[i] |= occupied[i];
     std::vector<Site> merged = result.sites;
     const std::size_t before = merged.size();
     growth.grow(&covered, quota, table, merged, step);
@@ -368,6 +382,30 @@ SitesResult place_sites(const Raster<float>& density, const Raster<std::uint8_t>
     // rank_size: within a class, sites (by density order) take the class's sizes, largest first.
     if (!table.populations.empty()) s.population = table.populations[std::size_t(s.radius_class)][std::size_t(c.kept)];
     ++c.kept;
+  }
+  if (!existing.empty()) {
+    // Existing and generated settlements classed together by their sizes, the largest first, and
+    // the hierarchy rebuilt over all of them by influence (below).
+    std::vector<Site> all = existing;
+    all.insert(all.end(), result.sites.begin(), result.sites.end());
+    std::stable_sort(all.begin(), all.end(), [](const Site& a, const Site& b) { return a.population > b.population; });
+    std::vector<std::int64_t> sizes;
+    for (const Site& x : all) sizes.push_back(x.population);
+    table = rank_size_quotas(cell_size, sizes, options);
+    for (auto& c : table.classes) c.placed = c.kept = 0;
+    std::size_t k = 0;
+    for (std::size_t c = 0; c < table.classes.size(); ++c)
+      for (std::size_t j = 0; j < table.populations[c].size(); ++j, ++k) {
+        Site& x = all[k];
+        x.id = int(k);
+        x.radius_class = int(c);
+        x.radius_m = table.classes[c].radius_m;
+        x.parent = -1;
+        x.depth = 0;
+        if (x.existing) x.density = std::isfinite(density(x.col, x.row)) ? density(x.col, x.row) : 0.0;
+        ++table.classes[c].kept, ++table.classes[c].placed;
+      }
+    result.sites = std::move(all);
   }
   // Suburbs by influence (rank_size, paris: Manhattan's regular tiling has none).
   if (options.quotas == SitesOptions::Quotas::rank_size && options.mode == SitesOptions::Mode::paris && result.land_area_km2 > 0) {

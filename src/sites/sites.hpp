@@ -3,6 +3,7 @@
 #pragma once
 #include <cstdint>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include "core/geodesy.hpp"
@@ -23,6 +24,8 @@ struct Site {
   double density = 0;            ///< density model value at the centre, in [0,1]
   int parent = -1;               ///< index of the parent site, -1 for a root (Algorithm 15)
   int depth = 0;                 ///< 0 for roots, parent's depth + 1 otherwise
+  bool existing = false;         ///< a real place given by SitesOptions::existing (its position and population kept)
+  std::string name;              ///< an existing place's name
 };
 
 struct SitesOptions {
@@ -75,6 +78,11 @@ struct SitesOptions {
   /// whose people equal the town's own (the central place's complementary region, Christaller
   /// 1933, at its simplest); 0: no suburbs beyond partial inclusions. Mode manhattan: none.
   double influence_factor = 1;
+  /// The settlements that exist (sites.existing: col, row, x, y, population, name set): each is
+  /// kept where it is with its people, counts towards the settled people, and the model places
+  /// settlements only for the rest, outside the existing discs; all are then classed and put in
+  /// the hierarchy together by their sizes. rank_size quotas only.
+  std::vector<Site> existing;
   // ---- belhadj2007 -----------------------------------------------------------------------------
   std::uint64_t seed = 1;   ///< seed of the candidate draw (std::mt19937_64)
   int candidates = 0;       ///< M, candidate positions drawn; 0: automatic (20 x N_sites, at most every buildable cell)
@@ -140,6 +148,7 @@ struct SitesResult {
   bool population_assumed = false;  ///< rank_size: target from people_per_km2 (no census figure given)
   std::int64_t room = 0;            ///< rank_size: settlements the land holds at spacing_km (settleable_count); 0: no limit
   bool count_limited = false;       ///< rank_size: the law would have made more settlements than `room`
+  double existing_population = 0;   ///< people of the existing settlements (SitesOptions::existing)
 };
 
 /// f(x) of Belhadj eq. 4.1: urban units of x people. For x >= x_max the base is clamped at 0
