@@ -204,4 +204,23 @@ Coverage coverage(const Raster<float>& minutes, const Raster<float>& people, con
   return c;
 }
 
+void for_each_level(const Raster<float>& dem, const Raster<std::uint8_t>& passable, const RoadCells& roads,
+                    const std::vector<Settlement>& settlements, const std::vector<double>& levels,
+                    const std::vector<double>& thresholds_minutes, const Raster<float>& people, const AccessOptions& options,
+                    Progress& progress, const std::function<void(const LevelFigures&)>& use) {
+  for (const double level : levels) {
+    std::vector<Destination> to;
+    for (const Settlement& s : settlements)
+      if (s.population >= level) to.push_back(s.at);
+    if (to.empty()) continue;
+    LevelFigures f;
+    f.level = level;
+    f.key = level > 0 ? std::to_string(std::llround(level)) : "all";
+    f.destinations = to.size();
+    f.times = travel_time(dem, passable, roads, to, options, progress);
+    f.coverage = coverage(f.times.minutes, people, thresholds_minutes);
+    use(f);
+  }
+}
+
 }  // namespace terrapolis::access

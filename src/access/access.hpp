@@ -4,6 +4,8 @@
 #pragma once
 #include <array>
 #include <cstdint>
+#include <functional>
+#include <string>
 #include <vector>
 
 #include "core/progress.hpp"
@@ -71,5 +73,27 @@ struct Coverage {
   double p90_minutes = 0;             ///< population-weighted 90th percentile, over the reached people
 };
 Coverage coverage(const Raster<float>& minutes, const Raster<float>& people, const std::vector<double>& thresholds_minutes);
+
+/// A settlement as a destination of a size level: its cell, id and people.
+struct Settlement {
+  Destination at;
+  double population = 0;
+};
+
+/// What one size level gives: the settlements of at least `level` people as destinations.
+struct LevelFigures {
+  double level = 0;              ///< 0: every settlement
+  std::string key;               ///< "all", or the level in people ("10000"): the figures' key and file suffix
+  std::size_t destinations = 0;
+  AccessResult times;
+  Coverage coverage;             ///< of `people` against the times
+};
+
+/// For each of `levels` (people, increasing) that some settlement reaches, travel_time to those
+/// settlements and coverage of `people`; `use` gets each level in turn (its rasters are then freed).
+void for_each_level(const Raster<float>& dem, const Raster<std::uint8_t>& passable, const RoadCells& roads,
+                    const std::vector<Settlement>& settlements, const std::vector<double>& levels,
+                    const std::vector<double>& thresholds_minutes, const Raster<float>& people, const AccessOptions& options,
+                    Progress& progress, const std::function<void(const LevelFigures&)>& use);
 
 }  // namespace terrapolis::access

@@ -31,8 +31,7 @@ namespace fs = std::filesystem;
 /// The settlements of `path` on the grid of `dem` with their ids (an integer `id` field, else the
 /// feature's index) and populations (a `population` field, else 0); points off the grid are counted.
 struct Places {
-  std::vector<access::Destination> all;
-  std::vector<double> population;
+  std::vector<access::Settlement> all;
   std::size_t outside = 0;
 };
 Places read_places(const std::string& path, const Dem& dem) {
@@ -59,8 +58,7 @@ Places read_places(const std::string& path, const Dem& dem) {
       if (const auto* i = std::get_if<std::int64_t>(&v)) people = double(*i);
       if (const auto* d = std::get_if<double>(&v)) people = *d;
     }
-    p.all.push_back({col, row, id});
-    p.population.push_back(people);
+    p.all.push_back({{col, row, id}, people});
   }
   if (p.all.empty()) throw bad_input(path + ": --to: no settlement lies on the DEM");
   return p;
@@ -121,29 +119,23 @@ class AccessCommand final : public Command {
 
     nlohmann::ordered_json levels = nlohmann::ordered_json::object();
     std::string lines;
-    for (const double level : settings.levels_population) {
-      std::vector<access::Destination> to;
-      for (std::size_t k = 0; k < places.all.size(); ++k)
-        if (places.population[k] >= level) to.push_back(places.all[k]);
-      if (to.empty()) continue;
-      const access::AccessResult r = access::travel_time(dem, land, roads, to, settings.options, context.progress);
-      const std::string suffix = level > 0 ? "_" + std::to_string(std::llround(level)) : "";
+    access::for_each_level(dem, land, roads, places.all, settings.levels_population, settings.thresholds_minutes, weight, settings.options,
+                           context.progress, [&](const access::LevelFigures& f) {
+      const bool all = f.level == 0;
       WriteOptions w;
-      w.description = level > 0 ? "Travel time to a settlement of " + std::to_string(std::llround(level)) + " people or more, minutes"
-                                : "Travel time to the nearest settlement, minutes";
+      w.description = all ? "Travel time to the nearest settlement, minutes" : "Travel time to a settlement of " + f.key + " people or more, minutes";
       w.metadata = {{"TERRAPOLIS_VERSION", version}, {"TERRAPOLIS_COMMAND", "access"}, {"UNIT", "min"},
                     {"TERRAPOLIS_ACCESS", scenario.resolved["access"].dump()}};
-      write_raster((dir / ("access_minutes" + suffix + ".tif")).string(), r.minutes, w);
-      if (level == 0) {
+      write_raster((dir / (all ? "access_minutes.tif" : "access_minutes_" + f.key + ".tif")).string(), f.times.minutes, w);
+      if (all) {
         w.description = "Id of the settlement nearest in time, -1 where none is reached";
         w.metadata[2] = {"UNIT", "id"};
-        write_raster((dir / "access_nearest.tif").string(), r.nearest, w);
+        write_raster((dir / "access_nearest.tif").string(), f.times.nearest, w);
       }
-      const access::Coverage c = access::coverage(r.minutes, weight, settings.thresholds_minutes);
+      const access::Coverage& c = f.coverage;
       nlohmann::ordered_json within = nlohmann::ordered_json::object();
       char text[160];
-      std::snprintf(text, sizeof text, "access: %s (%zu):", level > 0 ? (std::to_string(std::llround(level)) + "+ people").c_str() : "any settlement",
-                    to.size());
+      std::snprintf(text, sizeof text, "access: %s (%zu):", all ? "any settlement" : (f.key + "+ people").c_str(), f.destinations);
       lines += text;
       for (std::size_t k = 0; k < settings.thresholds_minutes.size(); ++k) {
         std::snprintf(text, sizeof text, "%g_min", settings.thresholds_minutes[k]);
@@ -154,10 +146,9 @@ class AccessCommand final : public Command {
       }
       std::snprintf(text, sizeof text, " mean %.1f min, p90 %.1f min\n", c.mean_minutes, c.p90_minutes);
       lines += text;
-      levels[level > 0 ? std::to_string(std::llround(level)) : "all"] = {
-          {"destinations", to.size()}, {"within", within}, {"unreachable", c.unreachable_people},
-          {"mean_minutes", c.mean_minutes}, {"p90_minutes", c.p90_minutes}, {"unreachable_land_cells", r.unreachable_land}};
-    }
+      levels[f.key] = {{"destinations", f.destinations}, {"within", within}, {"unreachable", c.unreachable_people},
+                       {"mean_minutes", c.mean_minutes}, {"p90_minutes", c.p90_minutes}, {"unreachable_land_cells", f.times.unreachable_land}};
+    });
     double total = 0;
     for (std::size_t i = 0; i < weight.size(); ++i)
       if (weight[i] > 0) total += weight[i];

@@ -86,12 +86,13 @@ void finish(Job& job, int status, const Log& log) {
     std::string text(line);
     while (!text.empty() && (text.back() == '\n' || text.back() == '\r')) text.pop_back();
     if (text.empty()) continue;
-    for (const char* prefix : {"terrapolis: error: ", "terrapolis: "})
-      if (text.rfind(prefix, 0) == 0) {
-        job.message = text.substr(std::string(prefix).size());
-        break;
-      }
-    if (job.message.empty() || text.find(job.message) == std::string::npos) log.warn(job.scenario + ": " + text);
+    // The run's last word ("terrapolis: error: ...", "terrapolis: interrupted ...") is its outcome; other lines are passed on.
+    static const std::string own = "terrapolis: ", error = "terrapolis: error: ";
+    if (text.rfind(own, 0) == 0) {
+      job.message = text.substr(text.rfind(error, 0) == 0 ? error.size() : own.size());
+    } else {
+      log.warn(job.scenario + ": " + text);
+    }
   }
   std::fclose(job.log);
   job.log = nullptr;

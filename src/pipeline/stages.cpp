@@ -398,35 +398,30 @@ void access_run(RunState& s, Progress& progress, const Log& log) {
   for (const auto& site : s.sites) total += double(site.population);
   if (s.summary["sites"].contains("target_population")) total = s.summary["sites"]["target_population"].get<double>();
   const Raster<float> people = sites::people_on_land(*s.density, *s.buildable, total);
+  std::vector<access::Settlement> settlements;
+  for (const auto& site : s.sites) settlements.push_back({{site.col, site.row, site.id}, double(site.population)});
   json levels = json::object();
-  for (const double level : a.levels_population) {
-    std::vector<access::Destination> to;
-    for (const auto& site : s.sites)
-      if (double(site.population) >= level) to.push_back({site.col, site.row, site.id});
-    if (to.empty()) continue;
-    const access::AccessResult r = access::travel_time(s.dem, land, road_cells, to, a.options, progress);
-    // Appended, not "_" + to_string(...): GCC 12 reports a false -Wrestrict on that (GCC bug 105651).
-    const std::string people_text = std::to_string(std::llround(level));
-    std::string suffix, whom = "the nearest settlement";
-    if (level > 0) suffix.append("_").append(people_text), whom = std::string("a settlement of ").append(people_text).append(" people or more");
-    s.write("access", "access_minutes" + suffix + ".tif", r.minutes, "travel time to " + whom + ", minutes (on foot off the roads, by road on them)",
-            Style::access_minutes, {{"UNIT", "min"}});
-    if (level == 0)
-      s.write("access", "access_nearest.tif", r.nearest, "id of the settlement nearest in time (cities.geojson), -1 where none is reached",
+  access::for_each_level(s.dem, land, road_cells, settlements, a.levels_population, a.thresholds_minutes, people, a.options, progress,
+                         [&](const access::LevelFigures& f) {
+    const bool all = f.level == 0;
+    const std::string whom = all ? "the nearest settlement" : "a settlement of " + f.key + " people or more";
+    s.write("access", all ? "access_minutes.tif" : "access_minutes_" + f.key + ".tif", f.times.minutes,
+            "travel time to " + whom + ", minutes (on foot off the roads, by road on them)", Style::access_minutes, {{"UNIT", "min"}});
+    if (all)
+      s.write("access", "access_nearest.tif", f.times.nearest, "id of the settlement nearest in time (cities.geojson), -1 where none is reached",
               Style::unit_ramp);
-    const access::Coverage c = access::coverage(r.minutes, people, a.thresholds_minutes);
+    const access::Coverage& c = f.coverage;
     json within = json::object();
     for (std::size_t k = 0; k < a.thresholds_minutes.size(); ++k) {
       char key[32];
       std::snprintf(key, sizeof key, "%g_min", a.thresholds_minutes[k]);
       within[key] = c.total_people > 0 ? std::round(c.within_people[k] / c.total_people * 1e4) / 1e4 : 0.0;
     }
-    levels[level > 0 ? std::to_string(std::llround(level)) : "all"] = {
-        {"destinations", to.size()}, {"share_within", within}, {"mean_minutes", std::round(c.mean_minutes * 10) / 10},
-        {"p90_minutes", std::round(c.p90_minutes * 10) / 10}, {"unreachable_people", std::llround(c.unreachable_people)}};
-    if (level == 0 && r.unreachable_land > 0)
-      log.warn(std::to_string(r.unreachable_land) + " land cells reach no settlement (islands or enclosed land without a road)");
-  }
+    levels[f.key] = {{"destinations", f.destinations}, {"share_within", within}, {"mean_minutes", std::round(c.mean_minutes * 10) / 10},
+                     {"p90_minutes", std::round(c.p90_minutes * 10) / 10}, {"unreachable_people", std::llround(c.unreachable_people)}};
+    if (all && f.times.unreachable_land > 0)
+      log.warn(std::to_string(f.times.unreachable_land) + " land cells reach no settlement (islands or enclosed land without a road)");
+  });
   s.summary["access"] = {{"people", std::llround(total)}, {"levels", levels}};
 }
 
