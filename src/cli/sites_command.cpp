@@ -103,6 +103,10 @@ class SitesCommand final : public Command {
       std::printf("sites: %zu existing places (%.0f people; %d moved to land, %d outside the DEM left out), %zu generated\n",
                   existing.sites.size(), result.existing_population, existing.moved, existing.outside,
                   result.sites.size() - existing.sites.size());
+    if (result.growth_people > 0)
+      std::printf("sites: growth +%g%%: %lld new settled people, %lld to the existing places, %lld in new settlements\n",
+                  100 * options.growth, static_cast<long long>(result.growth_people), static_cast<long long>(result.growth_to_existing),
+                  static_cast<long long>(result.growth_to_new));
     std::printf("sites: %zu cities (%d roots, %zu suburbs) from %d candidates, dr %.0f m, seed %llu\n", result.sites.size(), roots,
                 result.sites.size() - std::size_t(roots), result.candidates, result.dr_m, static_cast<unsigned long long>(result.seed));
   }

@@ -251,12 +251,28 @@ std::string format_summary(const json& manifest) {
     if (c.contains("population_source"))
       line("           %.0f people in the region, %s; largest %.0f\n", c["target_population"].get<double>(),
            c["population_source"].get<std::string>().c_str(), c["largest"].get<double>());
-    if (c.contains("settled_population"))
+    if (c.contains("growth"))
+      line("           %.0f of them in the settlements (the existing places grown by %g%%), the new ones split by a rank-size law of exponent %.2f\n",
+           c["settled_population"].get<double>(), 100 * c["growth"]["share"].get<double>(), c["sizes_exponent"].get<double>());
+    else if (c.contains("settled_population"))
       line("           %.0f of them in the settlements (sites.urban_share %g), split by a rank-size law of exponent %.2f (%s)\n",
            c["settled_population"].get<double>(), c["urban_share"].get<double>(), c["sizes_exponent"].get<double>(),
            c["sizes"] == "catchment" ? "read from the catchments" : "sites.zipf_exponent");
     if (c.value("count_limited_by_spacing", false))
       line("           count held to the %lld settlements the land holds at sites.spacing_km\n", c["room"].get<long long>());
+    if (c.contains("growth")) {
+      const json& g = c["growth"];
+      line("           growth +%g%%: %lld new settled people, %lld to the existing places, %lld in %d new settlements\n",
+           100 * g["share"].get<double>(), g["people"].get<long long>(), g["to_existing"].get<long long>(),
+           g["to_new_settlements"].get<long long>(), g["new_settlements"].get<int>());
+      int shown = 0;
+      for (const auto& [name, gain] : g["gained"].items())
+        if (shown++ < 3) line("             %s +%lld\n", name.c_str(), gain.get<long long>());
+      for (const auto& [rank, n] : g["new_largest"].items())
+        if (n.contains("near"))
+          line("             new settlement of %lld people %.1f km from %s\n", n["people"].get<long long>(), n["near_km"].get<double>(),
+               n["near"].get<std::string>().c_str());
+    }
     for (const auto& [k, v] : c["per_class"].items())
       line("           class %s (radius %.0f m): %d\n", k.c_str(), v["radius_m"].get<double>(), v["cities"].get<int>());
     if (c.contains("warnings"))

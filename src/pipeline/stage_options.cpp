@@ -171,7 +171,10 @@ sites::SitesOptions sites_options(const Scenario& scenario) {
   o.area_exponent = s["area_exponent"].get<double>();
   o.town_density_per_km2 = s["town_density_per_km2"].get<double>();
   o.influence_factor = s["influence_factor"].get<double>();
+  o.growth = s["growth"].get<double>();
+  o.growth_new_share = s["growth_new_share"].get<double>();
   sites::check_settings(o);
+  if (o.growth > 0 && s["existing"].get<std::string>().empty()) throw bad_input("/sites/growth: needs /sites/existing, the places that grow");
   if (!s["existing"].get<std::string>().empty() && o.quotas == sites::SitesOptions::Quotas::belhadj2007)
     throw bad_input("/sites/existing: needs /sites/quotas rank_size (the census table of belhadj2007 has no room for given places)");
   return o;

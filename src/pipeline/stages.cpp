@@ -179,6 +179,43 @@ void density_load(RunState& s) {
 
 // ---- sites (Belhadj 2007 §4.3.1, Algorithms 13-15; docs/sites.md) --------------------------
 
+/// A growth scenario's figures: the new people and where they went, each existing place's gain
+/// (keyed by name, so that `compare` lines two runs up), the largest new settlements and the
+/// existing place nearest each.
+json growth_figures(const sites::SitesResult& r, const sites::SitesOptions& options, const Crs& crs) {
+  std::vector<const sites::Site*> existing, created;
+  for (const auto& site : r.sites) (site.existing ? existing : created).push_back(&site);
+  const auto by_gain = [](const sites::Site* a, const sites::Site* b) { return a->gained > b->gained; };
+  std::stable_sort(existing.begin(), existing.end(), by_gain);
+  std::stable_sort(created.begin(), created.end(), by_gain);
+  json gained = json::object();
+  for (std::size_t k = 0; k < existing.size(); ++k) {
+    const std::string base = existing[k]->name.empty() ? "place " + std::to_string(k + 1) : existing[k]->name;
+    std::string key = base;
+    for (int n = 2; gained.contains(key); ++n) key = base + " (" + std::to_string(n) + ")";
+    gained[key] = existing[k]->gained;
+  }
+  json largest = json::object();
+  for (std::size_t k = 0; k < std::min<std::size_t>(5, created.size()); ++k) {
+    const sites::Site& c = *created[k];
+    const sites::Site* near = nullptr;
+    double near_m = INFINITY;
+    for (const sites::Site* e : existing)
+      if (const double d = crs_distance_m(crs, c.x, c.y, e->x, e->y); d < near_m) near_m = d, near = e;
+    json entry = {{"people", c.population}, {"x", c.x}, {"y", c.y}};
+    if (near) entry["near"] = near->name, entry["near_km"] = round_to(near_m / 1000, 0.1);
+    largest[std::to_string(k + 1)] = entry;
+  }
+  return {{"share", options.growth},
+          {"new_share", options.growth_new_share},
+          {"people", r.growth_people},
+          {"to_existing", r.growth_to_existing},
+          {"new_settlements", created.size()},
+          {"to_new_settlements", r.growth_to_new},
+          {"gained", gained},
+          {"new_largest", largest}};
+}
+
 void sites_run(RunState& s, Progress& progress, const Log& log) {
   sites::SitesOptions options = s.settings.sites;
   // The land of the density stage (water and nodata excluded), for the default population.
@@ -236,11 +273,12 @@ void sites_run(RunState& s, Progress& progress, const Log& log) {
     summary["existing"] = {{"places", existing.sites.size()}, {"people", r.existing_population}, {"moved_to_land", existing.moved},
                            {"outside_dem", existing.outside}, {"without_people", existing.without_people},
                            {"generated", r.sites.size() - existing.sites.size()},
-                           {"generated_people", population - std::llround(r.existing_population)}};
+                           {"generated_people", population - std::llround(r.existing_population) - r.growth_to_existing}};
     if (r.existing_population >= r.settled_population && r.settled_population > 0)
       log.warn("sites.existing: the given places hold " + std::to_string(std::llround(r.existing_population)) + " people, the settled share (" +
                std::to_string(std::llround(r.settled_population)) + ") or more: no settlement generated");
   }
+  if (options.growth > 0) summary["growth"] = growth_figures(r, options, s.dem.georef().crs);
   std::vector<std::string> warnings = settlement_warnings(s, r);
   const std::string reference = s.scenario.path("/sites/reference");
   const json realism = reference.empty() ? json() : realism_figures(s, density_inputs(s), r, reference, warnings, progress);

@@ -27,6 +27,9 @@ VectorLayer cities_layer(const SitesResult& result, const Crs& crs) {
   // Given places (sites.existing) are told apart, by name; without any the layer is as it was.
   const bool with_existing = std::any_of(result.sites.begin(), result.sites.end(), [](const Site& s) { return s.existing; });
   if (with_existing) layer.fields.insert(layer.fields.end(), {{"existing", FieldType::integer}, {"name", FieldType::string}});
+  // A growth scenario says what each settlement gained (a new one: all its people).
+  const bool with_growth = result.growth_people > 0;
+  if (with_growth) layer.fields.push_back({"gained", FieldType::integer});
   for (const Site& s : result.sites) {
     Feature f;
     f.parts = {{{s.x, s.y}}};
@@ -44,6 +47,7 @@ VectorLayer cities_layer(const SitesResult& result, const Crs& crs) {
       f.values[8] = std::int64_t(s.existing);
       if (s.existing) f.values[9] = s.name;
     }
+    if (with_growth) f.values[10] = std::int64_t(s.gained);
     layer.features.push_back(std::move(f));
   }
   return layer;

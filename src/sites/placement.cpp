@@ -148,7 +148,16 @@ QuotaTable rank_size_table(const Raster<float>& density, const Raster<std::uint8
   result.sizes_exponent = options.zipf_exponent;
   // Existing settlements hold their people: the law splits the rest over the places still free.
   for (const Site& e : options.existing) result.existing_population += double(e.population);
-  const double to_place = std::max(0.0, result.settled_population - result.existing_population);
+  double to_place = std::max(0.0, result.settled_population - result.existing_population);
+  if (options.growth > 0) {
+    // Growth scenario: the existing places are today's settled people; the region grows by
+    // `growth`, and the model places only growth_new_share of the new settled people.
+    const double today = std::max(result.target_population, result.existing_population);
+    result.target_population = std::round(today * (1 + options.growth));
+    result.growth_people = std::llround(result.existing_population * options.growth);
+    result.settled_population = result.existing_population + double(result.growth_people);
+    to_place = std::round(options.growth_new_share * double(result.growth_people));
+  }
   const std::size_t full_room = settleable_count(land_km2, options);
   const std::size_t room = full_room == std::numeric_limits<std::size_t>::max() ? full_room
                                                                                 : full_room - std::min(full_room, options.existing.size());
@@ -163,6 +172,7 @@ QuotaTable rank_size_table(const Raster<float>& density, const Raster<std::uint8
     pilot.population = result.target_population;
     pilot.land_area_km2 = land_km2;
     pilot.existing.clear();
+    pilot.growth = 0;
     const SitesResult central = place_sites(density, buildable, pilot, progress);
     result.room = central.room;
     result.count_limited = central.count_limited;
@@ -309,11 +319,26 @@ class Growth {
   std::unordered_map<std::uint32_t, std::size_t> rank_of_;  // candidate cell -> position in density order
 };
 
+/// Growth scenario: the new settlements' people are theirs; the rest of the growth goes to the
+/// existing places in proportion to their size (Gibrat 1931).
+void grow_existing(SitesResult& result, std::vector<Site>& existing) {
+  for (Site& s : result.sites) result.growth_to_new += (s.gained = s.population);
+  result.growth_to_existing = result.growth_people - result.growth_to_new;
+  std::vector<std::int64_t> sizes;
+  for (const Site& e : existing) sizes.push_back(e.population);
+  const std::vector<std::int64_t> gains = proportional_split(result.growth_to_existing, sizes);
+  for (std::size_t k = 0; k < existing.size(); ++k) {
+    existing[k].gained = gains[k];
+    existing[k].population += gains[k];
+  }
+}
+
 }  // namespace
 
 SitesResult place_sites(const Raster<float>& density, const Raster<std::uint8_t>& buildable, const SitesOptions& options,
                         Progress& progress) {
   check_settings(options);
+  if (options.growth > 0 && options.existing.empty()) throw bad_input("/sites/growth: needs /sites/existing, the places that grow");
   const int cols = density.cols(), rows = density.rows();
   if (buildable.cols() != cols || buildable.rows() != rows)
     throw bad_input("sites: the buildable mask and the density model are not on the same grid");
@@ -344,9 +369,10 @@ SitesResult place_sites(const Raster<float>& density, const Raster<std::uint8_t>
   result.candidates = int(pool.size());
   Growth growth(density, habitable, std::move(pool), std::move(radius), options, distance);
 
-  // Existing settlements occupy their built-up discs: no generated centre falls in one.
+  // Existing settlements occupy their built-up discs (grown by the whole growth share in a growth
+  // scenario, the most they may reach): no generated centre falls in one.
   std::vector<Site> existing = options.existing;
-  for (Site& e : existing) e.radius_m = urban_radius_m(double(e.population), options);
+  for (Site& e : existing) e.radius_m = urban_radius_m(double(e.population) * (1 + options.growth), options);
   const std::vector<std::uint8_t> occupied = existing.empty() ? std::vector<std::uint8_t>() : covered_cells(existing, distance, cols, rows);
   std::vector<Site> placed;
   {
@@ -383,6 +409,7 @@ SitesResult place_sites(const Raster<float>& density, const Raster<std::uint8_t>
     if (!table.populations.empty()) s.population = table.populations[std::size_t(s.radius_class)][std::size_t(c.kept)];
     ++c.kept;
   }
+  if (options.growth > 0) grow_existing(result, existing);
   if (!existing.empty()) {
     // Existing and generated settlements classed together by their sizes, the largest first, and
     // the hierarchy rebuilt over all of them by influence (below).

@@ -49,7 +49,13 @@ void check_settings(const SitesOptions& o) {
   if (!(std::isfinite(o.r_max_m) && o.r_max_m >= 0)) throw bad_input("/sites/r_max_m: must be >= 0 metres (0: automatic)");
   if (o.candidates < 0) throw bad_input("/sites/candidates: must be >= 0 (0: automatic)");
   if (o.refill_rounds < 0) throw bad_input("/sites/refill_rounds: must be >= 0");
-  if (o.quotas == SitesOptions::Quotas::belhadj2007) return;
+  if (!(std::isfinite(o.growth) && o.growth >= 0 && o.growth <= 100)) throw bad_input("/sites/growth: must lie in [0, 100] (0.2: +20 %)");
+  if (!(std::isfinite(o.growth_new_share) && o.growth_new_share >= 0 && o.growth_new_share <= 1))
+    throw bad_input("/sites/growth_new_share: must lie in [0, 1]");
+  if (o.quotas == SitesOptions::Quotas::belhadj2007) {
+    if (o.growth > 0) throw bad_input("/sites/growth: needs /sites/quotas rank_size (and /sites/existing)");
+    return;
+  }
   if (o.r_min_m > 0 || o.r_max_m > 0)
     throw bad_input(std::string(o.r_min_m > 0 ? "/sites/r_min_m" : "/sites/r_max_m") +
                     ": sets the classes of /sites/quotas belhadj2007; with rank_size the radii come from the populations");

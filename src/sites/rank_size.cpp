@@ -30,31 +30,53 @@ std::vector<std::int64_t> rank_size_populations(double total, double q, double m
   return rank_size_split(total, q, count);
 }
 
-std::vector<std::int64_t> rank_size_split(double total, double q, std::size_t count) {
-  if (!(std::isfinite(total) && total >= 0)) throw bad_input("sites: population must be a number of people >= 0");
-  if (!(std::isfinite(q) && q >= 0)) throw bad_input("sites: a rank-size exponent must be >= 0");
-  total = std::round(total);
-  std::vector<std::int64_t> sizes(count);
-  if (count == 0) return sizes;
-  double harmonic = 0;  // H_N(q), summed as rank_size_populations sums it
-  for (std::size_t k = 1; k <= count; ++k) harmonic += std::pow(double(k), -q);
-  // Largest remainders: floors first, then one more person to the largest fractional parts.
+namespace {
+
+/// round(total) split in proportion to `weights` (their sum positive): floors first, then one more
+/// person to the largest fractional parts (ties: the earlier index), so the shares add up exactly.
+std::vector<std::int64_t> largest_remainders(double total, const std::vector<double>& weights) {
+  const std::size_t count = weights.size();
+  double sum = 0;
+  for (double w : weights) sum += w;
   std::vector<double> exact(count);
+  std::vector<std::int64_t> shares(count);
   std::int64_t assigned = 0;
   for (std::size_t k = 0; k < count; ++k) {
-    exact[k] = total * std::pow(double(k + 1), -q) / harmonic;
-    sizes[k] = std::int64_t(std::floor(exact[k]));
-    assigned += sizes[k];
+    exact[k] = total * weights[k] / sum;
+    shares[k] = std::int64_t(std::floor(exact[k]));
+    assigned += shares[k];
   }
   std::vector<std::size_t> order(count);
   std::iota(order.begin(), order.end(), std::size_t(0));
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
     return exact[a] - std::floor(exact[a]) > exact[b] - std::floor(exact[b]);
   });
-  for (std::size_t k = 0; assigned < std::int64_t(total); ++k, ++assigned) ++sizes[order[k % count]];
+  for (std::size_t k = 0; assigned < std::int64_t(total); ++k, ++assigned) ++shares[order[k % count]];
+  return shares;
+}
+
+}  // namespace
+
+std::vector<std::int64_t> rank_size_split(double total, double q, std::size_t count) {
+  if (!(std::isfinite(total) && total >= 0)) throw bad_input("sites: population must be a number of people >= 0");
+  if (!(std::isfinite(q) && q >= 0)) throw bad_input("sites: a rank-size exponent must be >= 0");
+  if (count == 0) return {};
+  std::vector<double> weights(count);
+  for (std::size_t k = 0; k < count; ++k) weights[k] = std::pow(double(k + 1), -q);
+  std::vector<std::int64_t> sizes = largest_remainders(std::round(total), weights);
   // Equal shares can leave a later rank one person above an earlier one: keep the order.
   std::sort(sizes.begin(), sizes.end(), std::greater<>());
   return sizes;
+}
+
+std::vector<std::int64_t> proportional_split(std::int64_t total, const std::vector<std::int64_t>& weights) {
+  if (total < 0) throw bad_input("sites: a number of people to share must be >= 0");
+  std::vector<double> w(weights.begin(), weights.end());
+  const bool any = std::any_of(w.begin(), w.end(), [](double x) { return x > 0; });
+  if (std::any_of(w.begin(), w.end(), [](double x) { return x < 0; }) || (!any && total > 0))
+    throw bad_input("sites: people shared in proportion to negative or all-zero sizes");
+  if (!any) return std::vector<std::int64_t>(weights.size(), 0);
+  return largest_remainders(double(total), w);
 }
 
 std::size_t settleable_count(double land_area_km2, const SitesOptions& o) {

@@ -26,6 +26,9 @@ struct Site {
   int depth = 0;                 ///< 0 for roots, parent's depth + 1 otherwise
   bool existing = false;         ///< a real place given by SitesOptions::existing (its position and population kept)
   std::string name;              ///< an existing place's name
+  /// Growth scenario (SitesOptions::growth): people the settlement gained (an existing place's
+  /// share of the growth, or all the people of a new one); its population includes them.
+  std::int64_t gained = 0;
 };
 
 struct SitesOptions {
@@ -83,6 +86,17 @@ struct SitesOptions {
   /// settlements only for the rest, outside the existing discs; all are then classed and put in
   /// the hierarchy together by their sizes. rank_size quotas only.
   std::vector<Site> existing;
+  /// Growth scenario over the existing settlements: the region's people grow by this share (0.2:
+  /// +20 %), the settled people E of the existing places by as many, E x growth. Of those new
+  /// people, growth_new_share go to new settlements placed by the model (split by the rank-size
+  /// law, outside the grown discs of the existing places) and the rest to the existing places in
+  /// proportion to their size: Gibrat's law of proportionate growth (Gibrat 1931; Eeckhout 2004
+  /// finds it holds for every US place, large or small, 1990-2000). New people the model cannot
+  /// place (fewer than min_population, or no room) go to the existing places too. With growth
+  /// above 0 the existing places are the region's whole settled population today: the model fills
+  /// nothing else. 0: no growth scenario (the model places the rest of the settled share).
+  double growth = 0;
+  double growth_new_share = 0;
   // ---- belhadj2007 -----------------------------------------------------------------------------
   std::uint64_t seed = 1;   ///< seed of the candidate draw (std::mt19937_64)
   int candidates = 0;       ///< M, candidate positions drawn; 0: automatic (20 x N_sites, at most every buildable cell)
@@ -148,7 +162,10 @@ struct SitesResult {
   bool population_assumed = false;  ///< rank_size: target from people_per_km2 (no census figure given)
   std::int64_t room = 0;            ///< rank_size: settlements the land holds at spacing_km (settleable_count); 0: no limit
   bool count_limited = false;       ///< rank_size: the law would have made more settlements than `room`
-  double existing_population = 0;   ///< people of the existing settlements (SitesOptions::existing)
+  double existing_population = 0;   ///< people of the existing settlements (SitesOptions::existing), before any growth
+  /// Growth scenario: the new people (existing_population x growth), those that went to the
+  /// existing places and those in new settlements (growth_to_existing + growth_to_new = growth_people).
+  std::int64_t growth_people = 0, growth_to_existing = 0, growth_to_new = 0;
 };
 
 /// f(x) of Belhadj eq. 4.1: urban units of x people. For x >= x_max the base is clamped at 0
@@ -169,6 +186,10 @@ QuotaTable compute_quotas(double cell_size_m, const SitesOptions& options);
 /// remainders: the sizes add up to round(total) exactly. Largest first.
 std::vector<std::int64_t> rank_size_populations(double total, double zipf_exponent, double min_population,
                                                 std::size_t max_count = std::numeric_limits<std::size_t>::max());
+
+/// `total` people split in proportion to `weights` (>= 0, not all 0), by largest remainders (ties:
+/// the earlier index): the shares add up to `total` exactly.
+std::vector<std::int64_t> proportional_split(std::int64_t total, const std::vector<std::int64_t>& weights);
 
 /// `total` people split over `count` ranks by P_k = total k^-q / H_count(q) (q >= 0), rounded to
 /// whole people by largest remainders (they add up to round(total)). Largest first.

@@ -212,3 +212,100 @@ TEST(Suburbs, PlacementLinksSmallerSettlements) {
   const int without = suburbs(place_sites(flat.density, flat.buildable, o, progress));
   EXPECT_GT(with, 2 * without + 5);
 }
+
+// Largest remainders by hand: 7 over three equal sizes is 2.33 each, floors 6, the one left to the
+// first; exact shares stay exact; nothing to share of nothing.
+TEST(Growth, ProportionalSplitByHand) {
+  EXPECT_EQ(proportional_split(7, {1, 1, 1}), (std::vector<std::int64_t>{3, 2, 2}));
+  EXPECT_EQ(proportional_split(10, {5, 3, 2}), (std::vector<std::int64_t>{5, 3, 2}));
+  EXPECT_EQ(proportional_split(100, {0, 4}), (std::vector<std::int64_t>{0, 100}));
+  EXPECT_EQ(proportional_split(0, {0, 0}), (std::vector<std::int64_t>{0, 0}));
+  EXPECT_THROW(proportional_split(5, {0, 0}), Error);
+  EXPECT_THROW(proportional_split(5, {3, -1}), Error);
+}
+
+// Random sizes and totals: the shares add up to the total, each within one person of its exact share.
+TEST(Growth, ProportionalSplitAddsUp) {
+  std::uint64_t state = 42;
+  const auto next = [&] { return (state = state * 6364136223846793005ULL + 1442695040888963407ULL) >> 33; };
+  for (int trial = 0; trial < 200; ++trial) {
+    std::vector<std::int64_t> sizes(1 + next() % 40);
+    for (auto& s : sizes) s = std::int64_t(1 + next() % 100000);
+    const std::int64_t total = std::int64_t(next() % 1000000);
+    const auto shares = proportional_split(total, sizes);
+    const double sum = std::accumulate(sizes.begin(), sizes.end(), 0.0);
+    EXPECT_EQ(std::accumulate(shares.begin(), shares.end(), std::int64_t(0)), total);
+    for (std::size_t k = 0; k < sizes.size(); ++k) EXPECT_LT(std::abs(double(shares[k]) - double(total) * double(sizes[k]) / sum), 1.0);
+  }
+}
+
+namespace {
+/// Three existing places on the flat 20 km x 20 km region, far apart.
+std::vector<Site> three_places(const Raster<float>& density) {
+  std::vector<Site> places;
+  const int cells[3][2] = {{30, 30}, {170, 40}, {100, 160}};
+  const std::int64_t people[3] = {20000, 8000, 3000};
+  for (int k = 0; k < 3; ++k) {
+    Site s;
+    s.col = cells[k][0], s.row = cells[k][1];
+    const auto xy = density.georef().cell_centre(s.col, s.row);
+    s.x = xy[0], s.y = xy[1];
+    s.population = people[k];
+    s.existing = true;
+    s.name = "P";
+    s.name.append(std::to_string(k));
+    places.push_back(s);
+  }
+  return places;
+}
+}  // namespace
+
+// +25 % of 31,000 settled people is 7,750 new ones. All to the existing places (new share 0): each
+// grows by a quarter (5000, 2000, 750), nothing new is placed. Half to new settlements: the rank-size
+// law's new places hold 3,875, the places the rest; the sums add up; positions never move.
+TEST(Growth, SplitsAddUpAndPlacesKeepTheirCells) {
+  SilentProgress progress;
+  const auto flat = fixtures::flat_scenario(200, 200, 100.0);
+  SitesOptions o = fixed_law();
+  o.population = 40000;
+  o.existing = three_places(flat.density);
+  o.growth = 0.25;
+  const SitesResult gibrat = place_sites(flat.density, flat.buildable, o, progress);
+  EXPECT_EQ(gibrat.growth_people, 7750);
+  EXPECT_EQ(gibrat.growth_to_existing, 7750);
+  EXPECT_EQ(gibrat.growth_to_new, 0);
+  ASSERT_EQ(gibrat.sites.size(), 3u);
+  EXPECT_EQ(gibrat.target_population, 50000);
+  const std::int64_t grown[3] = {25000, 10000, 3750};
+  for (int k = 0; k < 3; ++k) {
+    const Site& s = gibrat.sites[std::size_t(k)];
+    EXPECT_EQ(s.population, grown[k]);
+    EXPECT_EQ(s.gained, grown[k] / 5);
+    EXPECT_EQ(s.col, o.existing[std::size_t(k)].col);
+    EXPECT_EQ(s.row, o.existing[std::size_t(k)].row);
+  }
+  o.growth_new_share = 0.5;
+  const SitesResult mixed = place_sites(flat.density, flat.buildable, o, progress);
+  EXPECT_EQ(mixed.growth_to_new, 3875);
+  EXPECT_EQ(mixed.growth_to_existing, 3875);
+  std::int64_t total = 0, created = 0, gained = 0;
+  for (const Site& s : mixed.sites) {
+    total += s.population;
+    gained += s.gained;
+    if (s.existing) continue;
+    created += s.population;
+    EXPECT_EQ(s.gained, s.population);
+  }
+  EXPECT_GT(mixed.sites.size(), 3u);
+  EXPECT_EQ(created, 3875);
+  EXPECT_EQ(gained, 7750);
+  EXPECT_EQ(total, 31000 + 7750);
+  // Growth 0 with every settled person in the places (urban share 1, population = their sum): nothing new.
+  o.growth = 0;
+  o.population = 31000;
+  EXPECT_EQ(place_sites(flat.density, flat.buildable, o, progress).sites.size(), 3u);
+  // No places, no growth scenario.
+  o.growth = 0.1;
+  o.existing.clear();
+  EXPECT_THROW(place_sites(flat.density, flat.buildable, o, progress), Error);
+}
