@@ -97,8 +97,13 @@ class SitesCommand final : public Command {
                   result.population_assumed ? "assumed: default people/km2 x buildable land" : "given", result.settled_population,
                   result.sizes_exponent, options.sizes == sites::SitesOptions::Sizes::catchment ? "from the catchments" : "zipf_exponent");
     if (result.count_limited)
-      std::printf("sites: count held to the %lld settlements the land holds %g km apart (--spacing)\n", static_cast<long long>(result.room),
-                  options.spacing_km);
+      std::printf("sites: count held to the %lld settlements the land holds %g km apart (--spacing; closer where denser than an urban centre)\n",
+                  static_cast<long long>(result.room), options.spacing_km);
+    if (result.crowded > 0)
+      std::printf("sites: %lld placed without a disc clear of water and steep land\n", static_cast<long long>(result.crowded));
+    if (result.unplaced > 0)
+      std::printf("sites: %lld settlements of the law (%lld people) found no place (raise --candidates)\n", static_cast<long long>(result.unplaced),
+                  static_cast<long long>(result.unplaced_people));
     if (!existing_file.empty())
       std::printf("sites: %zu existing places (%.0f people; %d moved to land, %d outside the DEM left out), %zu generated\n",
                   existing.sites.size(), result.existing_population, existing.moved, existing.outside,

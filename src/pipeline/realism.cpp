@@ -19,9 +19,10 @@ using json = nlohmann::ordered_json;
 
 double rounded(double v, double step) { return std::isfinite(v) ? std::round(v / step) * step : v; }
 
-/// People per km² of land above which a whole region is implausible: denser than Hong Kong's
-/// 6,700 over its whole land area would be a city-state, not a region.
-constexpr double kPlausiblePeoplePerKm2 = 5000;
+/// People per km² of land above which a region is denser than any real one: Manila, the densest
+/// city of millions over its whole land (1.85 M people on 42.9 km², 43,000/km², PSA 2020 census);
+/// Dhaka's city corporations and Macau (21,000/km²) are below it, New York City (11,000) far below.
+constexpr double kPlausiblePeoplePerKm2 = 45000;
 
 }  // namespace
 
@@ -46,10 +47,13 @@ std::vector<std::string> settlement_warnings(const RunState& s, const sites::Sit
     warnings.push_back(std::to_string(flat) + " settlement(s) on a perfectly flat surface (9 x 9 cells of one altitude, e.g. " + first_flat +
                        "): a lake or reservoir in SRTM-like DEMs; pass it as water (water.water_mask) or check");
   if (nodata) warnings.push_back(std::to_string(nodata) + " settlement(s) centred on a nodata cell");
+  if (r.unplaced > 0)
+    warnings.push_back(std::to_string(r.unplaced) + " settlement(s) of the law (" + std::to_string(r.unplaced_people) +
+                       " people) found no candidate outside the others' discs: in no settlement (raise sites.candidates)");
   if (r.land_area_km2 > 0 && r.target_population / r.land_area_km2 > kPlausiblePeoplePerKm2)
     warnings.push_back("population " + std::to_string(std::llround(r.target_population)) + " on " + std::to_string(std::llround(r.land_area_km2)) +
                        " km2 of land is " + std::to_string(std::llround(r.target_population / r.land_area_km2)) +
-                       " people/km2, above any real region (check sites.population)");
+                       " people/km2, denser than Manila (43,000/km2, the densest real city; check sites.population)");
   return warnings;
 }
 

@@ -259,7 +259,10 @@ std::string format_summary(const json& manifest) {
            c["settled_population"].get<double>(), c["urban_share"].get<double>(), c["sizes_exponent"].get<double>(),
            c["sizes"] == "catchment" ? "read from the catchments" : "sites.zipf_exponent");
     if (c.value("count_limited_by_spacing", false))
-      line("           count held to the %lld settlements the land holds at sites.spacing_km\n", c["room"].get<long long>());
+      line("           count held to the %lld settlements the land holds at sites.spacing_km (closer where denser than an urban centre)\n",
+           c["room"].get<long long>());
+    if (c.value("crowded", 0) > 0)
+      line("           %d placed without a disc clear of water and steep land (their built-up area reaches over it)\n", c["crowded"].get<int>());
     if (c.contains("growth")) {
       const json& g = c["growth"];
       line("           growth +%g%%: %lld new settled people, %lld to the existing places, %lld in %d new settlements\n",

@@ -263,6 +263,9 @@ void sites_run(RunState& s, Progress& progress, const Log& log) {
     summary["sizes_exponent"] = r.sizes_exponent;  // q of the law that split the settled people
     summary["room"] = r.room;  // settlements the land holds at sites.spacing_km; 0: no limit
     summary["count_limited_by_spacing"] = r.count_limited;
+    // Every settled person is in a settlement, or counted here: population + unplaced people = settled.
+    summary["crowded"] = r.crowded;
+    summary["unplaced"] = {{"settlements", r.unplaced}, {"people", r.unplaced_people}};
     summary["largest"] = r.sites.empty() ? 0 : std::max_element(r.sites.begin(), r.sites.end(), [](const auto& a, const auto& b) {
                                                  return a.population < b.population;
                                                })->population;

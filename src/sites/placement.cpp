@@ -109,22 +109,25 @@ class DiscTester {
   std::vector<std::uint16_t> row_gap_;
 };
 
-/// Cells whose centre lies strictly inside one of the discs of `sites` (the centre test of the
+/// Marks the cells whose centre lies strictly inside the disc of `s` (the centre test of the
 /// inclusion rules).
+void mark_disc(const Site& s, const GridDistance& distance, int cols, int rows, std::vector<std::uint8_t>& covered) {
+  const double y0 = distance.northing(s.row);
+  for (int dir : {1, -1})
+    for (int r = dir == 1 ? s.row : s.row - 1; r >= 0 && r < rows; r += dir) {
+      const double dy = std::abs(distance.northing(r) - y0);
+      if (dy >= s.radius_m) break;
+      const double w = distance.width_between(s.row, r);
+      const int reach = int(std::sqrt(s.radius_m * s.radius_m - dy * dy) / w) + 1;
+      for (int c = std::max(0, s.col - reach); c <= std::min(cols - 1, s.col + reach); ++c)
+        if (distance(s.col, s.row, c, r) < s.radius_m) covered[std::size_t(r) * std::size_t(cols) + std::size_t(c)] = 1;
+    }
+}
+
+/// Cells whose centre lies strictly inside one of the discs of `sites`.
 std::vector<std::uint8_t> covered_cells(const std::vector<Site>& sites, const GridDistance& distance, int cols, int rows) {
   std::vector<std::uint8_t> covered(std::size_t(cols) * std::size_t(rows), 0);
-  for (const Site& s : sites) {
-    const double y0 = distance.northing(s.row);
-    for (int dir : {1, -1})
-      for (int r = dir == 1 ? s.row : s.row - 1; r >= 0 && r < rows; r += dir) {
-        const double dy = std::abs(distance.northing(r) - y0);
-        if (dy >= s.radius_m) break;
-        const double w = distance.width_between(s.row, r);
-        const int reach = int(std::sqrt(s.radius_m * s.radius_m - dy * dy) / w) + 1;
-        for (int c = std::max(0, s.col - reach); c <= std::min(cols - 1, s.col + reach); ++c)
-          if (distance(s.col, s.row, c, r) < s.radius_m) covered[std::size_t(r) * std::size_t(cols) + std::size_t(c)] = 1;
-      }
-  }
+  for (const Site& s : sites) mark_disc(s, distance, cols, rows, covered);
   return covered;
 }
 
@@ -158,7 +161,7 @@ QuotaTable rank_size_table(const Raster<float>& density, const Raster<std::uint8
     result.settled_population = result.existing_population + double(result.growth_people);
     to_place = std::round(options.growth_new_share * double(result.growth_people));
   }
-  const std::size_t full_room = settleable_count(land_km2, options);
+  const std::size_t full_room = settleable_count(land_km2, options, result.target_population);
   const std::size_t room = full_room == std::numeric_limits<std::size_t>::max() ? full_room
                                                                                 : full_room - std::min(full_room, options.existing.size());
   std::vector<std::int64_t> sizes;
@@ -241,6 +244,25 @@ class Growth {
 
   bool candidates_left() const { return next_ < pool_.size(); }
 
+  /// The settlements still without a place once the growth is done: no candidate's disc was clear
+  /// of unbuildable land for them (a city on land cut by water or steep slopes). Each, largest
+  /// first, goes to the densest candidate whose cell no disc covers, its disc then reaching over
+  /// that land, as a city's does around a bay. `covered` gains every disc placed.
+  void crowd(std::vector<int>& quota, QuotaTable& table, std::vector<Site>& out, std::vector<std::uint8_t>& covered,
+             const GridDistance& distance) {
+    const int n = int(radius_.size());
+    int j = n - 1;
+    for (std::size_t k = 0; k < pool_.size(); ++k) {
+      while (j >= 0 && quota[std::size_t(j)] == 0) --j;
+      if (j < 0) break;
+      if (covered[pool_[k]]) continue;
+      --quota[std::size_t(j)];
+      ++table.classes[std::size_t(n - 1 - j)].placed;
+      out.push_back(site_at(k, j));
+      mark_disc(out.back(), distance, cols_, density_.rows(), covered);
+    }
+  }
+
   /// From candidate `next_` on, with quota[] left, skipping candidates whose cell is `covered`;
   /// appends the sites to `out`. Disc tests run in parallel a batch ahead; the quota bookkeeping is
   /// sequential, in density order.
@@ -319,11 +341,40 @@ class Growth {
   std::unordered_map<std::uint32_t, std::size_t> rank_of_;  // candidate cell -> position in density order
 };
 
+/// rank_size: every settlement of the law gets a place. Those the growth and its refills left
+/// without one are crowded in (Growth::crowd) and the list is put back in size order, parents
+/// first; result.crowded counts them.
+void crowd_the_rest(Growth& growth, QuotaTable& table, const std::vector<std::uint8_t>& occupied, const GridDistance& distance,
+                    int cols, int rows, SitesResult& result) {
+  const int n = int(table.classes.size());
+  std::vector<int> quota(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) quota[std::size_t(i)] = table.classes[std::size_t(n - 1 - i)].quota;
+  for (const Site& s : result.sites) --quota[std::size_t(n - 1 - s.radius_class)];
+  if (std::accumulate(quota.begin(), quota.end(), 0) == 0) return;
+  std::vector<std::uint8_t> covered = covered_cells(result.sites, distance, cols, rows);
+  for (std::size_t i = 0; i < occupied.size(); ++i) covered[i] |= occupied[i];
+  std::vector<Site>& sites = result.sites;
+  for (std::size_t k = 0; k < sites.size(); ++k) sites[k].id = int(k);
+  const std::size_t before = sites.size();
+  growth.crowd(quota, table, sites, covered, distance);
+  result.crowded = std::int64_t(sites.size() - before);
+  for (std::size_t k = before; k < sites.size(); ++k) sites[k].id = int(k);
+  growth.sort_by_size(sites);
+  std::vector<int> index_of(sites.size());
+  for (std::size_t k = 0; k < sites.size(); ++k) index_of[std::size_t(sites[k].id)] = int(k);
+  for (std::size_t k = 0; k < sites.size(); ++k) {
+    sites[k].id = int(k);
+    if (sites[k].parent >= 0) sites[k].parent = index_of[std::size_t(sites[k].parent)];
+  }
+  for (Site& s : sites) s.depth = s.parent < 0 ? 0 : sites[std::size_t(s.parent)].depth + 1;
+}
+
 /// Growth scenario: the new settlements' people are theirs; the rest of the growth goes to the
 /// existing places in proportion to their size (Gibrat 1931).
 void grow_existing(SitesResult& result, std::vector<Site>& existing) {
   for (Site& s : result.sites) result.growth_to_new += (s.gained = s.population);
   result.growth_to_existing = result.growth_people - result.growth_to_new;
+  result.unplaced = result.unplaced_people = 0;  // the people of new settlements with no place grow the existing ones
   std::vector<std::int64_t> sizes;
   for (const Site& e : existing) sizes.push_back(e.population);
   const std::vector<std::int64_t> gains = proportional_split(result.growth_to_existing, sizes);
@@ -403,12 +454,17 @@ SitesResult place_sites(const Raster<float>& density, const Raster<std::uint8_t>
     growth.sort_by_size(merged);
     result.sites = resolve_inclusions(merged, options.mode, distance, cols, rows);
   }
+  if (options.quotas == SitesOptions::Quotas::rank_size) crowd_the_rest(growth, table, occupied, distance, cols, rows, result);
   for (Site& s : result.sites) {
     QuotaClass& c = table.classes[std::size_t(s.radius_class)];
     // rank_size: within a class, sites (by density order) take the class's sizes, largest first.
     if (!table.populations.empty()) s.population = table.populations[std::size_t(s.radius_class)][std::size_t(c.kept)];
     ++c.kept;
   }
+  // Settlements of the law with no place even so (no candidate left outside the discs): reported.
+  for (std::size_t c = 0; c < table.populations.size(); ++c)
+    for (std::size_t j = std::size_t(table.classes[c].kept); j < table.populations[c].size(); ++j)
+      ++result.unplaced, result.unplaced_people += table.populations[c][j];
   if (options.growth > 0) grow_existing(result, existing);
   if (!existing.empty()) {
     // Existing and generated settlements classed together by their sizes, the largest first, and

@@ -79,12 +79,16 @@ std::vector<std::int64_t> proportional_split(std::int64_t total, const std::vect
   return largest_remainders(double(total), w);
 }
 
-std::size_t settleable_count(double land_area_km2, const SitesOptions& o) {
+std::size_t settleable_count(double land_area_km2, const SitesOptions& o, double people) {
   if (!(std::isfinite(o.spacing_km) && o.spacing_km >= 0)) throw bad_input("sites: spacing_km must be >= 0 (0: no limit)");
   if (o.spacing_km == 0) return std::numeric_limits<std::size_t>::max();
   // One hexagon of side-to-side width `spacing` per settlement of 1,000 people; a floor of
   // m people is reached by 1000 / m times fewer of them (q = 1), so the lattice widens as sqrt(m / 1000).
-  const double hexagon_km2 = std::sqrt(3.0) / 2 * o.spacing_km * o.spacing_km * (o.min_population / 1000.0);
+  double hexagon_km2 = std::sqrt(3.0) / 2 * o.spacing_km * o.spacing_km * (o.min_population / 1000.0);
+  // A region denser on average than an urban centre is urban through and through: its places lie
+  // as close as its people make them, each hexagon holding the people it holds at that density.
+  const double density = land_area_km2 > 0 ? people / land_area_km2 : 0;
+  if (density > kUrbanCentrePeoplePerKm2) hexagon_km2 *= kUrbanCentrePeoplePerKm2 / density;
   return std::size_t(std::max(1.0, std::floor(land_area_km2 / hexagon_km2 + 1e-9)));
 }
 

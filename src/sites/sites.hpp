@@ -166,6 +166,10 @@ struct SitesResult {
   /// Growth scenario: the new people (existing_population x growth), those that went to the
   /// existing places and those in new settlements (growth_to_existing + growth_to_new = growth_people).
   std::int64_t growth_people = 0, growth_to_existing = 0, growth_to_new = 0;
+  /// rank_size: settlements placed without a disc clear of unbuildable land (no candidate had one;
+  /// their discs reach over water or steep land), and those of the law with no place at all and
+  /// their people (the settled people are the placed ones plus these).
+  std::int64_t crowded = 0, unplaced = 0, unplaced_people = 0;
 };
 
 /// f(x) of Belhadj eq. 4.1: urban units of x people. For x >= x_max the base is clamped at 0
@@ -206,9 +210,16 @@ std::vector<double> catchment_people(const Raster<float>& density, const Raster<
 /// to density x cell area), per cell; 0 elsewhere.
 Raster<float> people_on_land(const Raster<float>& density, const Raster<std::uint8_t>& buildable, double total);
 
+/// People per km² above which a whole region counts as urban: the cell density of an urban
+/// centre in the EU-OECD degree of urbanisation (1,500; Dijkstra & Poelman 2014).
+constexpr double kUrbanCentrePeoplePerKm2 = 1500;
+
 /// The most settlements of min_population people `land_area_km2` holds at options.spacing_km
-/// apart on a hexagonal lattice (at least 1; unlimited when spacing_km is 0).
-std::size_t settleable_count(double land_area_km2, const SitesOptions& options);
+/// apart on a hexagonal lattice (at least 1; unlimited when spacing_km is 0). Christaller's
+/// lattice is that of a rural land with its towns; where `people` on that land are denser than an
+/// urban centre (kUrbanCentrePeoplePerKm2), the hexagons shrink in proportion (a metropolis holds
+/// hundreds of places of 1,000 or more, not the few of a 7 km lattice).
+std::size_t settleable_count(double land_area_km2, const SitesOptions& options, double people = 0);
 
 /// q of the rank-size law fitted to `sizes` by least squares on ln P_k = c - q ln(k - 1/2)
 /// (the rank shifted by 1/2 against the small-sample bias, Gabaix & Ibragimov 2011); NaN for

@@ -130,24 +130,25 @@ TEST(RankSize, CountsFollowThePopulationNotTheGrid) {
   EXPECT_EQ(d.target_population, 24000.0);
 }
 
-// The default spacing (7 km): 400 km2 hold 9 settlements (400 / 42.435 = 9.43), however many
-// people, on either grid; the sizes still add up to the population. 24,000 people: the law's own
-// count, 8 (24000 / (8 H_8) = 1104 >= 1000 > 24000 / (9 H_9) = 943), is below the limit and stays.
+// The default spacing (7 km): 400 km2 hold 9 settlements (400 / 42.435 = 9.43) at 500 people/km2,
+// on either grid; at 5,000/km2, denser than an urban centre, 10/3 times more (31); the sizes still
+// add up to the population. 24,000 people: the law's own count, 8 (24000 / (8 H_8) = 1104 >= 1000 >
+// 24000 / (9 H_9) = 943), is below the limit and stays.
 TEST(RankSize, SpacingLimitsTheCountOnCrowdedLand) {
   SilentProgress progress;
   SitesOptions o = fixed_law();
   const auto coarse = fixtures::flat_scenario(200, 200, 100.0), fine = fixtures::flat_scenario(400, 400, 50.0);
-  for (double people : {200000.0, 2000000.0})
+  for (const auto& [people, room] : {std::pair{200000.0, 9}, std::pair{2000000.0, 31}})
     for (const auto* g : {&coarse, &fine}) {
       o.population = people;
       const SitesResult r = place_sites(g->density, g->buildable, o, progress);
       int quota = 0;
       for (const auto& q : r.quotas) quota += q.quota;
-      EXPECT_EQ(quota, 9) << people;
-      EXPECT_EQ(r.room, 9);
+      EXPECT_EQ(quota, room) << people;
+      EXPECT_EQ(r.room, room);
       EXPECT_TRUE(r.count_limited);
-      if (people > 1e6) continue;  // a city of 700,000 on 400 km2 leaves no room for all the others
-      ASSERT_EQ(r.sites.size(), 9u);
+      EXPECT_EQ(r.unplaced, 0);
+      ASSERT_EQ(r.sites.size(), std::size_t(room));
       std::int64_t sum = 0;
       for (const auto& s : r.sites) sum += s.population;
       EXPECT_EQ(sum, std::int64_t(people));
@@ -308,4 +309,47 @@ TEST(Growth, SplitsAddUpAndPlacesKeepTheirCells) {
   o.growth = 0.1;
   o.existing.clear();
   EXPECT_THROW(place_sites(flat.density, flat.buildable, o, progress), Error);
+}
+
+// Land cut by a water channel every 2 km (a delta, a city of canals): no disc wider than 1 km is
+// clear, so no settlement above about 6,400 people has a clear site. They are crowded in on the
+// densest free candidates, and every settled person is in a settlement; the list stays in size
+// order with parents first.
+TEST(RankSize, EveryPersonPlacedOnLandCutByWater) {
+  SilentProgress progress;
+  auto land = fixtures::flat_scenario(200, 200, 100.0);
+  for (int r = 0; r < 200; ++r)
+    for (int c = 0; c < 200; c += 20) land.buildable(c, r) = 0;
+  for (int r = 0; r < 200; ++r)  // density rising to the east: the order of the candidates is known
+    for (int c = 0; c < 200; ++c) land.density(c, r) = land.buildable(c, r) ? float(0.2 + 0.7 * c / 200.0) : 0.0f;
+  SitesOptions o = fixed_law();
+  o.population = 500000;
+  o.spacing_km = 0;
+  const SitesResult r = place_sites(land.density, land.buildable, o, progress);
+  std::int64_t people = 0;
+  for (std::size_t k = 0; k < r.sites.size(); ++k) {
+    const Site& s = r.sites[k];
+    people += s.population;
+    EXPECT_EQ(s.id, int(k));
+    EXPECT_EQ(land.buildable(s.col, s.row), 1);
+    if (s.parent >= 0) {
+      EXPECT_LT(s.parent, s.id);
+    }
+    if (k > 0) {
+      EXPECT_LE(s.radius_m, r.sites[k - 1].radius_m);
+    }
+  }
+  EXPECT_EQ(r.unplaced, 0);
+  EXPECT_GT(r.crowded, 0);
+  EXPECT_EQ(people, 500000);
+  EXPECT_EQ(r.sites.size(), rank_size_populations(500000, 1, 1000).size());
+}
+
+// Christaller's lattice holds a rural land; a region denser than an urban centre (1,500/km²) has
+// its hexagons shrunk in proportion: 1,000 km² at 7 km hold 23 places, at 6,000/km² four times more.
+TEST(RankSize, DenseRegionsHoldMorePlaces) {
+  SitesOptions o;
+  EXPECT_EQ(settleable_count(1000, o, 100 * 1000.0), 23u);
+  EXPECT_EQ(settleable_count(1000, o, 1500 * 1000.0), 23u);
+  EXPECT_EQ(settleable_count(1000, o, 6000 * 1000.0), 94u);  // 1000 / (42.435 / 4) = 94.3
 }
