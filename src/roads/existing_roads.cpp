@@ -25,25 +25,27 @@ std::optional<GridPoint> grid_position(const TerrainField& t, const std::array<d
   return GridPoint{(g[5] * dx - g[2] * dy) / det, (-g[4] * dx + g[1] * dy) / det};
 }
 
-GridPoint centre_of(const TerrainField& t, std::uint32_t cell) {
-  return {double(cell % std::uint32_t(t.cols())), double(cell / std::uint32_t(t.cols()))};
-}
-
-/// Appends the chains of one line string (cut where it leaves the grid) to `out`.
-void draw_line(const TerrainField& t, const std::vector<std::array<double, 2>>& line, std::vector<CellChain>& out) {
+/// Appends the chains of one line string (cut where it leaves the grid) to `out`, and the length
+/// of each (m) of the line itself inside the grid to `lengths`.
+void draw_line(const TerrainField& t, const std::vector<std::array<double, 2>>& line, std::vector<CellChain>& out, std::vector<double>& lengths) {
   CellChain chain;
+  double length = 0;
+  std::optional<GridPoint> last;  // the previous sample, when inside the grid (cell centres at integers)
   auto flush = [&] {
-    if (chain.cells.size() >= 2) out.push_back(std::move(chain));
+    if (chain.cells.size() >= 2) out.push_back(std::move(chain)), lengths.push_back(length);
     chain = {};
+    length = 0;
+    last.reset();
   };
   auto visit = [&](double col, double row) {
     const int c = int(std::floor(col)), r = int(std::floor(row));
     if (!std::isfinite(col) || !std::isfinite(row) || !t.inside(c, r)) return flush();
+    const GridPoint here{col - 0.5, row - 0.5};
+    if (last) length += t.length_m(*last, here);
+    last = here;
     const std::uint32_t cell = std::uint32_t(t.index(c, r));
-    if (!chain.cells.empty()) {
-      if (chain.cells.back() == cell) return;
-      chain.structures.push_back(Structure::road);
-    }
+    if (!chain.cells.empty() && chain.cells.back() == cell) return;
+    if (!chain.cells.empty()) chain.structures.push_back(Structure::road);
     chain.cells.push_back(cell);
   };
   std::optional<GridPoint> prev;
@@ -104,14 +106,12 @@ ExistingRoads rasterise_roads(const TerrainField& t, const VectorLayer& lines) {
       continue;
     }
     const std::size_t before = out.chains.size();
-    draw_line(t, f.parts[0], out.chains);
+    draw_line(t, f.parts[0], out.chains, out.chain_length_m);
     if (out.chains.size() == before) ++out.outside;
     for (std::size_t k = before; k < out.chains.size(); ++k) {
       out.classes.push_back(*c);
       out.source_class.push_back(value);
-      const CellChain& chain = out.chains[k];
-      for (std::size_t i = 0; i + 1 < chain.cells.size(); ++i)
-        out.length_m[std::size_t(*c)] += t.length_m(centre_of(t, chain.cells[i]), centre_of(t, chain.cells[i + 1]));
+      out.length_m[std::size_t(*c)] += out.chain_length_m[k];
     }
   }
   return out;
@@ -139,11 +139,9 @@ VectorLayer existing_roads_layer(const TerrainField& t, const ExistingRoads& exi
   layer.crs = t.georef().crs;
   layer.fields = {{"class", FieldType::string}, {"source_class", FieldType::string}, {"length_m", FieldType::real}};
   for (std::size_t k = 0; k < existing.chains.size(); ++k) {
-    const CellChain& chain = existing.chains[k];
-    double length = 0;
-    for (std::size_t i = 0; i + 1 < chain.cells.size(); ++i) length += t.length_m(centre_of(t, chain.cells[i]), centre_of(t, chain.cells[i + 1]));
-    layer.features.push_back({{chain_line(t, chain.cells)},
-                              {std::string(name_of(existing.classes[k])), existing.source_class[k], std::round(length * 100) / 100}});
+    layer.features.push_back({{chain_line(t, existing.chains[k].cells)},
+                              {std::string(name_of(existing.classes[k])), existing.source_class[k],
+                               std::round(existing.chain_length_m[k] * 100) / 100}});
   }
   return layer;
 }

@@ -29,15 +29,17 @@ std::optional<RoadClass> existing_road_class(std::string_view value);
 int existing_class_field(const VectorLayer& lines);
 
 /// The given roads on the grid: each line (in the DEM's CRS) drawn as the chain of 8-connected
-/// cells it crosses (sampled every quarter cell), cut where it leaves the grid.
+/// cells it crosses (sampled every quarter cell: every cell it passes through, so a search's arcs
+/// along it find their start, middle and end cells on it), cut where it leaves the grid.
 struct ExistingRoads {
   std::vector<CellChain> chains;     ///< steps all Structure::road
   std::vector<RoadClass> classes;    ///< one per chain
   std::vector<std::string> source_class;  ///< the class field's value ("" without one)
+  std::vector<double> chain_length_m;     ///< length of each line inside the grid (m, geodesic on geographic grids)
   std::size_t lines = 0;             ///< lines read (multi-lines split)
   std::size_t outside = 0;           ///< lines with no step on the grid, left out
   std::size_t ferries = 0;           ///< ferry lines, left out
-  /// Length (m, geodesic on geographic grids) of the chains per class (motorway .. local).
+  /// Length of the lines inside the grid per class (motorway .. local), m.
   std::array<double, 4> length_m{};
   bool empty() const { return chains.empty(); }
 };

@@ -61,6 +61,19 @@ void simplify(const std::vector<GridPoint>& pts, std::size_t i, std::size_t j, d
 
 }  // namespace
 
+bool on_existing(const TerrainField& t, const std::vector<std::uint8_t>& existing, std::uint32_t a, std::uint32_t b) {
+  if (existing.empty() || (!existing[a] && !existing[b])) return false;
+  auto near = [&](std::uint32_t cell) {
+    if (existing[cell]) return true;
+    const int col = int(cell % std::uint32_t(t.cols())), row = int(cell / std::uint32_t(t.cols()));
+    for (int dr = -1; dr <= 1; ++dr)
+      for (int dc = -1; dc <= 1; ++dc)
+        if (t.inside(col + dc, row + dr) && existing[t.index(col + dc, row + dr)]) return true;
+    return false;
+  };
+  return near(a) && near(b);
+}
+
 std::vector<std::array<double, 2>> chain_line(const TerrainField& t, const std::vector<std::uint32_t>& cells) {
   std::vector<GridPoint> pts, kept;
   for (std::uint32_t c : cells) pts.push_back(point_of(t, c));
@@ -78,7 +91,7 @@ RoadNetworkLayout network_layout(const TerrainField& t, const std::vector<CellCh
   for (std::size_t r = 0; r < chains.size(); ++r)
     for (std::size_t i = 0; i < chains[r].structures.size(); ++i) {
       const std::uint32_t u = chains[r].cells[i], v = chains[r].cells[i + 1];
-      if (u != v) steps.push_back({std::min(u, v), std::max(u, v), chains[r].structures[i], {r}, !existing.empty() && existing[u] && existing[v]});
+      if (u != v) steps.push_back({std::min(u, v), std::max(u, v), chains[r].structures[i], {r}, on_existing(t, existing, u, v)});
     }
   std::sort(steps.begin(), steps.end(), [](const Edge& x, const Edge& y) { return std::tie(x.a, x.b, x.structure, x.roads[0]) < std::tie(y.a, y.b, y.structure, y.roads[0]); });
   std::vector<Edge> edges;

@@ -50,10 +50,17 @@ struct RoadNetworkLayout {
 
 /// Sections and junctions of the roads' chains (`classes[i]` the class of road i). Deterministic:
 /// sections are numbered in the order of their first edge by cell index. `existing`: per cell 1
-/// on a given road (roads.existing), or empty; a step between two such cells is existing, and a
+/// on a given road (roads.existing), or empty; a step on them (on_existing) is existing, and a
 /// section also breaks where that changes.
 RoadNetworkLayout network_layout(const TerrainField& terrain, const std::vector<CellChain>& chains, const std::vector<RoadClass>& classes,
                                  const std::vector<std::uint8_t>& existing = {});
+
+/// Whether the step between cells `a` and `b` (grid indices) lies on the given roads (`existing`:
+/// per cell 1 on one, roads.existing): one of the two cells is theirs and the other is theirs or
+/// touches one of theirs. The tolerance of one cell absorbs how differently a given line and a
+/// route along it cross the cells (a staircase drawn the other way round); a road one cell beside
+/// a given one, touching none of its cells, is new.
+bool on_existing(const TerrainField& terrain, const std::vector<std::uint8_t>& existing, std::uint32_t a, std::uint32_t b);
 
 /// A chain of cells as a line through their centres in the DEM's CRS, its staircase drawn as
 /// straight runs within half a cell (Douglas-Peucker).

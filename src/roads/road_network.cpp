@@ -126,13 +126,14 @@ class BuiltRoads {
   const std::vector<std::uint32_t>& changes() const { return changes_; }
   bool on_road(std::uint32_t cell) const { return class_[cell] != kNone; }
   bool joined(std::uint32_t a, std::uint32_t b) { return find(a) == find(b); }
-  /// Share of the chain's length (m) on cells already carrying a road at both ends of a step.
+  /// Share of the chain's length (m) on cells already carrying a road at both ends of a step, or
+  /// on the given roads (on_existing).
   double shared_share(const CellChain& chain) const {
-    return share_on(chain, [&](std::uint32_t cell) { return on_road(cell); });
+    return share_on(chain, [&](std::uint32_t a, std::uint32_t b) { return (on_road(a) && on_road(b)) || on_existing(t_, existing_, a, b); });
   }
   /// The same on the given roads only (roads.existing).
   double existing_share(const CellChain& chain) const {
-    return existing_.empty() ? 0 : share_on(chain, [&](std::uint32_t cell) { return existing_[cell] != 0; });
+    return existing_.empty() ? 0 : share_on(chain, [&](std::uint32_t a, std::uint32_t b) { return on_existing(t_, existing_, a, b); });
   }
   /// Adds a given road (roads.existing) before the first link: as a road built, and marked.
   void add_existing(const CellChain& chain, RoadClass c) {
@@ -165,7 +166,7 @@ class BuiltRoads {
     for (std::size_t i = 0; i < chain.structures.size(); ++i) {
       const double l = t_.length_m(point(chain.cells[i]), point(chain.cells[i + 1]));
       total += l;
-      if (on(chain.cells[i]) && on(chain.cells[i + 1])) shared += l;
+      if (on(chain.cells[i], chain.cells[i + 1])) shared += l;
     }
     return total > 0 ? shared / total : 0;
   }

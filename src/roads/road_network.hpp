@@ -63,8 +63,8 @@ struct Road {
   bool over_budget = false;  ///< the search ran out of max_seconds: no geometry, not written
   std::vector<GridPoint> ferry_line;  ///< for maritime links: the straight crossing
   CellChain chain;  ///< the route cell by cell (empty for a ferry): reuse, sections, junctions
-  /// Share of the route's length on the given roads (roads.existing; steps between two of their
-  /// cells): that much of the road exists, the rest is new.
+  /// Share of the route's length on the given roads (roads.existing; its steps on_existing): that
+  /// much of the road exists, the rest is new.
   double existing_share = 0;
 };
 
