@@ -46,7 +46,7 @@ struct RoadOptions {
 
   /// The files these options read (the outputs may not replace them).
   std::vector<std::string> inputs() const {
-    return {scenario().path("/roads/costs"), settings().vegetation, scenario().path("/roads/corridor/side_angles")};
+    return {scenario().path("/roads/costs"), settings().vegetation, scenario().path("/roads/corridor/side_angles"), settings().existing};
   }
 
   /// The schema's roads.corridor options, the side-angle map read onto the DEM's grid.

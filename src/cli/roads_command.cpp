@@ -22,6 +22,17 @@
 namespace terrapolis::cli {
 namespace {
 
+/// "existing roads: 90.1 km given (12 lines, 0 outside the DEM); the roads run 60.2 km on them, 20.3 km new (network drawn once)".
+std::string existing_line(const roads::ExistingRoads& e, const roads::NetworkResult& r) {
+  double given = 0, on = 0, fresh = 0;
+  for (double m : e.length_m) given += m / 1000;
+  for (const roads::NetworkSection& s : r.layout.sections) (s.existing ? on : fresh) += s.length_m / 1000;
+  char line[256];
+  std::snprintf(line, sizeof line, "existing roads: %.1f km given (%zu lines, %zu outside the DEM); the roads run %.1f km on them, %.1f km new (network drawn once)",
+                given, e.lines, e.outside, on, fresh);
+  return line;
+}
+
 class RoadsCommand final : public Command {
  public:
   std::string name() const override { return "roads"; }
@@ -68,10 +79,13 @@ class RoadsCommand final : public Command {
     }
     else context.log.warn("no cities.geojson beside the network: every road is departmental");
 
+    std::optional<roads::ExistingRoads> existing;
+    if (const std::string& lines = options_.settings().existing; !lines.empty()) existing = roads::read_existing_roads(lines, terrain);
+
     const roads::RoadGraph graph(terrain, model, options_.graph());
     const auto t0 = std::chrono::steady_clock::now();
-    roads::NetworkResult result =
-        roads::route_network(terrain, graph, network::road_links(network, cities ? &*cities : nullptr), options_.routing(), context.progress);
+    roads::NetworkResult result = roads::route_network(terrain, graph, network::road_links(network, cities ? &*cities : nullptr), options_.routing(),
+                                                       context.progress, existing ? &*existing : nullptr);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     for (const std::string& f : result.failed) context.log.warn("no road under the cost model for edge " + f + " (left out)");
     for (const std::string& f : result.over_budget) context.log.warn("not routed: budget (--max-seconds) for edge " + f);
@@ -80,7 +94,7 @@ class RoadsCommand final : public Command {
     double corridor_seconds = 0;
     if (corridor_) {
       const auto t1 = std::chrono::steady_clock::now();
-      corridors = roads::road_corridors(terrain, result.roads, corridor);
+      corridors = roads::road_corridors(terrain, result.roads, corridor, result.existing);
       corridor_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
       roads::add_corridor_fields(roads_layer, corridors);
       write_vector((dir / "corridors.geojson").string(), roads::corridors_layer(terrain, corridors));
@@ -90,6 +104,7 @@ class RoadsCommand final : public Command {
     write_vector((dir / "road_sections.geojson").string(), roads::sections_layer(terrain, result.roads));
     write_vector((dir / "sections.geojson").string(), roads::network_sections_layer(terrain, result.layout));
     write_vector((dir / "junctions.geojson").string(), roads::junctions_layer(terrain, result.layout));
+    if (existing) write_vector((dir / "existing_roads.geojson").string(), roads::existing_roads_layer(terrain, *existing));
     options_.write_earthworks(earthworks_path, dem, terrain, result.roads, corridor);
     outputs.commit();
     std::size_t ferries = 0;
@@ -103,6 +118,7 @@ class RoadsCommand final : public Command {
                   result.roads.size(), ferries, result.failed.size(), result.over_budget.size(), result.redundant.size(),
                   result.layout.sections.size(), result.layout.junctions.size(), km, seconds);
     context.log.info(line);
+    if (existing) context.log.info(existing_line(*existing, result));
     if (corridor_) context.log.info("corridors: " + roads::corridor_summary(corridors, corridor_seconds));
   }
 

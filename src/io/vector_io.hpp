@@ -48,4 +48,8 @@ void write_vector(const std::string& path, const VectorLayer& layer, bool overwr
 /// Multi-geometries are split into single features (attributes repeated).
 VectorLayer read_vector(const std::string& path, const Crs& target);
 
+/// Whether the first layer of a vector file declares its CRS (GeoJSON always does: RFC 7946 makes
+/// it WGS 84). Throws bad_input when the file cannot be read.
+bool vector_has_crs(const std::string& path);
+
 }  // namespace terrapolis

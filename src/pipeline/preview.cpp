@@ -185,7 +185,7 @@ void write_preview(const RunState& state, const std::string& path, int width) {
   // replace the per-link roads, which overlap along trunks.
   bool has_sections = false;
   for (const auto& v : state.vectors) has_sections = has_sections || v.first == Style::sections;
-  for (Style pass : {Style::city_extents, Style::streams, Style::network, Style::road_sections, Style::roads, Style::sections,
+  for (Style pass : {Style::city_extents, Style::streams, Style::network, Style::existing_roads, Style::road_sections, Style::roads, Style::sections,
                      Style::junctions, Style::cities}) {
     if (pass == Style::roads && has_sections) continue;
     for (const auto& [style, layer] : state.vectors) {
@@ -209,7 +209,12 @@ void write_preview(const RunState& state, const std::string& path, int width) {
         bool dashed = false;
         if (style == Style::streams) { w = unit * (0.5 + 0.3 * std::atoi(field(layer, f, "strahler").c_str())); }
         else if (style == Style::network) { if (field(layer, f, "kept") != "1") continue; color = hex(0x636363); w = unit * 0.6; dashed = true; }
-        else if (style == Style::roads || style == Style::sections) {
+        else if (style == Style::existing_roads) {
+          const auto& s = roads::style_of(roads::road_class_named(field(layer, f, "class")).value_or(roads::RoadClass::local));
+          color = hex(0x525252);
+          w = unit * (0.6 + 1.3 * s.width_mm);
+        } else if (style == Style::roads || style == Style::sections) {
+          if (style == Style::sections && field(layer, f, "existing") == "1") continue;  // drawn as the existing road under it
           const auto& s = roads::style_of(roads::road_class_named(field(layer, f, "class")).value_or(roads::RoadClass::departmental));
           color = hex(unsigned(std::stoul(std::string(s.colour.substr(1)), nullptr, 16)));
           w = unit * (0.6 + 1.3 * s.width_mm);  // the QGIS widths, scaled to the image
@@ -228,6 +233,7 @@ void write_preview(const RunState& state, const std::string& path, int width) {
       if (pass == Style::streams) legend.push_back({hex(0x2171b5), "streams", true});
       if (pass == Style::network) legend.push_back({hex(0x636363), "network", true});
       if (pass == Style::roads || pass == Style::sections) legend.push_back({hex(0xe31a1c), "roads", true});
+      if (pass == Style::existing_roads) legend.push_back({hex(0x525252), "existing roads", true});
       if (pass == Style::junctions) legend.push_back({hex(0x252525), "junctions", false});
       if (pass == Style::road_sections) legend.push_back({hex(0x08519c), "bridges", true});
       if (pass == Style::cities) legend.push_back({hex(0xcb181d), "cities", false});

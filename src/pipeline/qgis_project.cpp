@@ -145,6 +145,7 @@ int draw_rank(Style s) {
     case Style::streams: return 6;
     case Style::network: return 7;
     case Style::corridors: return 8;
+    case Style::existing_roads: return 8;
     case Style::road_sections: return 8;
     case Style::roads: return 9;
     case Style::sections: return 10;
@@ -235,6 +236,16 @@ std::string qgis_style_body(const OutputFile& o, const RunState& state) {
                                        {"tunnel", "tunnel", line("2", "#8c510a", 1.0, "dash")},
                                        {"ferry", "ferry", line("3", "#a6cee3", 0.6, "dot")}});
     case Style::junctions: return single(marker("0", "#252525", 1.6));
+    case Style::existing_roads: {  // under the new roads: dark grey, as wide as the class
+      std::vector<Category> cats;
+      for (const roads::RoadClassStyle& s : roads::kRoadClasses)
+        if (s.road_class != roads::RoadClass::maritime) {
+          std::string label = "existing ";
+          label += s.label;
+          cats.push_back({std::string(s.name), label, line(std::to_string(cats.size()), "#525252", s.width_mm + 0.4)});
+        }
+      return categorized("class", cats);
+    }
     case Style::corridors: return roads::corridors_renderer();
     case Style::access_minutes:
       return pseudocolor({{15, "#1a9850", "15 min or less"}, {30, "#91cf60", "15-30 min"}, {60, "#fee08b", "30-60 min"},

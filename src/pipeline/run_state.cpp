@@ -14,7 +14,7 @@ constexpr std::pair<Style, const char*> kStyleNames[] = {
     {Style::density, "density"},       {Style::mask, "mask"}, {Style::water, "water"},             {Style::flow_direction, "flow_direction"},
     {Style::accumulation, "accumulation"}, {Style::streams, "streams"},   {Style::cities, "cities"},
     {Style::city_extents, "city_extents"}, {Style::network, "network"},   {Style::roads, "roads"},
-    {Style::road_sections, "road_sections"}, {Style::sections, "sections"}, {Style::junctions, "junctions"},
+    {Style::road_sections, "road_sections"}, {Style::sections, "sections"}, {Style::junctions, "junctions"}, {Style::existing_roads, "existing_roads"},
     {Style::corridors, "corridors"}, {Style::access_minutes, "access_minutes"}};
 }  // namespace
 

@@ -21,6 +21,7 @@
 #include "pipeline/run_state.hpp"
 #include "pipeline/stage_options.hpp"
 #include "pipeline/stages.hpp"
+#include "roads/existing_roads.hpp"
 #include "terrapolis/version.hpp"
 
 namespace terrapolis::pipeline {
@@ -157,6 +158,13 @@ json run_scenario(const Scenario& scenario, const RunOptions& options, Progress&
       check_existing_places(existing, dem.georef().crs);
     } catch (const Error& e) {
       throw Error(e.kind(), scenario.source + ": /sites/existing: " + e.what());
+    }
+  }
+  if (const std::string& lines = settings.roads.existing; !lines.empty()) {
+    try {  // its CRS and geometry now, before any stage (which roads lie on the DEM needs its grid)
+      roads::check_existing_roads(lines, dem.georef().crs);
+    } catch (const Error& e) {
+      throw Error(e.kind(), scenario.source + ": /roads/existing: " + e.what());
     }
   }
   const std::string dem_sha256 = file_sha256(dem_path);
@@ -307,7 +315,17 @@ std::string format_summary(const json& manifest) {
     if (r.contains("network_km"))
       line("           network %.1f km drawn once, %d sections, %d junctions\n", r["network_km"].get<double>(), r.value("sections", 0),
            r.value("junctions", 0));
-    for (const auto& [cls, km] : r["length_km"].items()) line("           %-13s %9.1f km\n", cls.c_str(), km.get<double>());
+    if (r.contains("existing")) {
+      const json& e = r["existing"];
+      line("           existing roads %.1f km given (%d lines, %d outside the DEM); the new links run %.1f km on them, %.1f km new\n",
+           e["total_km"].get<double>(), e["lines"].get<int>(), e["outside_dem"].get<int>(), r["on_existing_km"].get<double>(),
+           r["new_network_km"].get<double>());
+      line("           %-13s %9s %9s %9s   (links; new, drawn once; existing given)\n", "", "links", "new", "existing");
+      for (const auto& [cls, km] : r["length_km"].items())
+        line("           %-13s %9.1f %9.1f %9.1f km\n", cls.c_str(), km.get<double>(), r["new_km"].value(cls, 0.0), e["km"].value(cls, 0.0));
+    } else {
+      for (const auto& [cls, km] : r["length_km"].items()) line("           %-13s %9.1f km\n", cls.c_str(), km.get<double>());
+    }
   }
   if (sum.contains("access")) {
     const json& a = sum["access"];

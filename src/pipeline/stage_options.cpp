@@ -221,6 +221,7 @@ RoadsSettings roads_settings(const Scenario& scenario) {
   s.routing.bezier.threshold = r["bezier_threshold"].get<double>();
   s.routing.bezier.tries = r["bezier_tries"].get<int>();
   s.vegetation = scenario.path("/roads/vegetation");
+  s.existing = scenario.path("/roads/existing");
   s.routing.max_seconds = r["max_seconds"].get<double>();
   for (std::size_t c = 0; c < s.routing.reuse_discount.size(); ++c) {
     const std::string name(roads::name_of(roads::RoadClass(c)));
@@ -321,6 +322,7 @@ StageSettings prepare_stages(const Scenario& scenario) {
     check_file("/roads/corridor/side_angles", s.corridor.side_angles);
     check_file("/water/water_mask", scenario.path("/water/water_mask"));
     check_file("/roads/vegetation", s.roads.vegetation);
+    check_file("/roads/existing", s.roads.existing);
     check_file("/sites/reference", scenario.path("/sites/reference"));
     check_file("/sites/existing", scenario.path("/sites/existing"));
     const json& density = scenario.resolved["density"];

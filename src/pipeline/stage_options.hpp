@@ -69,6 +69,7 @@ struct RoadsSettings {
   roads::CostModel model;
   roads::RoutingOptions routing;
   std::string vegetation;  ///< resolved path, "" for none
+  std::string existing;    ///< roads.existing, resolved path, "" for none
 };
 RoadsSettings roads_settings(const Scenario& scenario);
 

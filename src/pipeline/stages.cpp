@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <optional>
 
 #include "core/error.hpp"
 #include "core/geodesy.hpp"
@@ -16,6 +17,7 @@
 #include "pipeline/places.hpp"
 #include "pipeline/realism.hpp"
 #include "pipeline/stage_options.hpp"
+#include "roads/existing_roads.hpp"
 #include "roads/road_network.hpp"
 #include "roads/terrain_field.hpp"
 #include "sites/layers.hpp"
@@ -328,14 +330,17 @@ void network_load(RunState& s) { s.network = read_vector(saved(s, "network.geojs
 // ---- roads (Galin et al. 2010, Peytavie 2010 ch. 4; Belhadj 2007 Alg. 16; docs/roads.md) ----
 
 /// roads.corridor.enabled: corridors.geojson and the land take and volumes for the summary (null when off).
-json corridor_hook(RunState& s, const roads::TerrainField& terrain, const std::vector<roads::Road>& built) {
+json corridor_hook(RunState& s, const roads::TerrainField& terrain, const std::vector<roads::Road>& built,
+                   const std::vector<std::uint8_t>& existing) {
   CorridorSettings c = s.settings.corridor;
   if (!c.enabled) return nullptr;
   if (!c.side_angles.empty())
     c.options.side_angles_deg = read_resampled(c.side_angles, s.dem.georef(), s.dem.cols(), s.dem.rows(), Resampling::nearest);
-  const roads::Corridors corridors = roads::road_corridors(terrain, built, c.options);
+  const roads::Corridors corridors = roads::road_corridors(terrain, built, c.options, existing);  // the new stretches only
   s.write("roads", "corridors.geojson", roads::corridors_layer(terrain, corridors),
-          "per section the carriageway and earthworks zone (cut, fill), and the land take united", Style::corridors);
+          existing.empty() ? "per section the carriageway and earthworks zone (cut, fill), and the land take united"
+                           : "per section of the new roads off the existing ones the carriageway and earthworks zone (cut, fill), and the land take united",
+          Style::corridors);
   json out = {{"land_take_ha", round_to(corridors.run.land_take_ha, 0.01)}, {"cut_m3", round_to(corridors.run.cut_m3, 1)},
               {"fill_m3", round_to(corridors.run.fill_m3, 1)}};
   if (corridors.vegetation) out["cleared_ha"] = round_to(corridors.run.cleared_ha, 0.01);
@@ -353,6 +358,47 @@ roads::TerrainField road_terrain(const RunState& s) {
                              settings.model.road_radius_m, &lakes);
 }
 
+/// roads.existing read onto the grid (nullopt when not given); its errors name the option.
+std::optional<roads::ExistingRoads> existing_roads(RunState& s, const roads::TerrainField& terrain, const Log& log) {
+  const std::string& path = s.settings.roads.existing;
+  if (path.empty()) return std::nullopt;
+  roads::ExistingRoads e;
+  try {
+    e = roads::read_existing_roads(path, terrain);
+  } catch (const Error& error) {
+    throw Error(error.kind(), "/roads/existing: " + std::string(error.what()));
+  }
+  if (e.outside > 0) log.warn(std::string("roads.existing: ").append(std::to_string(e.outside)).append(" lines outside the DEM left out"));
+  if (e.ferries > 0)
+    log.warn(std::string("roads.existing: ").append(std::to_string(e.ferries)).append(" ferry lines left out (no road on the ground)"));
+  s.write("roads", "existing_roads.geojson", roads::existing_roads_layer(terrain, e),
+          "the given roads (roads.existing) as the run read them: through the cells they cross, with their class", Style::existing_roads);
+  return e;
+}
+
+/// The summary's figures of the given roads and of what is new: the network's sections off them
+/// (drawn once) by class, and those on them.
+json existing_figures(const roads::ExistingRoads& e, const roads::NetworkResult& r) {
+  std::map<std::string, double> new_km;
+  double on_km = 0, new_total = 0;
+  for (const auto& section : r.layout.sections) {
+    if (section.existing) on_km += section.length_m / 1000;
+    else new_km[std::string(roads::name_of(section.road_class))] += section.length_m / 1000, new_total += section.length_m / 1000;
+  }
+  json given = json::object(), built = json::object();
+  double given_total = 0;
+  for (const roads::RoadClassStyle& c : roads::kRoadClasses) {
+    const std::string name(c.name);
+    built[name] = round_to(new_km[name], 0.01);
+    if (c.road_class == roads::RoadClass::maritime) continue;
+    given[name] = round_to(e.length_m[std::size_t(c.road_class)] / 1000, 0.01);
+    given_total += e.length_m[std::size_t(c.road_class)] / 1000;
+  }
+  return {{"existing", {{"lines", e.lines}, {"outside_dem", e.outside}, {"ferries_left_out", e.ferries}, {"km", given},
+                        {"total_km", round_to(given_total, 0.01)}}},
+          {"new_km", built}, {"new_network_km", round_to(new_total, 0.01)}, {"on_existing_km", round_to(on_km, 0.01)}};
+}
+
 void roads_run(RunState& s, Progress& progress, const Log& log) {
   const RoadsSettings& settings = s.settings.roads;
   roads::TerrainField terrain = road_terrain(s);
@@ -361,7 +407,8 @@ void roads_run(RunState& s, Progress& progress, const Log& log) {
   plugin::add_to_terrain(plugin::road_terms(s.plugins, s.dem, progress, log), terrain);
   const roads::RoadGraph graph(terrain, settings.model, settings.routing.graph);
   const std::vector<roads::Link> links = network::road_links(*s.network, &*s.cities);
-  const roads::NetworkResult r = roads::route_network(terrain, graph, links, settings.routing, progress);
+  const std::optional<roads::ExistingRoads> existing = existing_roads(s, terrain, log);
+  const roads::NetworkResult r = roads::route_network(terrain, graph, links, settings.routing, progress, existing ? &*existing : nullptr);
   // Links routed ahead in parallel are routed again when the roads before them change what they saw.
   log.detail(std::to_string(links.size()) + " links, " + std::to_string(r.searches) + " searches");
   for (const auto& f : r.failed) log.warn("no road: " + f);
@@ -381,7 +428,7 @@ void roads_run(RunState& s, Progress& progress, const Log& log) {
             Style::junctions);
   s.write("roads", "road_sections.geojson", roads::sections_layer(terrain, r.roads), "road, bridge, tunnel and ferry sections",
           Style::road_sections);
-  const json corridor = corridor_hook(s, terrain, r.roads);
+  const json corridor = corridor_hook(s, terrain, r.roads, r.existing);
   std::map<std::string, double> km;
   double bridge_m = 0, tunnel_m = 0, over_limit_m = 0, water_m = 0, network_km = 0;
   for (const auto& road : r.roads) {
@@ -400,6 +447,7 @@ void roads_run(RunState& s, Progress& progress, const Log& log) {
                         {"bridge_m", round_to(bridge_m, 0.1)}, {"tunnel_m", round_to(tunnel_m, 0.1)},
                         {"network_km", round_to(network_km, 0.01)}, {"over_grade_limit_m", round_to(over_limit_m, 0.1)},
                         {"on_water_m", round_to(water_m, 0.1)}};
+  if (existing) s.summary["roads"].update(existing_figures(*existing, r));
   if (!corridor.is_null()) s.summary["roads"]["corridor"] = corridor;
 }
 

@@ -364,4 +364,59 @@ Corridors road_corridors(const TerrainField& terrain, const std::vector<Road>& r
   return corridors(terrain, geometries, options, classes);
 }
 
+namespace {
+
+/// The stretches of a road off the given roads: maximal runs of segments not on them (on_existing).
+std::vector<RoadGeometry> new_stretches(const RoadGeometry& road, const TerrainField& t, const std::vector<std::uint8_t>& existing) {
+  auto cell = [&](const GridPoint& p) {
+    const int c = std::clamp(int(std::lround(p.col)), 0, t.cols() - 1), r = std::clamp(int(std::lround(p.row)), 0, t.rows() - 1);
+    return std::uint32_t(t.index(c, r));
+  };
+  std::vector<RoadGeometry> out;
+  RoadGeometry* open = nullptr;
+  for (std::size_t i = 0; i < road.segments.size(); ++i) {
+    if (on_existing(t, existing, cell(road.points[i]), cell(road.points[i + 1]))) {
+      open = nullptr;
+      continue;
+    }
+    if (!open) {
+      open = &out.emplace_back();
+      open->points.push_back(road.points[i]);
+      open->z.push_back(road.z[i]);
+    }
+    open->points.push_back(road.points[i + 1]);
+    open->z.push_back(road.z[i + 1]);
+    open->segments.push_back(road.segments[i]);
+  }
+  return out;
+}
+
+}  // namespace
+
+Corridors road_corridors(const TerrainField& terrain, const std::vector<Road>& roads, const CorridorOptions& options,
+                         const std::vector<std::uint8_t>& existing) {
+  if (existing.empty()) return road_corridors(terrain, roads, options);
+  std::vector<RoadGeometry> stretches;
+  std::vector<std::size_t> road_of;
+  std::vector<RoadClass> classes;
+  for (std::size_t i = 0; i < roads.size(); ++i)
+    for (RoadGeometry& g : new_stretches(roads[i].geometry, terrain, existing)) {
+      stretches.push_back(std::move(g));
+      road_of.push_back(i);
+      classes.push_back(roads[i].road_class);
+    }
+  std::vector<const RoadGeometry*> geometries;
+  for (const RoadGeometry& g : stretches) geometries.push_back(&g);
+  Corridors out = corridors(terrain, geometries, options, classes);
+  std::vector<CorridorTotals> per_road(roads.size());
+  for (std::size_t k = 0; k < out.roads.size(); ++k) add(per_road[road_of[k]], out.roads[k]);
+  std::vector<std::size_t> next_section(roads.size(), 0);
+  for (SectionCorridor& s : out.sections) {
+    s.road = road_of[s.road];
+    s.section = next_section[s.road]++;
+  }
+  out.roads = std::move(per_road);
+  return out;
+}
+
 }  // namespace terrapolis::roads

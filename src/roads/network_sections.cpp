@@ -33,6 +33,7 @@ struct Edge {
   std::uint32_t a = 0, b = 0;  ///< a < b
   Structure structure = Structure::road;
   std::vector<std::size_t> roads;
+  bool existing = false;
   auto key() const { return std::make_tuple(a, b, int(structure)); }
 };
 
@@ -58,7 +59,22 @@ void simplify(const std::vector<GridPoint>& pts, std::size_t i, std::size_t j, d
   }
 }
 
-std::vector<std::array<double, 2>> section_line(const TerrainField& t, const std::vector<std::uint32_t>& cells) {
+}  // namespace
+
+bool on_existing(const TerrainField& t, const std::vector<std::uint8_t>& existing, std::uint32_t a, std::uint32_t b) {
+  if (existing.empty() || (!existing[a] && !existing[b])) return false;
+  auto near = [&](std::uint32_t cell) {
+    if (existing[cell]) return true;
+    const int col = int(cell % std::uint32_t(t.cols())), row = int(cell / std::uint32_t(t.cols()));
+    for (int dr = -1; dr <= 1; ++dr)
+      for (int dc = -1; dc <= 1; ++dc)
+        if (t.inside(col + dc, row + dr) && existing[t.index(col + dc, row + dr)]) return true;
+    return false;
+  };
+  return near(a) && near(b);
+}
+
+std::vector<std::array<double, 2>> chain_line(const TerrainField& t, const std::vector<std::uint32_t>& cells) {
   std::vector<GridPoint> pts, kept;
   for (std::uint32_t c : cells) pts.push_back(point_of(t, c));
   kept.push_back(pts.front());
@@ -68,15 +84,14 @@ std::vector<std::array<double, 2>> section_line(const TerrainField& t, const std
   return out;
 }
 
-}  // namespace
-
-RoadNetworkLayout network_layout(const TerrainField& t, const std::vector<CellChain>& chains, const std::vector<RoadClass>& classes) {
+RoadNetworkLayout network_layout(const TerrainField& t, const std::vector<CellChain>& chains, const std::vector<RoadClass>& classes,
+                                 const std::vector<std::uint8_t>& existing) {
   // Every step of every chain, as an undirected edge with the roads using it.
   std::vector<Edge> steps;
   for (std::size_t r = 0; r < chains.size(); ++r)
     for (std::size_t i = 0; i < chains[r].structures.size(); ++i) {
       const std::uint32_t u = chains[r].cells[i], v = chains[r].cells[i + 1];
-      if (u != v) steps.push_back({std::min(u, v), std::max(u, v), chains[r].structures[i], {r}});
+      if (u != v) steps.push_back({std::min(u, v), std::max(u, v), chains[r].structures[i], {r}, on_existing(t, existing, u, v)});
     }
   std::sort(steps.begin(), steps.end(), [](const Edge& x, const Edge& y) { return std::tie(x.a, x.b, x.structure, x.roads[0]) < std::tie(y.a, y.b, y.structure, y.roads[0]); });
   std::vector<Edge> edges;
@@ -106,7 +121,7 @@ RoadNetworkLayout network_layout(const TerrainField& t, const std::vector<CellCh
     const auto [lo, hi] = incident(node);
     if (hi - lo != 2) return true;
     const Edge &x = edges[lo->second], &y = edges[(lo + 1)->second];
-    return x.structure != y.structure || x.roads != y.roads;
+    return x.structure != y.structure || x.roads != y.roads || x.existing != y.existing;
   };
   auto other_end = [&](std::size_t e, std::uint32_t node) { return edges[e].a == node ? edges[e].b : edges[e].a; };
   auto next_edge = [&](std::uint32_t node, std::size_t e) {  // at a non-breakpoint: the other edge
@@ -115,6 +130,7 @@ RoadNetworkLayout network_layout(const TerrainField& t, const std::vector<CellCh
   };
 
   RoadNetworkLayout layout;
+  layout.with_existing = !existing.empty();
   std::vector<std::size_t> section_of(edges.size(), SIZE_MAX);
   for (std::size_t e0 = 0; e0 < edges.size(); ++e0) {
     if (section_of[e0] != SIZE_MAX) continue;
@@ -130,6 +146,7 @@ RoadNetworkLayout network_layout(const TerrainField& t, const std::vector<CellCh
     NetworkSection s;
     s.roads = edges[e].roads;
     s.structure = edges[e].structure;
+    s.existing = edges[e].existing;
     s.cells.push_back(node);
     const std::size_t id = layout.sections.size();
     while (true) {
@@ -194,11 +211,15 @@ VectorLayer network_sections_layer(const TerrainField& t, const RoadNetworkLayou
   layer.crs = t.georef().crs;
   layer.fields = {{"id", FieldType::integer},     {"roads", FieldType::string},     {"count", FieldType::integer},
                   {"class", FieldType::string},   {"structure", FieldType::string}, {"length_m", FieldType::real}};
+  if (layout.with_existing) layer.fields.push_back({"existing", FieldType::integer});
   for (std::size_t i = 0; i < layout.sections.size(); ++i) {
     const NetworkSection& s = layout.sections[i];
-    layer.features.push_back({{section_line(t, s.cells)},
-                              {std::int64_t(i), id_list(s.roads), std::int64_t(s.roads.size()), std::string(name_of(s.road_class)),
-                               std::string(structure_name(s.structure)), std::round(s.length_m * 100) / 100}});
+    Feature f;
+    f.parts.push_back(chain_line(t, s.cells));
+    f.values = {std::int64_t(i), id_list(s.roads), std::int64_t(s.roads.size()), std::string(name_of(s.road_class)),
+                std::string(structure_name(s.structure)), std::round(s.length_m * 100) / 100};
+    if (layout.with_existing) f.values.push_back(std::int64_t(s.existing ? 1 : 0));
+    layer.features.push_back(std::move(f));
   }
   return layer;
 }

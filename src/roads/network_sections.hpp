@@ -30,6 +30,7 @@ struct NetworkSection {
   RoadClass road_class = RoadClass::local;  ///< the most important class among them
   Structure structure = Structure::road;
   double length_m = 0;
+  bool existing = false;  ///< every step on cells of the given roads (roads.existing): nothing to build
 };
 
 /// A cell where three or more sections meet.
@@ -44,13 +45,29 @@ struct RoadNetworkLayout {
   std::vector<NetworkSection> sections;
   std::vector<Junction> junctions;
   std::vector<std::vector<std::size_t>> road_sections;  ///< per road: its sections in order along it
+  bool with_existing = false;  ///< given roads were in (roads.existing): the layers say what is new
 };
 
 /// Sections and junctions of the roads' chains (`classes[i]` the class of road i). Deterministic:
-/// sections are numbered in the order of their first edge by cell index.
-RoadNetworkLayout network_layout(const TerrainField& terrain, const std::vector<CellChain>& chains, const std::vector<RoadClass>& classes);
+/// sections are numbered in the order of their first edge by cell index. `existing`: per cell 1
+/// on a given road (roads.existing), or empty; a step on them (on_existing) is existing, and a
+/// section also breaks where that changes.
+RoadNetworkLayout network_layout(const TerrainField& terrain, const std::vector<CellChain>& chains, const std::vector<RoadClass>& classes,
+                                 const std::vector<std::uint8_t>& existing = {});
 
-/// The layers: sections (LineString: id, roads "i,j,...", count, class, structure, length_m) and
+/// Whether the step between cells `a` and `b` (grid indices) lies on the given roads (`existing`:
+/// per cell 1 on one, roads.existing): one of the two cells is theirs and the other is theirs or
+/// touches one of theirs. The tolerance of one cell absorbs how differently a given line and a
+/// route along it cross the cells (a staircase drawn the other way round); a road one cell beside
+/// a given one, touching none of its cells, is new.
+bool on_existing(const TerrainField& terrain, const std::vector<std::uint8_t>& existing, std::uint32_t a, std::uint32_t b);
+
+/// A chain of cells as a line through their centres in the DEM's CRS, its staircase drawn as
+/// straight runs within half a cell (Douglas-Peucker).
+std::vector<std::array<double, 2>> chain_line(const TerrainField& terrain, const std::vector<std::uint32_t>& cells);
+
+/// The layers: sections (LineString: id, roads "i,j,...", count, class, structure, length_m, and
+/// `existing` 0/1 when given roads were in) and
 /// junctions (Point: degree, classes "national,local", roads). Road ids are the features' order
 /// in roads.geojson.
 VectorLayer network_sections_layer(const TerrainField& terrain, const RoadNetworkLayout& layout);

@@ -126,16 +126,22 @@ class BuiltRoads {
   const std::vector<std::uint32_t>& changes() const { return changes_; }
   bool on_road(std::uint32_t cell) const { return class_[cell] != kNone; }
   bool joined(std::uint32_t a, std::uint32_t b) { return find(a) == find(b); }
-  /// Share of the chain's length (m) on cells already carrying a road at both ends of a step.
+  /// Share of the chain's length (m) on cells already carrying a road at both ends of a step, or
+  /// on the given roads (on_existing).
   double shared_share(const CellChain& chain) const {
-    double shared = 0, total = 0;
-    for (std::size_t i = 0; i < chain.structures.size(); ++i) {
-      const double l = t_.length_m(point(chain.cells[i]), point(chain.cells[i + 1]));
-      total += l;
-      if (on_road(chain.cells[i]) && on_road(chain.cells[i + 1])) shared += l;
-    }
-    return total > 0 ? shared / total : 0;
+    return share_on(chain, [&](std::uint32_t a, std::uint32_t b) { return (on_road(a) && on_road(b)) || on_existing(t_, existing_, a, b); });
   }
+  /// The same on the given roads only (roads.existing).
+  double existing_share(const CellChain& chain) const {
+    return existing_.empty() ? 0 : share_on(chain, [&](std::uint32_t a, std::uint32_t b) { return on_existing(t_, existing_, a, b); });
+  }
+  /// Adds a given road (roads.existing) before the first link: as a road built, and marked.
+  void add_existing(const CellChain& chain, RoadClass c) {
+    if (existing_.empty()) existing_.assign(t_.size(), 0);
+    for (std::uint32_t cell : chain.cells) existing_[cell] = 1;
+    add(chain, c);
+  }
+  const std::vector<std::uint8_t>& existing() const { return existing_; }
   /// Adds a road: its surface cells become cheaper for the next roads; all its cells are joined.
   void add(const CellChain& chain, RoadClass c) {
     for (std::size_t i = 0; i < chain.structures.size(); ++i) {
@@ -154,6 +160,16 @@ class BuiltRoads {
 
  private:
   static constexpr std::uint8_t kNone = 0xff;
+  template <class On>
+  double share_on(const CellChain& chain, On on) const {
+    double shared = 0, total = 0;
+    for (std::size_t i = 0; i < chain.structures.size(); ++i) {
+      const double l = t_.length_m(point(chain.cells[i]), point(chain.cells[i + 1]));
+      total += l;
+      if (on(chain.cells[i], chain.cells[i + 1])) shared += l;
+    }
+    return total > 0 ? shared / total : 0;
+  }
   GridPoint point(std::uint32_t cell) const { return {double(cell % std::uint32_t(t_.cols())), double(cell / std::uint32_t(t_.cols()))}; }
   std::uint32_t find(std::uint32_t x) {
     while (parent_[x] != x) x = parent_[x] = parent_[parent_[x]];
@@ -169,6 +185,7 @@ class BuiltRoads {
   std::vector<std::uint8_t> class_;
   std::vector<std::uint32_t> parent_;
   std::vector<std::uint32_t> changes_;
+  std::vector<std::uint8_t> existing_;  ///< cells of the given roads (empty: none)
   ArcDiscount view_;
 };
 
@@ -202,7 +219,7 @@ struct Attempt {
 class NetworkRouter {
  public:
   NetworkRouter(const TerrainField& t, const RoadGraph& base, const std::vector<Link>& links, const RoutingOptions& options,
-                Progress& progress)
+                Progress& progress, const ExistingRoads* existing)
       : t_(t), base_(base), links_(links), options_(options), built_(t, options.reuse_discount),
         tile_cols_((std::size_t(t.cols()) >> kShift) + 1), tile_rows_((std::size_t(t.rows()) >> kShift) + 1) {
     // One graph per road class, under the class's design standards, built before routing (the
@@ -235,6 +252,9 @@ class NetworkRouter {
     for (std::size_t a = 0; a < base.surface_arcs(); ++a)
       reach_ = std::max({reach_, std::abs(base.arcs()[a].dcol), std::abs(base.arcs()[a].drow)});
     attempts_.resize(order_.size());
+    // The given roads, built before the first link (in their order: the same state at any thread count).
+    if (existing)
+      for (std::size_t k = 0; k < existing->chains.size(); ++k) built_.add_existing(existing->chains[k], existing->classes[k]);
     step_.emplace(progress, "roads");
   }
 
@@ -264,8 +284,12 @@ class NetworkRouter {
     }
     std::vector<CellChain> chains;
     std::vector<RoadClass> classes;
-    for (const Road& r : result.roads) chains.push_back(r.chain), classes.push_back(r.road_class);
-    result.layout = network_layout(t_, chains, classes);
+    for (Road& r : result.roads) {
+      r.existing_share = built_.existing_share(r.chain);
+      chains.push_back(r.chain), classes.push_back(r.road_class);
+    }
+    result.existing = built_.existing();
+    result.layout = network_layout(t_, chains, classes, result.existing);
     return result;
   }
 
@@ -373,8 +397,8 @@ class NetworkRouter {
 }  // namespace
 
 NetworkResult route_network(const TerrainField& t, const RoadGraph& base, const std::vector<Link>& links, const RoutingOptions& options,
-                            Progress& progress) {
-  NetworkRouter router(t, base, links, options, progress);
+                            Progress& progress, const ExistingRoads* existing) {
+  NetworkRouter router(t, base, links, options, progress, existing);
   return router.run();
 }
 
@@ -400,6 +424,8 @@ VectorLayer roads_layer(const TerrainField& t, const std::vector<Road>& roads, c
                   {"tunnel_m", FieldType::real},      {"grade_limit_pct", FieldType::real}, {"over_limit_m", FieldType::real},
                   {"longest_over_limit_m", FieldType::real}, {"water_m", FieldType::real}, {"tight_corners", FieldType::integer}};
   if (layout) layer.fields.push_back({"sections", FieldType::string});
+  const bool split = layout && layout->with_existing;
+  if (split) layer.fields.insert(layer.fields.end(), {{"new_m", FieldType::real}, {"existing_m", FieldType::real}});
   for (std::size_t i = 0; i < roads.size(); ++i) {
     const Road& r = roads[i];
     Feature f;
@@ -414,6 +440,11 @@ VectorLayer roads_layer(const TerrainField& t, const std::vector<Road>& roads, c
     for (double v : {r.stats.over_limit_m, r.stats.longest_over_limit_m, r.stats.water_m}) f.values.push_back(round_to(v, 0.01));
     f.values.push_back(std::int64_t(r.geometry.tight_corners));
     if (layout) f.values.push_back(id_list(layout->road_sections[i]));
+    if (split) {
+      const double existing_m = round_to(r.stats.length_m * r.existing_share, 0.01);
+      f.values.push_back(round_to(r.stats.length_m, 0.01) - existing_m);
+      f.values.push_back(existing_m);
+    }
     layer.features.push_back(std::move(f));
   }
   return layer;

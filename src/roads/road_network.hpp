@@ -11,6 +11,7 @@
 #include "io/vector_io.hpp"
 #include "roads/anisotropic_search.hpp"
 #include "roads/bezier_router.hpp"
+#include "roads/existing_roads.hpp"
 #include "roads/network_sections.hpp"
 #include "roads/road_class.hpp"
 #include "roads/road_geometry.hpp"
@@ -62,6 +63,9 @@ struct Road {
   bool over_budget = false;  ///< the search ran out of max_seconds: no geometry, not written
   std::vector<GridPoint> ferry_line;  ///< for maritime links: the straight crossing
   CellChain chain;  ///< the route cell by cell (empty for a ferry): reuse, sections, junctions
+  /// Share of the route's length on the given roads (roads.existing; its steps on_existing): that
+  /// much of the road exists, the rest is new.
+  double existing_share = 0;
 };
 
 /// Routes one road between two cells. Ends on water are moved to land (snap_cells); ends on two
@@ -86,19 +90,25 @@ struct Link {
 /// routed ahead in parallel and kept only when the roads added meanwhile change nothing their search
 /// read, else routed again; so the output depends neither on the threads nor on the look-ahead.
 /// Links with no road are reported in `failed` and left out. Roads are listed in link order.
+/// `existing` (roads.existing): roads already built, on the grid before the first link is routed,
+/// as if routed before it with their classes: the links reuse them at their classes' discounts,
+/// a link running on them (and the earlier roads) for redundant_share of its length between ends
+/// they join is dropped, and each road's existing_share says how much of it they carry.
 struct NetworkResult {
   std::vector<Road> roads;
   std::vector<std::string> failed;
   std::vector<std::string> over_budget;  ///< links not routed within roads.max_seconds ("from-to")
   std::vector<std::string> redundant;    ///< links dropped: their route ran on earlier roads ("from-to")
   RoadNetworkLayout layout;              ///< the roads' shared sections and junctions
+  std::vector<std::uint8_t> existing;    ///< per cell 1 on a given road (empty without roads.existing)
   std::size_t searches = 0;              ///< links routed, attempts routed again included (depends on the threads)
 };
 NetworkResult route_network(const TerrainField& terrain, const RoadGraph& graph, const std::vector<Link>& links,
-                            const RoutingOptions& options, Progress& progress);
+                            const RoutingOptions& options, Progress& progress, const ExistingRoads* existing = nullptr);
 
 /// The roads layer (one LineString per road, in the DEM's CRS) and the sections layer.
-/// With `layout`, each road lists its sections' ids (field `sections`).
+/// With `layout`, each road lists its sections' ids (field `sections`), and when given roads were in
+/// (layout->with_existing) its `new_m` and `existing_m` (length_m split by existing_share).
 VectorLayer roads_layer(const TerrainField& terrain, const std::vector<Road>& roads, const RoadNetworkLayout* layout = nullptr);
 VectorLayer sections_layer(const TerrainField& terrain, const std::vector<Road>& roads);
 
