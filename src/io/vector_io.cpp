@@ -136,36 +136,29 @@ void write_vector(const std::string& path, const VectorLayer& layer, bool overwr
   detail::commit_file(tmp, path);
 }
 
-bool vector_has_crs(const std::string& path) {
+namespace {
+
+using DatasetPtr = std::unique_ptr<GDALDataset, void (*)(GDALDataset*)>;
+
+/// The vector file at `path`, read-only, with at least one layer; bad_input naming it otherwise.
+DatasetPtr open_vector(const std::string& path) {
   init_gdal();
   std::error_code ec;
   if (!std::filesystem::exists(path, ec) && path.rfind("/vsi", 0) != 0) throw bad_input(path + ": no such file");
-  GDALDataset* ds = [&] {
+  DatasetPtr ds([&] {
     const detail::QuietGdal quiet;
     return GDALDataset::Open(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY);
-  }();
-  if (!ds || ds->GetLayerCount() == 0) {
-    if (ds) GDALClose(GDALDataset::ToHandle(ds));
-    throw bad_input(path + ": not a vector layer GDAL can read");
-  }
-  const bool has = ds->GetLayer(0)->GetSpatialRef() != nullptr;
-  GDALClose(GDALDataset::ToHandle(ds));
-  return has;
+  }(), [](GDALDataset* d) { if (d) GDALClose(GDALDataset::ToHandle(d)); });
+  if (!ds || ds->GetLayerCount() == 0) throw bad_input(path + ": not a vector layer GDAL can read");
+  return ds;
 }
 
+}  // namespace
+
+bool vector_has_crs(const std::string& path) { return open_vector(path)->GetLayer(0)->GetSpatialRef() != nullptr; }
+
 VectorLayer read_vector(const std::string& path, const Crs& target) {
-  init_gdal();
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec) && path.rfind("/vsi", 0) != 0) throw bad_input(path + ": no such file");
-  GDALDataset* ds = [&] {
-    const detail::QuietGdal quiet;
-    return GDALDataset::Open(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY);
-  }();
-  if (!ds || ds->GetLayerCount() == 0) {
-    if (ds) GDALClose(GDALDataset::ToHandle(ds));
-    throw bad_input(path + ": not a vector layer GDAL can read");
-  }
-  std::unique_ptr<GDALDataset, void (*)(GDALDataset*)> guard(ds, [](GDALDataset* d) { GDALClose(GDALDataset::ToHandle(d)); });
+  const DatasetPtr ds = open_vector(path);
   OGRLayer* in = ds->GetLayer(0);
   VectorLayer layer;
   layer.name = in->GetName();
