@@ -133,21 +133,35 @@ def cell_of(path, lonlat):
     return (b, c, r) if 0 <= c < b.RasterXSize and 0 <= r < b.RasterYSize else None
 
 
-def near_buildable(buildable, lonlat):
-    """True when a buildable cell lies within two cells of (lon, lat): a place sites.existing takes."""
-    cell = cell_of(buildable, lonlat)
-    if cell is None:
-        return False
-    b, c, r = cell
-    c0, r0 = max(0, c - 2), max(0, r - 2)
-    window = b.ReadAsArray(c0, r0, min(b.RasterXSize, c + 3) - c0, min(b.RasterYSize, r + 3) - r0)
-    return bool((window == 1).any())
+def takeable(buildable, places):
+    """The places sites.existing takes, as it takes them (src/pipeline/places.cpp): largest first,
+    each on its cell or the nearest free buildable one within two cells; a place with none (on
+    nodata, in a lake, or every cell near it held by a larger place) is left out."""
+    from osgeo import gdal
+    b = gdal.Open(buildable)
+    grid = b.ReadAsArray() == 1
+    rows, cols = grid.shape
+    taken = set()
+    out = []
+    for f in sorted(places, key=lambda f: -f["properties"]["population"]):
+        cell = cell_of(buildable, f["geometry"]["coordinates"])
+        if cell is None:
+            continue
+        _, c0, r0 = cell
+        free = [((c - c0) ** 2 + (r - r0) ** 2, r, c) for r in range(r0 - 2, r0 + 3) for c in range(c0 - 2, c0 + 3)
+                if 0 <= r < rows and 0 <= c < cols and grid[r, c] and (c, r) not in taken]
+        if free:
+            best = min(free, key=lambda t: t[0])  # the first nearest in row order, as places.cpp scans
+            best = next(t for t in free if t[0] == best[0])
+            taken.add((best[2], best[1]))
+            out.append(f)
+    return out
 
 
 def split(places_path, buildable, given_path, hidden_path):
-    """The places a run takes (a buildable cell within two cells), the largest half given, the rest hidden."""
+    """The places a run takes (takeable), the largest half given, the rest hidden."""
     places = [f for f in json.load(open(places_path))["features"] if (f["properties"].get("population") or 0) >= 1]
-    places = [f for f in places if near_buildable(buildable, f["geometry"]["coordinates"])]
+    places = takeable(buildable, places)
     places.sort(key=lambda f: -f["properties"]["population"])
     half = (len(places) + 1) // 2
     for path, part in ((given_path, places[:half]), (hidden_path, places[half:])):

@@ -168,6 +168,7 @@ sites::SitesOptions sites_options(const Scenario& scenario) {
   o.zipf_exponent = s["zipf_exponent"].get<double>();
   o.min_population = s["min_population"].get<double>();
   o.spacing_km = s["spacing_km"].get<double>();
+  o.min_distance_share = s["min_distance_share"].get<double>();
   o.area_exponent = s["area_exponent"].get<double>();
   o.town_density_per_km2 = s["town_density_per_km2"].get<double>();
   o.influence_factor = s["influence_factor"].get<double>();

@@ -131,6 +131,15 @@ std::vector<std::uint8_t> covered_cells(const std::vector<Site>& sites, const Gr
   return covered;
 }
 
+/// Places left for new settlements out of `room`: those the existing places do not take, and at
+/// least the new people's share of the room (where more places are given than the lattice
+/// holds, the given places show the land holds more).
+std::size_t free_room(std::size_t room, double to_place, const SitesResult& result, const SitesOptions& options) {
+  const std::size_t left = room - std::min(room, options.existing.size());
+  if (!(to_place > 0) || !(result.settled_population > 0)) return left;
+  return std::max(left, std::size_t(std::ceil(double(room) * to_place / result.settled_population)));
+}
+
 /// The rank_size quotas: the region's people (the figure given, else the default density times
 /// the land area), the settled share of them split by the rank-size law (its exponent given, or
 /// read from the catchments of a first placement), at most as many places as the land holds.
@@ -149,8 +158,13 @@ QuotaTable rank_size_table(const Raster<float>& density, const Raster<std::uint8
   result.target_population = result.population_assumed ? std::round(options.people_per_km2 * land_km2) : options.population;
   result.settled_population = std::round(options.urban_share * result.target_population);
   result.sizes_exponent = options.zipf_exponent;
-  // Existing settlements hold their people: the law splits the rest over the places still free.
-  for (const Site& e : options.existing) result.existing_population += double(e.population);
+  // Existing settlements hold their people and the law's first ranks: the rest are its tail, the
+  // ranks below the existing places of min_population or more, over the places still free.
+  std::size_t first_rank = 1;
+  for (const Site& e : options.existing) {
+    result.existing_population += double(e.population);
+    if (double(e.population) >= options.min_population) ++first_rank;
+  }
   double to_place = std::max(0.0, result.settled_population - result.existing_population);
   if (options.growth > 0) {
     // Growth scenario: the existing places are today's settled people; the region grows by
@@ -162,8 +176,7 @@ QuotaTable rank_size_table(const Raster<float>& density, const Raster<std::uint8
     to_place = std::round(options.growth_new_share * double(result.growth_people));
   }
   const std::size_t full_room = settleable_count(land_km2, options, result.target_population);
-  const std::size_t room = full_room == std::numeric_limits<std::size_t>::max() ? full_room
-                                                                                : full_room - std::min(full_room, options.existing.size());
+  const std::size_t room = full_room == std::numeric_limits<std::size_t>::max() ? full_room : free_room(full_room, to_place, result, options);
   std::vector<std::int64_t> sizes;
   if (options.sizes == SitesOptions::Sizes::catchment) {
     // The central places of all the region's people by the law, their catchments on the
@@ -176,6 +189,7 @@ QuotaTable rank_size_table(const Raster<float>& density, const Raster<std::uint8
     pilot.land_area_km2 = land_km2;
     pilot.existing.clear();
     pilot.growth = 0;
+    pilot.min_distance_share = 0;  // the catchments of the densest sites, unspaced, give the sizes their spread
     const SitesResult central = place_sites(density, buildable, pilot, progress);
     result.room = central.room;
     result.count_limited = central.count_limited;
@@ -184,14 +198,14 @@ QuotaTable rank_size_table(const Raster<float>& density, const Raster<std::uint8
       if (p >= options.min_population) settled.push_back(p);
     const double q = rank_size_exponent(settled);
     if (std::isfinite(q)) result.sizes_exponent = q;  // fewer than 3 catchments that large: zipf_exponent
-    const std::size_t free = central.sites.size() - std::min(central.sites.size(), options.existing.size());
+    const std::size_t free = free_room(central.sites.size(), to_place, result, options);
     if (options.existing.empty()) sizes = rank_size_split(to_place, result.sizes_exponent, free);
-    else if (to_place > 0)  // the rest over the free places, none below min_population
-      sizes = rank_size_populations(to_place, result.sizes_exponent, options.min_population, free);
+    else if (to_place > 0)  // the law's tail over the free places, none below min_population
+      sizes = rank_size_populations(to_place, result.sizes_exponent, options.min_population, free, first_rank);
     sizes.erase(std::find(sizes.begin(), sizes.end(), 0), sizes.end());  // more places than settled people
   } else {
     const auto law = [&](std::size_t max_count) {
-      return rank_size_populations(to_place, options.zipf_exponent, options.min_population, max_count);
+      return rank_size_populations(to_place, options.zipf_exponent, options.min_population, max_count, first_rank);
     };
     sizes = law(room);
     if (room != std::numeric_limits<std::size_t>::max()) {
@@ -199,6 +213,9 @@ QuotaTable rank_size_table(const Raster<float>& density, const Raster<std::uint8
       result.count_limited = sizes.size() == room && law(room + 1).size() > room;
     }
   }
+  // People of the law's tail too few for one settlement of min_population: reported, not lost.
+  if (!options.existing.empty() && options.growth == 0)
+    result.unplaced_people += std::llround(to_place) - std::accumulate(sizes.begin(), sizes.end(), std::int64_t(0));
   QuotaTable table = rank_size_quotas(cell_size, sizes, options);
   return table;
 }
@@ -230,6 +247,46 @@ std::vector<std::uint32_t> draw_candidates(const Raster<float>& density, const s
   return pool;
 }
 
+/// The centres placed so far, bucketed on a grid of blocks at least `metres` wide, for the test
+/// that a new centre keeps `metres` from every one of them.
+class Spacing {
+ public:
+  Spacing(double metres, const GridDistance& distance) : metres_(metres), distance_(distance) {
+    if (!(metres_ > 0)) return;
+    const CellMetrics& m = distance.metrics();
+    const double width = *std::min_element(m.width_m.begin(), m.width_m.end());
+    const double height = *std::min_element(m.height_m.begin(), m.height_m.end());
+    block_cols_ = std::max(1, int(std::ceil(metres_ / std::max(width, 1e-9))));
+    block_rows_ = std::max(1, int(std::ceil(metres_ / std::max(height, 1e-9))));
+  }
+
+  void add(int c, int r) {
+    if (metres_ > 0) blocks_[key(c / block_cols_, r / block_rows_)].push_back({c, r});
+  }
+
+  bool too_close(int c, int r) const {
+    if (!(metres_ > 0)) return false;
+    const int bc = c / block_cols_, br = r / block_rows_;
+    for (int dr = -1; dr <= 1; ++dr)
+      for (int dc = -1; dc <= 1; ++dc) {
+        const auto it = blocks_.find(key(bc + dc, br + dr));
+        if (it == blocks_.end()) continue;
+        for (const auto& [pc, pr] : it->second)
+          if (distance_(c, r, pc, pr) < metres_) return true;
+      }
+    return false;
+  }
+
+ private:
+  std::uint64_t key(int bc, int br) const {
+    return (std::uint64_t(std::uint32_t(br + 1)) << 32) | std::uint32_t(bc + 1);  // blocks -1.. of the edges
+  }
+  double metres_;
+  const GridDistance& distance_;
+  int block_cols_ = 1, block_rows_ = 1;
+  std::unordered_map<std::uint64_t, std::vector<std::pair<int, int>>> blocks_;
+};
+
 /// Growth (Algorithm 14) over the candidates in density order, resumable: each call goes on from
 /// the first candidate not reached yet.
 class Growth {
@@ -238,8 +295,15 @@ class Growth {
   Growth(const Raster<float>& density, const std::vector<std::uint8_t>& habitable, std::vector<std::uint32_t> pool,
          std::vector<double> radius, const SitesOptions& options, const GridDistance& distance)
       : density_(density), pool_(std::move(pool)), radius_(std::move(radius)), options_(options), cols_(density.cols()),
-        tester_(habitable, density.cols(), density.rows(), distance) {
+        distance_(distance), tester_(habitable, density.cols(), density.rows(), distance) {
     if (options.disc_test == SitesOptions::DiscTest::exact) tester_.build_row_pass();
+  }
+
+  /// Central-place spacing: no new centre closer than `metres` to another centre, `fixed` (the
+  /// existing places) included; 0: the discs alone keep them apart.
+  void keep_apart(double metres, const std::vector<Site>& fixed) {
+    min_distance_m_ = metres;
+    fixed_ = &fixed;
   }
 
   bool candidates_left() const { return next_ < pool_.size(); }
@@ -271,6 +335,10 @@ class Growth {
     const int n = int(radius_.size());
     int remaining = std::accumulate(quota.begin(), quota.end(), 0);
     std::vector<int> limit;
+    Spacing spacing(min_distance_m_, distance_);
+    if (fixed_)
+      for (const Site& s : *fixed_) spacing.add(s.col, s.row);
+    for (const Site& s : out) spacing.add(s.col, s.row);
     const std::size_t batch = 4096;
     while (next_ < m && remaining > 0) {
       const std::size_t begin = next_, end = std::min(m, begin + batch);
@@ -283,10 +351,13 @@ class Growth {
         int j = limit[k - begin] - 1;
         while (j >= 0 && quota[std::size_t(j)] == 0) --j;  // the largest valid class with quota left
         if (j < 0) continue;                                 // supprimer(L_sites, S)
+        const int c = int(pool_[k] % std::uint32_t(cols_)), r = int(pool_[k] / std::uint32_t(cols_));
+        if (spacing.too_close(c, r)) continue;
         --quota[std::size_t(j)];
         --remaining;
         ++table.classes[std::size_t(n - 1 - j)].placed;
         out.push_back(site_at(k, j));
+        spacing.add(c, r);
       }
       step.update(double(next_) / double(m));
     }
@@ -336,7 +407,10 @@ class Growth {
   const std::vector<double> radius_;
   const SitesOptions& options_;
   const int cols_;
+  const GridDistance& distance_;
   DiscTester tester_;
+  double min_distance_m_ = 0;
+  const std::vector<Site>* fixed_ = nullptr;
   std::size_t next_ = 0;
   std::unordered_map<std::uint32_t, std::size_t> rank_of_;  // candidate cell -> position in density order
 };
@@ -425,6 +499,11 @@ SitesResult place_sites(const Raster<float>& density, const Raster<std::uint8_t>
   std::vector<Site> existing = options.existing;
   for (Site& e : existing) e.radius_m = urban_radius_m(double(e.population) * (1 + options.growth), options);
   const std::vector<std::uint8_t> occupied = existing.empty() ? std::vector<std::uint8_t>() : covered_cells(existing, distance, cols, rows);
+  if (options.quotas == SitesOptions::Quotas::rank_size && options.min_distance_share > 0 && result.land_area_km2 > 0) {
+    // The mean spacing of the region's places spread evenly, sqrt(land / count), times the share.
+    const double count = double(table.total() + existing.size());
+    growth.keep_apart(options.min_distance_share * std::sqrt(result.land_area_km2 * 1e6 / std::max(1.0, count)), existing);
+  }
   std::vector<Site> placed;
   {
     ProgressStep step(progress, "sites: growth");

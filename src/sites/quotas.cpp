@@ -65,6 +65,8 @@ void check_settings(const SitesOptions& o) {
   if (!(std::isfinite(o.urban_share) && o.urban_share > 0 && o.urban_share <= 1)) throw bad_input("/sites/urban_share: must lie in (0, 1]");
   if (!(std::isfinite(o.min_population) && o.min_population >= 1)) throw bad_input("/sites/min_population: must be at least 1 person");
   if (!(std::isfinite(o.spacing_km) && o.spacing_km >= 0)) throw bad_input("/sites/spacing_km: must be >= 0 (0: no limit)");
+  if (!(std::isfinite(o.min_distance_share) && o.min_distance_share >= 0 && o.min_distance_share <= 2))
+    throw bad_input("/sites/min_distance_share: must lie in [0, 2] (0: none)");
   if (!(std::isfinite(o.area_exponent) && o.area_exponent > 0 && o.area_exponent <= 1.5))
     throw bad_input("/sites/area_exponent: must lie in (0, 1.5]");
 }

@@ -11,23 +11,26 @@
 
 namespace terrapolis::sites {
 
-std::vector<std::int64_t> rank_size_populations(double total, double q, double min_population, std::size_t max_count) {
+std::vector<std::int64_t> rank_size_populations(double total, double q, double min_population, std::size_t max_count,
+                                                std::size_t first_rank) {
   if (!(std::isfinite(total) && total >= 0)) throw bad_input("sites: population must be a number of people >= 0");
   if (!(std::isfinite(q) && q > 0)) throw bad_input("sites: zipf_exponent must be positive");
   if (!(std::isfinite(min_population) && min_population >= 1)) throw bad_input("sites: min_population must be at least 1 person");
   total = std::round(total);
-  // g(N) = total N^-q / H_N(q), the N-th size of the law over N ranks, decreases with N: the
-  // count is the last N with g(N) >= min_population.
+  if (first_rank < 1) throw bad_input("sites: the rank-size law's first rank is 1");
+  // g(N) = total k_N^-q / sum_{k <= k_N} k^-q (k from first_rank), the N-th size of the law over N
+  // ranks, decreases with N: the count is the last N with g(N) >= min_population.
   double harmonic = 0;
   std::size_t count = 0;
   for (std::size_t n = 1; n <= max_count; ++n) {
-    const double h = harmonic + std::pow(double(n), -q);
-    if (total * std::pow(double(n), -q) / h < min_population) break;
+    const double term = std::pow(double(first_rank + n - 1), -q);
+    const double h = harmonic + term;
+    if (total * term / h < min_population) break;
     harmonic = h;
     count = n;
     if (count > 50000000) throw bad_input("sites: the rank-size law gives more than 5x10^7 settlements; raise min_population");
   }
-  return rank_size_split(total, q, count);
+  return rank_size_split(total, q, count, first_rank);
 }
 
 namespace {
@@ -57,12 +60,12 @@ std::vector<std::int64_t> largest_remainders(double total, const std::vector<dou
 
 }  // namespace
 
-std::vector<std::int64_t> rank_size_split(double total, double q, std::size_t count) {
+std::vector<std::int64_t> rank_size_split(double total, double q, std::size_t count, std::size_t first_rank) {
   if (!(std::isfinite(total) && total >= 0)) throw bad_input("sites: population must be a number of people >= 0");
   if (!(std::isfinite(q) && q >= 0)) throw bad_input("sites: a rank-size exponent must be >= 0");
   if (count == 0) return {};
   std::vector<double> weights(count);
-  for (std::size_t k = 0; k < count; ++k) weights[k] = std::pow(double(k + 1), -q);
+  for (std::size_t k = 0; k < count; ++k) weights[k] = std::pow(double(first_rank + k), -q);
   std::vector<std::int64_t> sizes = largest_remainders(std::round(total), weights);
   // Equal shares can leave a later rank one person above an earlier one: keep the order.
   std::sort(sizes.begin(), sizes.end(), std::greater<>());

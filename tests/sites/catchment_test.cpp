@@ -80,6 +80,7 @@ TEST(SettlementCatchment, SizesFollowTheCatchmentsExponent) {
   pilot.sizes = SitesOptions::Sizes::rank_size;
   pilot.urban_share = 1;
   pilot.influence_factor = 0;
+  pilot.min_distance_share = 0;  // the first placement is unspaced
   const SitesResult central = place_sites(g.density, g.buildable, pilot, progress);
   std::vector<double> large;
   for (double p : catchment_people(g.density, g.buildable, central.sites, 110000))

@@ -3,7 +3,9 @@
 // SPDX-License-Identifier: MIT
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <numeric>
 
@@ -352,4 +354,64 @@ TEST(RankSize, DenseRegionsHoldMorePlaces) {
   EXPECT_EQ(settleable_count(1000, o, 100 * 1000.0), 23u);
   EXPECT_EQ(settleable_count(1000, o, 1500 * 1000.0), 23u);
   EXPECT_EQ(settleable_count(1000, o, 6000 * 1000.0), 94u);  // 1000 / (42.435 / 4) = 94.3
+}
+
+// The law's tail from rank 2 (one existing place above): 3000 people, q = 1. N = 2: 3000 x (1/3) /
+// (1/2 + 1/3) = 1200 >= 1000; N = 3: 3000 x (1/4) / (13/12) = 692 < 1000. So 1800 and 1200.
+TEST(RankSize, TailOfTheLawBelowExistingPlaces) {
+  EXPECT_EQ(rank_size_populations(3000, 1.0, 1000, std::numeric_limits<std::size_t>::max(), 2),
+            (std::vector<std::int64_t>{1800, 1200}));
+  EXPECT_EQ(rank_size_populations(3000, 1.0, 1000, std::numeric_limits<std::size_t>::max(), 1), rank_size_populations(3000, 1.0, 1000));
+  EXPECT_THROW(rank_size_populations(3000, 1.0, 1000, 10, 0), Error);
+}
+
+// Three places of 20,000, 8,000 and 3,000 given, 40,000 people: the 9,000 left are the law's ranks 4
+// on (9000 x (1/4) / (1/4 + ... + 1/9) = 2260 down to 1004 at rank 9; rank 10 would hold 821), all
+// below the smallest given place, placed, and adding up.
+TEST(RankSize, NewPlacesTakeTheRanksBelowTheGivenOnes) {
+  SilentProgress progress;
+  const auto flat = fixtures::flat_scenario(200, 200, 100.0);
+  SitesOptions o = fixed_law();
+  o.population = 40000;
+  o.existing = three_places(flat.density);
+  const SitesResult r = place_sites(flat.density, flat.buildable, o, progress);
+  std::vector<std::int64_t> created;
+  for (const Site& s : r.sites)
+    if (!s.existing) created.push_back(s.population);
+  std::sort(created.begin(), created.end(), std::greater<>());
+  EXPECT_EQ(created, rank_size_populations(9000, 1.0, 1000, std::numeric_limits<std::size_t>::max(), 4));
+  ASSERT_EQ(created.size(), 6u);
+  EXPECT_EQ(created.front(), 2260);
+  EXPECT_EQ(std::accumulate(created.begin(), created.end(), std::int64_t(0)), 9000);
+  EXPECT_EQ(r.unplaced_people, 0);
+}
+
+// Density peaking at the centre of a flat 20 km x 20 km region: without the spacing rule the
+// densest candidates, all near the peak, become the towns; with it no two centres are closer than
+// min_distance_share x sqrt(400 km2 / settlements).
+TEST(RankSize, CentresKeepTheCentralPlaceSpacing) {
+  SilentProgress progress;
+  auto peak = fixtures::flat_scenario(200, 200, 100.0);
+  for (int r = 0; r < 200; ++r)
+    for (int c = 0; c < 200; ++c) peak.density(c, r) = float(1.0 / (1.0 + std::hypot(c - 100.0, r - 100.0) / 20.0));
+  SitesOptions o = fixed_law();
+  o.population = 60000;
+  o.spacing_km = 0;
+  const GridDistance distance(peak.density.georef(), 200, 200);
+  const auto closest = [&](const SitesResult& r) {
+    double best = std::numeric_limits<double>::infinity();
+    for (std::size_t a = 0; a < r.sites.size(); ++a)
+      for (std::size_t b = a + 1; b < r.sites.size(); ++b)
+        best = std::min(best, distance(r.sites[a].col, r.sites[a].row, r.sites[b].col, r.sites[b].row));
+    return best;
+  };
+  o.min_distance_share = 0.5;
+  const SitesResult spaced = place_sites(peak.density, peak.buildable, o, progress);
+  ASSERT_EQ(spaced.crowded, 0);
+  const double metres = 0.5 * std::sqrt(400e6 / double(spaced.sites.size()));
+  EXPECT_GE(closest(spaced), metres);
+  o.min_distance_share = 0;
+  const SitesResult packed = place_sites(peak.density, peak.buildable, o, progress);
+  EXPECT_EQ(packed.sites.size(), spaced.sites.size());
+  EXPECT_LT(closest(packed), 0.5 * metres);
 }
