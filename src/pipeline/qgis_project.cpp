@@ -59,11 +59,16 @@ std::string num(double v) {
   return s.str();
 }
 
-std::string pseudocolor(const std::vector<Stop>& stops, const char* type = "INTERPOLATED", double opacity = 1.0) {
+/// `clear_zero`: cells of value 0 drawn transparent (the density on water and unbuildable land,
+/// so the terrain's sea shows through, as in the preview).
+std::string pseudocolor(const std::vector<Stop>& stops, const char* type = "INTERPOLATED", double opacity = 1.0, bool clear_zero = false) {
   std::ostringstream x;
   x << "<pipe><rasterrenderer type=\"singlebandpseudocolor\" band=\"1\" opacity=\"" << num(opacity)
-    << "\" alphaBand=\"-1\" classificationMin=\"" << num(stops.front().value) << "\" classificationMax=\"" << num(stops.back().value)
-    << "\"><rastershader><colorrampshader colorRampType=\"" << type << "\" classificationMode=\"1\" clip=\"0\">";
+    << "\" alphaBand=\"-1\" classificationMin=\"" << num(stops.front().value) << "\" classificationMax=\"" << num(stops.back().value) << "\">";
+  if (clear_zero)
+    x << "<rasterTransparency><singleValuePixelList><pixelListEntry min=\"0\" max=\"0\" percentTransparent=\"100\"/>"
+         "</singleValuePixelList></rasterTransparency>";
+  x << "<rastershader><colorrampshader colorRampType=\"" << type << "\" classificationMode=\"1\" clip=\"0\">";
   for (const auto& s : stops)
     x << "<item alpha=\"255\" value=\"" << num(s.value) << "\" label=\"" << escape(s.label) << "\" color=\"" << s.color << "\"/>";
   x << "</colorrampshader></rastershader></rasterrenderer><brightnesscontrast brightness=\"0\" contrast=\"0\"/>"
@@ -169,13 +174,13 @@ std::string qgis_style_body(const OutputFile& o, const RunState& state) {
   switch (o.style) {
     case Style::elevation: {
       const double lo = state.summary["terrain"]["min_m"].get<double>(), hi = state.summary["terrain"]["max_m"].get<double>();
+      // Cells at or below the sea level are water (water.sea_level_m; SRTM seas are exactly 0 m): blue.
+      const double sea = state.scenario.resolved["water"]["sea_level_m"].get<double>();
       std::vector<Stop> stops;
-      if (lo < 0) {
-        stops.push_back({lo, "#08306b", num(lo) + " m"});
-        stops.push_back({std::min(0.0, hi) - 1e-3, "#9ecae1", "sea level"});
-      }
-      const double base = std::max(lo, 0.0), top = std::max(hi, base + 1);
-      stops.push_back({base, "#1a9641", num(base) + " m"});
+      if (lo < sea) stops.push_back({lo, "#08306b", num(lo) + " m"});
+      if (lo <= sea) stops.push_back({std::min(sea, hi), "#9ecae1", "sea level"});
+      const double base = lo <= sea ? std::min(sea, hi) + 1e-3 : lo, top = std::max(hi, base + 1);
+      stops.push_back({base, "#1a9641", num(lo <= sea ? std::min(sea, hi) : lo) + " m"});
       stops.push_back({base + 0.25 * (top - base), "#a6d96a", ""});
       stops.push_back({base + 0.5 * (top - base), "#ffffbf", ""});
       stops.push_back({base + 0.75 * (top - base), "#c08040", ""});
@@ -187,7 +192,7 @@ std::string qgis_style_body(const OutputFile& o, const RunState& state) {
       return pseudocolor({{0, "#440154", "0"}, {0.25, "#3b528b", ""}, {0.5, "#21918c", ""}, {0.75, "#5ec962", ""}, {1, "#fde725", "1"}});
     case Style::density:
       return pseudocolor({{0, "#ffffb2", "0 (empty)"}, {0.25, "#fecc5c", ""}, {0.5, "#fd8d3c", ""}, {0.75, "#f03b20", ""}, {1, "#bd0026", "1 (most attractive)"}},
-                         "INTERPOLATED", 0.7);
+                         "INTERPOLATED", 0.7, true);
     case Style::mask: return paletted({{0, "#000000", "not buildable"}, {1, "#4daf4a", "buildable"}}, 0.4);
     case Style::water: return paletted({{0, "#000000", "land"}, {1, "#2171b5", "inland water"}}, 0.8);
     case Style::flow_direction:

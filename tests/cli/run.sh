@@ -77,6 +77,12 @@ expect_fail 2 "other 'density' parameters; rerun from density" "$TP" run -o reru
 cp -r run1 grass
 "$TP" --quiet run -o grass --only hydro --set hydro.d8_codes=grass
 grep -q 'value="8" color="#e41a1c" alpha="255" label="E"' grass/flowdir.qml || fail "flowdir.qml does not use the GRASS codes"
+# Water looks like water in QGIS: the density is transparent where it is 0 (the sea, as in the
+# preview) and the terrain is blue up to the sea level (water.sea_level_m).
+grep -q '<pixelListEntry min="0" max="0" percentTransparent="100"/>' run1/density.qml || fail "density.qml draws the sea"
+grep -q 'value="0" label="sea level" color="#9ecae1"' run1/elevation.qml || fail "elevation.qml: no sea level"
+"$TP" --quiet run -o sea50 --until terrain --set water.sea_level_m=50
+grep -q 'value="50" label="sea level" color="#9ecae1"' sea50/elevation.qml || fail "elevation.qml ignores water.sea_level_m"
 expect_fail 2 "other 'density' parameters" "$TP" run -o rerun --only hydro roads --set density.r_max_m=6000
 # A run that stopped early (--until) can rerun its last stage: the stages it never made stay absent.
 "$TP" --quiet run -o short --until sites
