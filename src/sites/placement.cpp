@@ -247,41 +247,40 @@ std::vector<std::uint32_t> draw_candidates(const Raster<float>& density, const s
   return pool;
 }
 
-/// The centres placed so far, bucketed on a grid of blocks at least `metres` wide, for the test
-/// that a new centre keeps `metres` from every one of them.
+/// The centres placed so far, bucketed on a grid of blocks at least `block_metres` wide, for the
+/// test that a new centre keeps a distance (of `block_metres` or more) from every one of them.
 class Spacing {
  public:
-  Spacing(double metres, const GridDistance& distance) : metres_(metres), distance_(distance) {
-    if (!(metres_ > 0)) return;
+  Spacing(double block_metres, const GridDistance& distance) : block_metres_(block_metres), distance_(distance) {
+    if (!(block_metres_ > 0)) return;
     const CellMetrics& m = distance.metrics();
     const double width = *std::min_element(m.width_m.begin(), m.width_m.end());
     const double height = *std::min_element(m.height_m.begin(), m.height_m.end());
-    block_cols_ = std::max(1, int(std::ceil(metres_ / std::max(width, 1e-9))));
-    block_rows_ = std::max(1, int(std::ceil(metres_ / std::max(height, 1e-9))));
+    block_cols_ = std::max(1, int(std::ceil(block_metres_ / std::max(width, 1e-9))));
+    block_rows_ = std::max(1, int(std::ceil(block_metres_ / std::max(height, 1e-9))));
   }
 
   void add(int c, int r) {
-    if (metres_ > 0) blocks_[key(c / block_cols_, r / block_rows_)].push_back({c, r});
+    if (block_metres_ > 0) blocks_[key(c / block_cols_, r / block_rows_)].push_back({c, r});
   }
 
-  bool too_close(int c, int r) const {
-    if (!(metres_ > 0)) return false;
+  bool too_close(int c, int r, double metres) const {
+    if (!(block_metres_ > 0) || blocks_.empty()) return false;
     const int bc = c / block_cols_, br = r / block_rows_;
-    for (int dr = -1; dr <= 1; ++dr)
-      for (int dc = -1; dc <= 1; ++dc) {
+    const int reach = int(std::ceil(metres / block_metres_ - 1e-9));
+    for (int dr = -reach; dr <= reach; ++dr)
+      for (int dc = -reach; dc <= reach; ++dc) {
         const auto it = blocks_.find(key(bc + dc, br + dr));
         if (it == blocks_.end()) continue;
         for (const auto& [pc, pr] : it->second)
-          if (distance_(c, r, pc, pr) < metres_) return true;
+          if (distance_(c, r, pc, pr) < metres) return true;
       }
     return false;
   }
 
  private:
-  std::uint64_t key(int bc, int br) const {
-    return (std::uint64_t(std::uint32_t(br + 1)) << 32) | std::uint32_t(bc + 1);  // blocks -1.. of the edges
-  }
-  double metres_;
+  static std::uint64_t key(int bc, int br) { return (std::uint64_t(std::uint32_t(br)) << 32) | std::uint32_t(bc); }
+  double block_metres_;
   const GridDistance& distance_;
   int block_cols_ = 1, block_rows_ = 1;
   std::unordered_map<std::uint64_t, std::vector<std::pair<int, int>>> blocks_;
@@ -299,10 +298,17 @@ class Growth {
     if (options.disc_test == SitesOptions::DiscTest::exact) tester_.build_row_pass();
   }
 
-  /// Central-place spacing: no new centre closer than `metres` to another centre, `fixed` (the
-  /// existing places) included; 0: the discs alone keep them apart.
-  void keep_apart(double metres, const std::vector<Site>& fixed) {
-    min_distance_m_ = metres;
+  /// Central-place spacing, by radius index j: the settlement of rank k (the next of class j has
+  /// rank first_rank[j] + those of j placed) keeps share x sqrt(land / k) from every centre at least
+  /// as large, a generated one of index j or more or a `fixed` (existing) one of `floor[j]` people
+  /// or more. Not called: the discs alone keep them apart.
+  void keep_apart(double share, double land_m2, std::vector<std::size_t> first_rank, std::vector<std::size_t> last_rank,
+                  std::vector<std::int64_t> floor, const std::vector<Site>& fixed) {
+    share_ = share;
+    land_m2_ = land_m2;
+    first_rank_ = std::move(first_rank);
+    last_rank_ = std::move(last_rank);
+    floor_ = std::move(floor);
     fixed_ = &fixed;
   }
 
@@ -335,10 +341,25 @@ class Growth {
     const int n = int(radius_.size());
     int remaining = std::accumulate(quota.begin(), quota.end(), 0);
     std::vector<int> limit;
-    Spacing spacing(min_distance_m_, distance_);
-    if (fixed_)
-      for (const Site& s : *fixed_) spacing.add(s.col, s.row);
-    for (const Site& s : out) spacing.add(s.col, s.row);
+    // One grid of centres per class, holding those it keeps its distance from (its blocks as wide
+    // as the distance of its last rank, the least it keeps).
+    const bool spaced = !first_rank_.empty();
+    const auto metres = [&](std::size_t rank) { return share_ * std::sqrt(land_m2_ / double(std::max<std::size_t>(rank, 1))); };
+    std::vector<Spacing> spacing;
+    std::vector<std::size_t> in_class(std::size_t(n), 0);
+    for (int j = 0; j < n; ++j) spacing.emplace_back(spaced ? metres(last_rank_[std::size_t(j)]) : 0.0, distance_);
+    const auto add = [&](int c, int r, int index) {
+      ++in_class[std::size_t(index)];
+      for (int j = 0; j <= index; ++j) spacing[std::size_t(j)].add(c, r);
+    };
+    const auto too_close = [&](int c, int r, int j) {
+      return spaced && spacing[std::size_t(j)].too_close(c, r, metres(first_rank_[std::size_t(j)] + in_class[std::size_t(j)]));
+    };
+    if (fixed_ && spaced)
+      for (const Site& s : *fixed_)
+        for (int j = 0; j < n; ++j)
+          if (s.population >= floor_[std::size_t(j)]) spacing[std::size_t(j)].add(s.col, s.row);
+    for (const Site& s : out) add(s.col, s.row, n - 1 - s.radius_class);
     const std::size_t batch = 4096;
     while (next_ < m && remaining > 0) {
       const std::size_t begin = next_, end = std::min(m, begin + batch);
@@ -348,16 +369,15 @@ class Growth {
           limit[k - begin] = covered && (*covered)[pool_[k]] ? 0 : clear_classes(pool_[k]);
       });
       for (std::size_t k = begin; k < end && remaining > 0; ++k, next_ = k) {
-        int j = limit[k - begin] - 1;
-        while (j >= 0 && quota[std::size_t(j)] == 0) --j;  // the largest valid class with quota left
-        if (j < 0) continue;                                 // supprimer(L_sites, S)
         const int c = int(pool_[k] % std::uint32_t(cols_)), r = int(pool_[k] / std::uint32_t(cols_));
-        if (spacing.too_close(c, r)) continue;
+        int j = limit[k - begin] - 1;  // the largest valid class with quota left, spaced from the larger centres
+        while (j >= 0 && (quota[std::size_t(j)] == 0 || too_close(c, r, j))) --j;
+        if (j < 0) continue;  // supprimer(L_sites, S)
         --quota[std::size_t(j)];
         --remaining;
         ++table.classes[std::size_t(n - 1 - j)].placed;
         out.push_back(site_at(k, j));
-        spacing.add(c, r);
+        add(c, r, j);
       }
       step.update(double(next_) / double(m));
     }
@@ -409,11 +429,36 @@ class Growth {
   const int cols_;
   const GridDistance& distance_;
   DiscTester tester_;
-  double min_distance_m_ = 0;
+  double share_ = 0, land_m2_ = 0;
+  std::vector<std::size_t> first_rank_, last_rank_;
+  std::vector<std::int64_t> floor_;
   const std::vector<Site>* fixed_ = nullptr;
   std::size_t next_ = 0;
   std::unordered_map<std::uint32_t, std::size_t> rank_of_;  // candidate cell -> position in density order
 };
+
+/// Central places by rank (Christaller 1933: the fewer the places of an order, the farther apart):
+/// the k places of rank k or better spread evenly over the land L lie sqrt(L / k) apart, so the
+/// settlement of rank k keeps share x sqrt(L / k) from every centre at least as large (existing
+/// places ranked among the law's sizes by their people).
+void keep_central_places_apart(Growth& growth, const QuotaTable& table, const std::vector<Site>& existing, double share, double land_km2) {
+  const std::size_t n = table.classes.size();
+  std::vector<std::size_t> first(n, 1), last(n, 1);
+  std::vector<std::int64_t> floor(n, std::numeric_limits<std::int64_t>::max());
+  std::size_t larger = 0;  // generated settlements of the classes above
+  for (std::size_t c = 0; c < n; ++c) {
+    const std::vector<std::int64_t>& sizes = table.populations[c];
+    const std::size_t j = n - 1 - c;
+    std::size_t above = 0;
+    if (!sizes.empty())
+      for (const Site& e : existing) above += e.population > sizes.front();
+    first[j] = 1 + larger + above;
+    last[j] = first[j] + std::max<std::size_t>(sizes.size(), 1) - 1;
+    if (!sizes.empty()) floor[j] = sizes.back();
+    larger += sizes.size();
+  }
+  growth.keep_apart(share, land_km2 * 1e6, std::move(first), std::move(last), std::move(floor), existing);
+}
 
 /// rank_size: every settlement of the law gets a place. Those the growth and its refills left
 /// without one are crowded in (Growth::crowd) and the list is put back in size order, parents
@@ -499,11 +544,8 @@ SitesResult place_sites(const Raster<float>& density, const Raster<std::uint8_t>
   std::vector<Site> existing = options.existing;
   for (Site& e : existing) e.radius_m = urban_radius_m(double(e.population) * (1 + options.growth), options);
   const std::vector<std::uint8_t> occupied = existing.empty() ? std::vector<std::uint8_t>() : covered_cells(existing, distance, cols, rows);
-  if (options.quotas == SitesOptions::Quotas::rank_size && options.min_distance_share > 0 && result.land_area_km2 > 0) {
-    // The mean spacing of the region's places spread evenly, sqrt(land / count), times the share.
-    const double count = double(table.total() + existing.size());
-    growth.keep_apart(options.min_distance_share * std::sqrt(result.land_area_km2 * 1e6 / std::max(1.0, count)), existing);
-  }
+  if (options.quotas == SitesOptions::Quotas::rank_size && options.min_distance_share > 0 && result.land_area_km2 > 0)
+    keep_central_places_apart(growth, table, existing, options.min_distance_share, result.land_area_km2);
   std::vector<Site> placed;
   {
     ProgressStep step(progress, "sites: growth");

@@ -387,8 +387,9 @@ TEST(RankSize, NewPlacesTakeTheRanksBelowTheGivenOnes) {
 }
 
 // Density peaking at the centre of a flat 20 km x 20 km region: without the spacing rule the
-// densest candidates, all near the peak, become the towns; with it no two centres are closer than
-// min_distance_share x sqrt(400 km2 / settlements).
+// densest candidates, all near the peak, become the towns; with it no two centres of one class are
+// closer than min_distance_share x sqrt(400 km2 / settlements) (the least any class keeps), and the
+// two largest lie at least share x sqrt(400 km2 / 2) apart (the second keeps that from the first).
 TEST(RankSize, CentresKeepTheCentralPlaceSpacing) {
   SilentProgress progress;
   auto peak = fixtures::flat_scenario(200, 200, 100.0);
@@ -398,20 +399,27 @@ TEST(RankSize, CentresKeepTheCentralPlaceSpacing) {
   o.population = 60000;
   o.spacing_km = 0;
   const GridDistance distance(peak.density.georef(), 200, 200);
-  const auto closest = [&](const SitesResult& r) {
+  const auto closest = [&](const SitesResult& r) {  // of two centres of one class
     double best = std::numeric_limits<double>::infinity();
     for (std::size_t a = 0; a < r.sites.size(); ++a)
       for (std::size_t b = a + 1; b < r.sites.size(); ++b)
-        best = std::min(best, distance(r.sites[a].col, r.sites[a].row, r.sites[b].col, r.sites[b].row));
+        if (r.sites[a].radius_class == r.sites[b].radius_class)
+          best = std::min(best, distance(r.sites[a].col, r.sites[a].row, r.sites[b].col, r.sites[b].row));
     return best;
+  };
+  const auto two_largest = [&](const SitesResult& r) {
+    return distance(r.sites[0].col, r.sites[0].row, r.sites[1].col, r.sites[1].row);
   };
   o.min_distance_share = 0.5;
   const SitesResult spaced = place_sites(peak.density, peak.buildable, o, progress);
   ASSERT_EQ(spaced.crowded, 0);
   const double metres = 0.5 * std::sqrt(400e6 / double(spaced.sites.size()));
   EXPECT_GE(closest(spaced), metres);
+  ASSERT_GE(spaced.sites.size(), 2u);
+  EXPECT_GE(two_largest(spaced), 0.5 * std::sqrt(400e6 / 2));
   o.min_distance_share = 0;
   const SitesResult packed = place_sites(peak.density, peak.buildable, o, progress);
   EXPECT_EQ(packed.sites.size(), spaced.sites.size());
   EXPECT_LT(closest(packed), 0.5 * metres);
+  EXPECT_LT(two_largest(packed), 0.5 * std::sqrt(400e6 / 2));
 }
