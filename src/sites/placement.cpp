@@ -301,7 +301,7 @@ class Growth {
   /// Central-place spacing, by radius index j: the settlement of rank k (the next of class j has
   /// rank first_rank[j] + those of j placed) keeps share x sqrt(land / k) from every centre at least
   /// as large, a generated one of index j or more or a `fixed` (existing) one of `floor[j]` people
-  /// or more. Not called: the discs alone keep them apart.
+  /// or more. Without it the discs alone keep them apart.
   void keep_apart(double share, double land_m2, std::vector<std::size_t> first_rank, std::vector<std::size_t> last_rank,
                   std::vector<std::int64_t> floor, const std::vector<Site>& fixed) {
     share_ = share;

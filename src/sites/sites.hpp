@@ -67,11 +67,11 @@ struct SitesOptions {
   /// them, and a population the law would split into more is split over that many (the smallest
   /// then above min_population). 0: no limit, the count follows the law alone.
   double spacing_km = 7;
-  /// rank_size: no settlement centre closer than this share of sqrt(land area / settlements), the
-  /// spacing of that many places spread evenly, to another (existing places included), so that
-  /// the densest candidates of one cluster do not all become towns. Real places lie more evenly
-  /// than random points (Clark and Evans 1954: R of 0.8-1.35 on the shared regions, the nearest
-  /// place at a median 0.35-0.65 of that spacing; 0.5 wins the placement backtest). 0: the discs
+  /// rank_size: central places by rank (Christaller 1933): the settlement of rank k keeps this
+  /// share of sqrt(land area / k), the spacing of the k largest places spread evenly, from every
+  /// centre at least as large (existing places included). Real places lie more evenly than random
+  /// points (Clark and Evans 1954: R of 0.8-1.35 on the shared regions, the nearest place at a
+  /// median 0.35-0.65 of sqrt(land / places); 0.5 wins the placement backtest). 0: the discs
   /// alone keep them apart (Belhadj 2007).
   double min_distance_share = 0.5;
   /// b of the urban-area allometry A = A_0 (P / 1000)^b: built-up area grows slower than
