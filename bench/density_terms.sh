@@ -6,16 +6,9 @@
 # (minus the elevation, minus the slope, nearness to water), how many meet the issue's bar (>= 0.75
 # and above it), the mean in-sample AUC (not a criterion), each region's held-out AUC and the weights
 # fitted on all the regions (docs/benchmarks.md, "Held-out skill of the terrain terms").
-# Usage: bench/density_terms.sh [TERRAPOLIS] [DEMS_DIR] [PLACES_DIR]
+# Usage: bench/density_terms.sh [TERRAPOLIS] [DEMS_DIR] [PLACES_DIR] [KEEP_DIR]
 set -euo pipefail
-TP=$(realpath "${1:-build/src/cli/terrapolis}")
-DEMS=$(realpath "${2:-../shared/dems}")
-PLACES=$(realpath "${3:-../shared/reference/geonames}")
-SRC=$(cd "$(dirname "$0")/.." && pwd)
-OUT=$(mktemp -d)
-trap 'rm -rf "$OUT"' EXIT
-cd "$OUT"
-source "$SRC/bench/realism_regions.sh"
+source "$(dirname "$0")/realism_regions.sh" "$@"  # TP, DEMS, PLACES, SRC, OUT (and cd there), the regions
 
 four=altitude,slope,coast_near,position_5km
 eight=coast,hydrometry,plateau,plain,altitude,slope,coast_near,river_near

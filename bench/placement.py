@@ -152,7 +152,6 @@ def takeable(buildable, places):
                 if 0 <= r < rows and 0 <= c < cols and grid[r, c] and (c, r) not in taken]
         if free:
             best = min(free, key=lambda t: t[0])  # the first nearest in row order, as places.cpp scans
-            best = next(t for t in free if t[0] == best[0])
             taken.add((best[2], best[1]))
             out.append(f)
     return out

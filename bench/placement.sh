@@ -9,19 +9,7 @@
 # Usage: bench/placement.sh [TERRAPOLIS] [DEMS_DIR] [PLACES_DIR] [KEEP_DIR]
 # (PLACEMENT_SET="sites.x=1 sites.y=2": more --set for every region run)
 set -euo pipefail
-TP=$(realpath "${1:-build/src/cli/terrapolis}")
-DEMS=$(realpath "${2:-../shared/dems}")
-PLACES=$(realpath "${3:-../shared/reference/geonames}")
-SRC=$(cd "$(dirname "$0")/.." && pwd)
-if [[ -n ${4:-} ]]; then
-  mkdir "$4"
-  OUT=$(realpath "$4")
-else
-  OUT=$(mktemp -d)
-  trap 'rm -rf "$OUT"' EXIT
-fi
-cd "$OUT"
-source "$SRC/bench/realism_regions.sh"
+source "$(dirname "$0")/realism_regions.sh" "$@"  # TP, DEMS, PLACES, SRC, OUT (and cd there), the regions
 extra=()
 for s in ${PLACEMENT_SET:-}; do extra+=(--set "$s"); done
 

@@ -9,20 +9,7 @@
 # Usage: bench/realism.sh [TERRAPOLIS] [DEMS_DIR] [PLACES_DIR] [KEEP_DIR]  (KEEP_DIR: keep the runs there;
 # REALISM_SET=sites.spacing_km=0: one more --set for the region runs, e.g. the rank-size law alone)
 set -euo pipefail
-TP=$(realpath "${1:-build/src/cli/terrapolis}")
-DEMS=$(realpath "${2:-../shared/dems}")
-PLACES=$(realpath "${3:-../shared/reference/geonames}")
-SRC=$(cd "$(dirname "$0")/.." && pwd)
-if [[ -n ${4:-} ]]; then
-  mkdir "$4"  # refuses an existing folder: never mixes runs
-  OUT=$(realpath "$4")
-else
-  OUT=$(mktemp -d)
-  trap 'rm -rf "$OUT"' EXIT
-fi
-cd "$OUT"
-
-source "$SRC/bench/realism_regions.sh"
+source "$(dirname "$0")/realism_regions.sh" "$@"  # TP, DEMS, PLACES, SRC, OUT (and cd there), the regions
 
 echo "== calibration, leave one region out ($(date -u +%F))"
 /usr/bin/time -f "calibrate: %e s, %M kB" "$TP" --quiet calibrate "${dems[@]}" --settlements "${places[@]}" "${scenarios[@]}" \

@@ -44,6 +44,9 @@ std::optional<std::int64_t> as_int(const FieldValue& v) {
 }
 }  // namespace
 
+/// The fewest people of a city at a motorway's end, at a national road's.
+constexpr double kMotorwayPeople = 100000, kNationalPeople = 10000;
+
 std::vector<roads::Link> road_links(const VectorLayer& network, const VectorLayer* cities) {
   const int f_from = network.field_index("from"), f_to = network.field_index("to"), f_kept = network.field_index("kept");
   if (f_from < 0 || f_to < 0) throw bad_input(network.name + ": the network needs integer fields 'from' and 'to'");
@@ -75,7 +78,12 @@ std::vector<roads::Link> road_links(const VectorLayer& network, const VectorLaye
       if (x.population != y.population) return x.population > y.population;
       return x.size_class != y.size_class ? x.size_class < y.size_class : x.id < y.id;
     });
-    for (std::size_t r = 0; r < ranked.size(); ++r) city_class[ranked[r].id] = r < 4 ? 0 : r < 13 ? 1 : r < 40 ? 2 : 3;
+    // A level also needs the people of its order: a motorway end a city of 100,000 or more, a
+    // national road's one of 10,000 (the levels of access.levels_population), so the towns of a
+    // rural region are joined by departmental roads, not by roads built to 6-7 % grades.
+    const auto floor_level = [](double people) { return people >= kMotorwayPeople ? 0 : people >= kNationalPeople ? 1 : 2; };
+    for (std::size_t r = 0; r < ranked.size(); ++r)
+      city_class[ranked[r].id] = std::max(r < 4 ? 0 : r < 13 ? 1 : r < 40 ? 2 : 3, floor_level(ranked[r].population));
   }
   auto class_of = [&](std::int64_t id) {
     const auto it = city_class.find(id);

@@ -50,6 +50,9 @@ std::vector<std::string> settlement_warnings(const RunState& s, const sites::Sit
   if (r.unplaced > 0)
     warnings.push_back(std::to_string(r.unplaced) + " settlement(s) of the law (" + std::to_string(r.unplaced_people) +
                        " people) found no candidate outside the others' discs: in no settlement (raise sites.candidates)");
+  else if (r.unplaced_people > 0)  // the settled people the given places leave, fewer than one settlement holds
+    warnings.push_back(std::to_string(r.unplaced_people) + " settled people beside the given places, too few for a settlement of "
+                       "sites.min_population: in no settlement");
   if (r.land_area_km2 > 0 && r.target_population / r.land_area_km2 > kPlausiblePeoplePerKm2)
     warnings.push_back("population " + std::to_string(std::llround(r.target_population)) + " on " + std::to_string(std::llround(r.land_area_km2)) +
                        " km2 of land is " + std::to_string(std::llround(r.target_population / r.land_area_km2)) +

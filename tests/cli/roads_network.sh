@@ -20,8 +20,8 @@ cat > "$out/net/network.geojson" <<'JSON'
 JSON
 cat > "$out/net/cities.geojson" <<'JSON'
 {"type": "FeatureCollection", "features": [
-{"type": "Feature", "properties": {"id": 0, "radius_m": 900, "class": 0, "population": 40000, "density": 300, "parent": null, "depth": 0}, "geometry": {"type": "Point", "coordinates": [9.30, 42.68]}},
-{"type": "Feature", "properties": {"id": 1, "radius_m": 700, "class": 1, "population": 20000, "density": 200, "parent": 0, "depth": 1}, "geometry": {"type": "Point", "coordinates": [9.42, 42.70]}},
+{"type": "Feature", "properties": {"id": 0, "radius_m": 900, "class": 0, "population": 400000, "density": 300, "parent": null, "depth": 0}, "geometry": {"type": "Point", "coordinates": [9.30, 42.68]}},
+{"type": "Feature", "properties": {"id": 1, "radius_m": 700, "class": 1, "population": 200000, "density": 200, "parent": 0, "depth": 1}, "geometry": {"type": "Point", "coordinates": [9.42, 42.70]}},
 {"type": "Feature", "properties": {"id": 2, "radius_m": 300, "class": 3, "population": 2000, "density": 50, "parent": 1, "depth": 2}, "geometry": {"type": "Point", "coordinates": [9.40, 43.0]}},
 {"type": "Feature", "properties": {"id": 3, "radius_m": 300, "class": 3, "population": 2000, "density": 50, "parent": 0, "depth": 1}, "geometry": {"type": "Point", "coordinates": [9.10, 42.60]}},
 {"type": "Feature", "properties": {"id": 4, "radius_m": 200, "class": 4, "population": 500, "density": 20, "parent": 2, "depth": 3}, "geometry": {"type": "Point", "coordinates": [9.0, 43.15]}}

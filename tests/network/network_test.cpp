@@ -287,9 +287,9 @@ TEST(Network, HighLatitudeGeographicReplay) {
 }
 
 TEST(Network, RoadLinksReadTheKeptEdgesAndClassThemByTheCitiesRanks) {
-  // 41 cities, city i of population 1000 - i (rank i): ranks 0-3 are level 0, 4-12 level 1, 13-39
-  // level 2, 40 level 3. Kept links 0-1 (motorway), 1-13 (departmental: the smaller end decides)
-  // and 5-40 (local); the removed candidate 0-2 is no link.
+  // 41 cities, city i of population 200,000 - 1000 i (rank i; all large enough for any level):
+  // ranks 0-3 are level 0, 4-12 level 1, 13-39 level 2, 40 level 3. Kept links 0-1 (motorway), 1-13
+  // (departmental: the smaller end decides) and 5-40 (local); the removed candidate 0-2 is no link.
   VectorLayer net;
   net.name = "network.geojson";
   net.geometry = GeometryType::line_string;
@@ -301,7 +301,7 @@ TEST(Network, RoadLinksReadTheKeptEdgesAndClassThemByTheCitiesRanks) {
   VectorLayer cities;
   cities.name = "cities.geojson";
   cities.fields = {{"id", FieldType::integer}, {"class", FieldType::integer}, {"population", FieldType::integer}};
-  for (int id = 40; id >= 0; --id) cities.features.push_back({{}, {std::int64_t(id), std::int64_t(3), std::int64_t(1000 - id)}});
+  for (int id = 40; id >= 0; --id) cities.features.push_back({{}, {std::int64_t(id), std::int64_t(3), std::int64_t(200000 - 1000 * id)}});
   const auto links = network::road_links(net, &cities);
   ASSERT_EQ(links.size(), 3u);
   EXPECT_EQ(links[0].road_class, roads::RoadClass::motorway);
@@ -311,6 +311,13 @@ TEST(Network, RoadLinksReadTheKeptEdgesAndClassThemByTheCitiesRanks) {
   EXPECT_EQ(links[1].to, 13);
   EXPECT_EQ(links[1].b[0], 2.0);
   EXPECT_EQ(network::road_links(net, nullptr)[0].road_class, roads::RoadClass::departmental);  // no cities: departmental
+  // The same ranks in a rural region: towns of 9,000 to 40,000 people. A motorway needs two cities of
+  // 100,000, a national road two of 10,000: 0-1 (40,000 and 39,000) is national; 5-40 stays local.
+  for (int id = 0; id <= 40; ++id) cities.features[std::size_t(40 - id)].values[2] = std::int64_t(id == 0 ? 40000 : id == 1 ? 39000 : 9000 - id);
+  const auto rural = network::road_links(net, &cities);
+  EXPECT_EQ(rural[0].road_class, roads::RoadClass::national);
+  EXPECT_EQ(rural[1].road_class, roads::RoadClass::departmental);
+  EXPECT_EQ(rural[2].road_class, roads::RoadClass::local);
   cities.fields[1].name = "rank";
   EXPECT_THROW(network::road_links(net, &cities), Error);
 }

@@ -261,6 +261,14 @@ std::vector<Site> three_places(const Raster<float>& density) {
   }
   return places;
 }
+
+/// The fixed law over 40,000 people with the three places given (31,000 of them).
+SitesOptions with_three_places(const Raster<float>& density) {
+  SitesOptions o = fixed_law();
+  o.population = 40000;
+  o.existing = three_places(density);
+  return o;
+}
 }  // namespace
 
 // +25 % of 31,000 settled people is 7,750 new ones. All to the existing places (new share 0): each
@@ -269,9 +277,7 @@ std::vector<Site> three_places(const Raster<float>& density) {
 TEST(Growth, SplitsAddUpAndPlacesKeepTheirCells) {
   SilentProgress progress;
   const auto flat = fixtures::flat_scenario(200, 200, 100.0);
-  SitesOptions o = fixed_law();
-  o.population = 40000;
-  o.existing = three_places(flat.density);
+  SitesOptions o = with_three_places(flat.density);
   o.growth = 0.25;
   const SitesResult gibrat = place_sites(flat.density, flat.buildable, o, progress);
   EXPECT_EQ(gibrat.growth_people, 7750);
@@ -371,9 +377,7 @@ TEST(RankSize, TailOfTheLawBelowExistingPlaces) {
 TEST(RankSize, NewPlacesTakeTheRanksBelowTheGivenOnes) {
   SilentProgress progress;
   const auto flat = fixtures::flat_scenario(200, 200, 100.0);
-  SitesOptions o = fixed_law();
-  o.population = 40000;
-  o.existing = three_places(flat.density);
+  SitesOptions o = with_three_places(flat.density);
   const SitesResult r = place_sites(flat.density, flat.buildable, o, progress);
   std::vector<std::int64_t> created;
   for (const Site& s : r.sites)
@@ -384,6 +388,12 @@ TEST(RankSize, NewPlacesTakeTheRanksBelowTheGivenOnes) {
   EXPECT_EQ(created.front(), 2260);
   EXPECT_EQ(std::accumulate(created.begin(), created.end(), std::int64_t(0)), 9000);
   EXPECT_EQ(r.unplaced_people, 0);
+  // 500 people beside the places, too few for a settlement of 1,000: none made, the 500 reported.
+  o.population = 31500;
+  const SitesResult few = place_sites(flat.density, flat.buildable, o, progress);
+  EXPECT_EQ(few.sites.size(), 3u);
+  EXPECT_EQ(few.unplaced, 0);
+  EXPECT_EQ(few.unplaced_people, 500);
 }
 
 // Density peaking at the centre of a flat 20 km x 20 km region: without the spacing rule the
