@@ -169,9 +169,8 @@ double reuse_factor(const RoadGraph& graph, const ArcDiscount* discount, Cell c,
 }
 
 /// Distances to the target on a relaxed 2-D graph: nodes are cells (the orientation dropped, so no
-/// turn is priced), arcs are every surface arc at its exact cost and every sampled bridge or tunnel
-/// arc at a lower bound of its cost (its deck slope term exact, the height or depth, water and
-/// vegetation terms at their minima). Every arc of the oriented graph costs at least its relaxed
+/// turn is priced), arcs are every surface arc and every sampled bridge or tunnel arc at its exact
+/// cost (a long arc integrated only when a cheap bound of its cost could improve its source). Every arc of the oriented graph costs at least its relaxed
 /// arc, so the relaxed distance is an admissible and consistent heuristic for it, and on relief it
 /// is far tighter than the straight-line bound: it knows where the valleys and passes are.
 /// Computed lazily by a reverse A* from the target guided by the straight-line bound towards the
@@ -183,8 +182,8 @@ double reuse_factor(const RoadGraph& graph, const ArcDiscount* discount, Cell c,
 /// factor to stay consistent: the forward search keeps a tight heuristic along and off the roads.
 class RelaxedDistance {
  public:
-  RelaxedDistance(const RoadGraph& graph, Cell target, Cell source, ArcCache* cache, const ArcDiscount* discount)
-      : graph_(graph), t_(graph.terrain()), source_(source), cache_(cache), discount_(discount),
+  RelaxedDistance(const RoadGraph& graph, Cell target, Cell source, ArcCache* cache, LongArcCache* long_cache, const ArcDiscount* discount)
+      : graph_(graph), t_(graph.terrain()), source_(source), cache_(cache), long_cache_(long_cache), discount_(discount),
         guide_scale_(discount ? discount->floor : 1.0) {
     if (scratch_in_use_) own_.emplace();  // a nested search on this thread gets its own arrays
     else scratch_in_use_ = true;
@@ -357,7 +356,10 @@ class RelaxedDistance {
     const double floor = fixed_[st] + slope_floor_[st].front();
     const auto& table = slope_floor_[st];
     // Sampled pairs are unordered: the long arcs out of v list the cells w whose arc w -> v exists.
-    for (int a : graph_.arcs_from(v, 0, e.ring + 1)) {
+    const std::span<const int> list = graph_.arcs_from(v, 0, e.ring + 1);
+    float* costs = nullptr;
+    for (std::size_t k = 0; k < list.size(); ++k) {
+      const int a = list[k];
       const Cell w{v.col + arcs[std::size_t(a)].dcol, v.row + arcs[std::size_t(a)].drow};
       if (!t_.inside(w.col, w.row) || t_.water(w.col, w.row)) continue;
       const std::size_t wi = t_.index(w.col, w.row);
@@ -369,8 +371,20 @@ class RelaxedDistance {
       const double grade = std::fabs(zv - double(t_.surface(w.col, w.row))) / length;
       if (grade > tan_max_[st] * (1 + 1e-9)) continue;  // the deck breaks the slope threshold
       const double slope = table[std::min(table.size() - 1, std::size_t(grade / grade_step_[st]))];
+      if (d + (1 - 1e-6) * length * (slope + fixed_[st]) >= scratch().g[wi]) continue;
+      // Then the arc's own cost: a bridge that would cut the ground, a tunnel that would leave it or
+      // a deep crossing costs what the forward search will pay (a long arc costs the same both ways:
+      // the same samples along the same deck), so the heuristic is tight at the structures too.
+      if (!costs) costs = long_cache_->ring(e.cell, e.ring, list.size());
+      double exact;
+      if (costs) {
+        if (std::isnan(costs[k])) costs[k] = float(graph_.arc_cost(v, a));
+        exact = costs[k];
+      } else {
+        exact = double(float(graph_.arc_cost(v, a)));
+      }
       // 1e-6 covers the float rounding of the priced long arcs.
-      relax(wi, d + (1 - 1e-6) * length * (slope + fixed_[st]));
+      if (exact < kInfinity) relax(wi, d + (1 - 1e-6) * exact);
     }
     if (ring.next >= 0) {
       Entry next = e;
@@ -385,6 +399,7 @@ class RelaxedDistance {
   Cell source_;
   ArcCache* cache_;              ///< shared with later searches to the target, or nullptr (the arcs
                                  ///< it prices are each priced once: caching them costs more)
+  LongArcCache* long_cache_;     ///< the long arc costs, shared with the forward search
   const ArcDiscount* discount_;  ///< road reuse, or nullptr
   const double guide_scale_;     ///< the smallest discount factor, 1 without reuse
   std::optional<Scratch> own_;
@@ -430,7 +445,7 @@ class PathSearch {
       // With road reuse the roads built since the last search changed the discounted costs: the
       // relaxed search starts again (its arc caches, of undiscounted costs, stay shared).
       if (state.relaxed && !discount) state.relaxed->set_source(from);
-      else state.relaxed.reset(), state.relaxed.emplace(graph, to, from, state_shared ? &cache_ : nullptr, discount);
+      else state.relaxed.reset(), state.relaxed.emplace(graph, to, from, state_shared ? &cache_ : nullptr, &long_cache_, discount);
       rel_ = &*state.relaxed;
       settled_before_ = rel_->settled_cells();
     }

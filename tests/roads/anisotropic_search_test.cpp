@@ -370,6 +370,36 @@ TEST(AnisotropicSearch, SampledLongArcsAreSymmetricAndListedBothWays) {
   EXPECT_LT(rate, 1.3 * expected);
 }
 
+TEST(AnisotropicSearch, ALongArcCostsTheSameBothWays) {
+  // The relaxed reverse search prices the arc w -> v as v -> w (the heuristic stays a lower bound
+  // only if the two agree): the same deck over the same samples, bridges and tunnels, over water too.
+  std::mt19937_64 rng(11);
+  std::size_t finite = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    const RandomProblem problem(rng);
+    const RoadGraph& g = problem.graph;
+    const auto& arcs = g.arcs();
+    for (int r = 0; r < 16; ++r)
+      for (int c = 0; c < 16; ++c)
+        for (std::size_t a = g.surface_arcs(); a < arcs.size(); ++a) {
+          const Cell from{c, r}, to{c + arcs[a].dcol, r + arcs[a].drow};
+          if (!problem.terrain.inside(to.col, to.row)) continue;
+          int back = -1;
+          for (std::size_t b = g.surface_arcs(); b < arcs.size() && back < 0; ++b)
+            if (arcs[b].dcol == -arcs[a].dcol && arcs[b].drow == -arcs[a].drow && arcs[b].structure == arcs[a].structure) back = int(b);
+          ASSERT_GE(back, 0);
+          const double there = g.arc_cost(from, int(a)), back_cost = g.arc_cost(to, back);
+          if (there == kInfinity) {
+            EXPECT_EQ(back_cost, kInfinity) << trial;
+            continue;
+          }
+          EXPECT_NEAR(back_cost, there, 1e-9 * there) << trial;
+          ++finite;
+        }
+  }
+  EXPECT_GT(finite, 1000u);
+}
+
 // Long arcs scale with the cell (the paper's 50..300 m on a 10 m grid) but never exceed the
 // structure's longest_m: 3 km bridges and 5 km tunnels by default.
 TEST(AnisotropicSearch, LongArcsStayUnderTheirLongestLength) {
