@@ -64,9 +64,7 @@ class PathCommand final : public Command {
     const roads::CostModel model = options_.cost_model();
     const plugin::PluginSet plugins = options_.plugins.load(context.log);
     const Dem dem = dem_.read();
-    const hydro::FlatWater lakes = options_.flat_water(dem);
-    roads::TerrainField terrain(dem, options_.sea_level(), model.unknown_water_depth_m, model.road_radius_m, &lakes.mask);
-    options_.load_layers(terrain, plugins, dem, context.progress, context.log);
+    roads::TerrainField terrain = options_.terrain(dem, plugins, context.progress, context.log);
     const roads::CorridorOptions corridor_options = options_.corridor_options(dem);
     const auto a = locate("--from", from_, terrain), b = locate("--to", to_, terrain);
     if (a == b) throw bad_input("--from/--to: both points fall in the same cell");

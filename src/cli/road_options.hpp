@@ -8,8 +8,8 @@
 
 #include "cli/plugin_options.hpp"
 #include "cli/schema_options.hpp"
-#include "hydro/flat_water.hpp"
 #include "io/raster_io.hpp"
+#include "pipeline/inland_water.hpp"
 #include "pipeline/stage_options.hpp"
 #include "roads/corridor.hpp"
 #include "roads/road_network.hpp"
@@ -42,11 +42,11 @@ struct RoadOptions {
     if (!settings_) settings_ = schema.settings([&] { return pipeline::roads_settings(scenario()); });
     return *settings_;
   }
-  double sea_level() const { return scenario().resolved["water"]["sea_level_m"].get<double>(); }
 
   /// The files these options read (the outputs may not replace them).
   std::vector<std::string> inputs() const {
-    return {scenario().path("/roads/costs"), settings().vegetation, scenario().path("/roads/corridor/side_angles"), settings().existing};
+    return {scenario().path("/roads/costs"), settings().vegetation, scenario().path("/roads/corridor/side_angles"), settings().existing,
+            scenario().path("/water/water_mask")};
   }
 
   /// The schema's roads.corridor options, the side-angle map read onto the DEM's grid.
@@ -71,15 +71,14 @@ struct RoadOptions {
     return out;
   }
 
-  /// Lakes the DEM flattens (hydro::detect_flat_water), for the TerrainField.
-  hydro::FlatWater flat_water(const Dem& dem) const { return hydro::detect_flat_water(dem, pipeline::flat_water_options(scenario())); }
-
   const roads::CostModel& cost_model() const { return settings().model; }
-  /// Loads --vegetation onto the DEM's grid when given, and adds the plugins' road cost terms.
-  void load_layers(roads::TerrainField& terrain, const plugin::PluginSet& set, const Dem& dem, Progress& progress, const Log& log) const {
-    if (const std::string& vegetation = settings().vegetation; !vegetation.empty())
-      terrain.set_vegetation(read_resampled(vegetation, terrain.georef(), terrain.cols(), terrain.rows(), Resampling::bilinear));
-    plugin::add_to_terrain(plugin::road_terms(set, dem, progress, log), terrain);
+  /// The roads' terrain as a run builds it: the inland water (flattened lakes, --water-mask),
+  /// --vegetation and the plugins' road cost terms.
+  roads::TerrainField terrain(const Dem& dem, const plugin::PluginSet& set, Progress& progress, const Log& log) const {
+    const pipeline::InlandWater water = pipeline::inland_water(dem, pipeline::inland_water_settings(scenario()), progress, log);
+    roads::TerrainField t = pipeline::road_terrain(dem, scenario(), cost_model(), water.mask);
+    pipeline::add_road_layers(t, settings(), set, dem, progress, log);
+    return t;
   }
   roads::GraphOptions graph() const { return settings().routing.graph; }
   roads::RoutingOptions routing() const { return settings().routing; }

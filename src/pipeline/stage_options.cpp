@@ -75,6 +75,10 @@ std::vector<lake::LakeSpec> reservoir_specs(const Scenario& scenario) {
   return out;
 }
 
+InlandWaterSettings inland_water_settings(const Scenario& scenario) {
+  return {flat_water_options(scenario), scenario.path("/water/water_mask"), reservoir_specs(scenario)};
+}
+
 bool TileSettings::tiled(const std::string& dem_path) const {
   return tile_size > 0 || memory_limit_mb > 0 || std::filesystem::is_directory(dem_path);
 }
@@ -309,8 +313,7 @@ StageSettings prepare_stages(const Scenario& scenario) {
     if (const TileSettings t = tile_settings(scenario); t.tile_size > 0 || t.memory_limit_mb > 0)
       throw bad_input(std::string(t.tile_size > 0 ? "/input/tile_size" : "/input/memory_limit_mb") +
                       ": a run does not work tile by tile yet (only the hydro and density commands do)");
-    s.flat_water = flat_water_options(scenario);
-    s.reservoirs = reservoir_specs(scenario);
+    s.water = inland_water_settings(scenario);
     s.hydro = hydro_options(scenario);
     s.river_types = river_type_options(scenario);
     s.d8_codes = d8_codes(scenario);

@@ -96,9 +96,17 @@ struct AccessSettings {
 };
 AccessSettings access_settings(const Scenario& scenario);
 
-struct StageSettings {
+/// The water section's inland water (docs/lakes.md): what pipeline::inland_water reads.
+struct InlandWaterSettings {
   hydro::FlatWaterOptions flat_water;
-  std::vector<lake::LakeSpec> reservoirs;
+  std::string water_mask;                  ///< water.water_mask (empty: none)
+  std::vector<lake::LakeSpec> reservoirs;  ///< in the scenario's order
+};
+/// Errors name the setting's pointer.
+InlandWaterSettings inland_water_settings(const Scenario& scenario);
+
+struct StageSettings {
+  InlandWaterSettings water;
   hydro::HydroOptions hydro;
   std::optional<hydro::RiverTypeOptions> river_types;
   hydro::D8Codes d8_codes{};

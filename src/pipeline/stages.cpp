@@ -9,11 +9,11 @@
 
 #include "core/error.hpp"
 #include "core/geodesy.hpp"
-#include "io/mask_io.hpp"
 #include "io/raster_io.hpp"
 #include "network/layers.hpp"
 #include "pipeline/density_folder.hpp"
 #include "pipeline/hillshade.hpp"
+#include "pipeline/inland_water.hpp"
 #include "pipeline/places.hpp"
 #include "pipeline/realism.hpp"
 #include "pipeline/stage_options.hpp"
@@ -54,40 +54,14 @@ void terrain_load(RunState&) {}  // the DEM is always read from the input
 
 constexpr const char* kInlandWater = "inland_water.tif";
 
-/// Water no sea level sees, as one mask (1 water, 0 not) that the density (uninhabitable, lakeshores
-/// as coast) and the roads (bridged or avoided) both read: lakes the DEM flattens
-/// (hydro::detect_flat_water), the user's water.water_mask, and the scenario's reservoirs flooded
-/// to their level (Peytavie 2010 §2.4.1).
+/// The inland water (pipeline::inland_water) as inland_water.tif, which the density, the roads and
+/// the access stages read back.
 void write_inland_water(RunState& s, Progress& progress, const Log& log) {
-  hydro::FlatWater flat = hydro::detect_flat_water(s.dem, s.settings.flat_water);
-  Raster<std::uint8_t>& water = flat.mask;
-  if (const std::string user = s.scenario.path("/water/water_mask"); !user.empty()) {
-    const Raster<std::uint8_t> m = read_mask(user, s.dem.georef(), s.dem.cols(), s.dem.rows());
-    for (std::size_t i = 0; i < m.size(); ++i)
-      if (m[i]) water[i] = 1;
-  }
-  const std::vector<lake::LakeSpec>& specs = s.settings.reservoirs;
-  json reservoirs = json::array();
-  if (!specs.empty()) {
-    const CellMetrics metrics = cell_metrics(s.dem.georef(), s.dem.cols(), s.dem.rows());
-    for (std::size_t k = 0; k < specs.size(); ++k) {
-      lake::Lake l;
-      try {
-        l = lake::flood(s.dem, metrics, specs[k], progress);
-      } catch (const Error& e) {
-        throw bad_input("/water/reservoirs/" + std::to_string(k) + e.what());
-      }
-      for (std::size_t i = 0; i < l.mask.size(); ++i)
-        if (l.mask[i] == 1) water[i] = 1;
-      if (l.spills) log.warn("/water/reservoirs/" + std::to_string(k) + ": the water reaches the DEM's edge or nodata");
-      reservoirs.push_back({{"level_m", round_to(l.level_m, 0.01)}, {"area_km2", round_to(l.area_km2, 1e-4)},
-                            {"volume_m3", std::round(l.volume_m3)}, {"max_depth_m", round_to(l.max_depth_m, 0.01)}});
-    }
-  }
-  s.write("hydro", kInlandWater, water, "inland water (1): lakes the DEM flattens, water.water_mask and water.reservoirs", Style::water);
-  s.summary["hydro"]["flat_lakes"] = flat.lakes;
-  s.summary["hydro"]["flat_lake_km2"] = round_to(flat.area_km2, 0.01);
-  if (!specs.empty()) s.summary["hydro"]["reservoirs"] = reservoirs;
+  InlandWater water = inland_water(s.dem, s.settings.water, progress, log);
+  s.write("hydro", kInlandWater, water.mask, "inland water (1): lakes the DEM flattens, water.water_mask and water.reservoirs", Style::water);
+  s.summary["hydro"]["flat_lakes"] = water.flat_lakes;
+  s.summary["hydro"]["flat_lake_km2"] = round_to(water.flat_lake_km2, 0.01);
+  if (!water.reservoirs.empty()) s.summary["hydro"]["reservoirs"] = std::move(water.reservoirs);
 }
 
 // ---- hydro (Belhadj 2007 §4.2.2; Barnes et al. 2014; docs/hydro.md) ----------------------
@@ -347,15 +321,12 @@ json corridor_hook(RunState& s, const roads::TerrainField& terrain, const std::v
   return out;
 }
 
-/// The roads' terrain: the DEM with the sea (below water.sea_level_m, and nodata) and the run's
-/// inland water (inland_water.tif: flattened lakes, water.water_mask, the reservoirs).
+/// The roads' terrain (pipeline::road_terrain) on the run's inland water (inland_water.tif).
 roads::TerrainField road_terrain(const RunState& s) {
-  const RoadsSettings& settings = s.settings.roads;
   const Raster<float> water = read_resampled(saved(s, kInlandWater), s.dem.georef(), s.dem.cols(), s.dem.rows(), Resampling::nearest);
   Raster<std::uint8_t> lakes = s.dem.like<std::uint8_t>(0);
   for (std::size_t i = 0; i < water.size(); ++i) lakes[i] = water[i] == 1;
-  return roads::TerrainField(s.dem, s.scenario.resolved["water"]["sea_level_m"].get<double>(), settings.model.unknown_water_depth_m,
-                             settings.model.road_radius_m, &lakes);
+  return pipeline::road_terrain(s.dem, s.scenario, s.settings.roads.model, lakes);
 }
 
 /// roads.existing read onto the grid (nullopt when not given); its errors name the option.
@@ -402,9 +373,7 @@ json existing_figures(const roads::ExistingRoads& e, const roads::NetworkResult&
 void roads_run(RunState& s, Progress& progress, const Log& log) {
   const RoadsSettings& settings = s.settings.roads;
   roads::TerrainField terrain = road_terrain(s);
-  if (!settings.vegetation.empty())
-    terrain.set_vegetation(read_resampled(settings.vegetation, s.dem.georef(), s.dem.cols(), s.dem.rows(), Resampling::bilinear));
-  plugin::add_to_terrain(plugin::road_terms(s.plugins, s.dem, progress, log), terrain);
+  add_road_layers(terrain, settings, s.plugins, s.dem, progress, log);
   const roads::RoadGraph graph(terrain, settings.model, settings.routing.graph);
   const std::vector<roads::Link> links = network::road_links(*s.network, &*s.cities);
   const std::optional<roads::ExistingRoads> existing = existing_roads(s, terrain, log);

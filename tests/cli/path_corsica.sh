@@ -33,3 +33,26 @@ cost=$("$bin" -q path "$dem" --from 9.30,42.68 --to 9.42,42.70 "$out/none.geojso
 # The Bézier router answers the same question.
 "$bin" -q path "$dem" --from 9.30,42.68 --to 9.42,42.70 "$out/bezier.geojson" --router bezier --bezier-evaluations 200
 grep -q '"router": "bezier"' "$out/bezier.geojson"
+# --water-mask: a 1 km band of water across the cape (3 cells at 9.355-9.365 E), as a run's
+# water.water_mask: the road bridges it (no bridge without it); without bridges and tunnels the two
+# sides are two land masses, joined by a ferry.
+/usr/bin/python3 - "$dem" "$out/band.tif" <<'PY'
+import sys
+import numpy as np
+from osgeo import gdal
+src = gdal.Open(sys.argv[1])
+gt = src.GetGeoTransform()
+band = np.zeros((src.RasterYSize, src.RasterXSize), np.uint8)
+band[:, int((9.355 - gt[0]) / gt[1]):int((9.365 - gt[0]) / gt[1]) + 1] = 1
+out = gdal.GetDriverByName('GTiff').Create(sys.argv[2], src.RasterXSize, src.RasterYSize, 1, gdal.GDT_Byte)
+out.SetGeoTransform(gt)
+out.SetProjection('EPSG:4326')
+out.GetRasterBand(1).WriteArray(band)
+PY
+line() { "$bin" -v path "$dem" --from 9.30,42.68 --to 9.42,42.70 "$out/$1.geojson" "${@:2}" 2>&1 | grep '^galin:'; }
+[[ $(line dry) == *"bridges 0 m"* ]] || { echo "a bridge without the band"; exit 1; }
+wet=$(line wet --water-mask "$out/band.tif")
+[[ $wet =~ bridges\ ([0-9]+)\ m && ${BASH_REMATCH[1]} -ge 1000 ]] || { echo "no bridge over the masked band: $wet"; exit 1; }
+"$bin" -q path "$dem" --from 9.30,42.68 --to 9.42,42.70 "$out/ferry.geojson" --water-mask "$out/band.tif" --no-bridges --no-tunnels
+grep -q '"router": "ferry"' "$out/ferry.geojson" || { echo "no ferry across the masked band"; exit 1; }
+refuse "missing.tif" --from 9.30,42.68 --to 9.42,42.70 --water-mask "$out/missing.tif"
