@@ -69,27 +69,11 @@ int VectorLayer::field_index(const std::string& field) const {
   return -1;
 }
 
-void write_vector(const std::string& path, const VectorLayer& layer, bool overwrite) {
-  init_gdal();
-  detail::check_output(path, overwrite);
-  const std::string ext = lower_extension(path);
-  const bool geojson = ext == ".geojson" || ext == ".json";
-  if (!geojson && ext != ".gpkg") throw bad_input(path + ": unknown vector format (use .geojson or .gpkg)");
-  GDALDriver* driver = GetGDALDriverManager()->GetDriverByName(geojson ? "GeoJSON" : "GPKG");
-  // OGR's GeoJSON writer does not check its writes: build the file in memory, then write its bytes
-  // with every write checked (a full disk fails the command instead of leaving a cut file).
-  static std::atomic<int> serial{0};
-  const std::string mem = "/vsimem/terrapolis-" + std::to_string(serial++) + ext;
-  std::optional<detail::QuietGdal> quiet(std::in_place);
-  auto fail = [&](GDALDataset* ds, const std::string& what) {
-    const std::string msg = detail::last_gdal_error(what);
-    if (ds) GDALClose(GDALDataset::ToHandle(ds));
-    quiet.reset();
-    VSIUnlink(mem.c_str());
-    throw processing_error(path + ": cannot write output (" + msg + ")");
-  };
-  GDALDataset* ds = driver->Create(mem.c_str(), 0, 0, 0, GDT_Unknown, nullptr);
-  if (!ds) fail(ds, "create failed");
+namespace {
+
+/// Writes one layer into `ds` (the caller's dataset of `path`); throws through `fail`.
+template <class Fail>
+void add_layer(GDALDataset* ds, const VectorLayer& layer, bool geojson, const Fail& fail) {
   OGRSpatialReference srs = detail::to_ogr(layer.crs);
   CPLStringList lco;
   if (geojson) {
@@ -97,12 +81,11 @@ void write_vector(const std::string& path, const VectorLayer& layer, bool overwr
     lco.SetNameValue("WRITE_NAME", "YES");
   }
   OGRLayer* out = ds->CreateLayer(layer.name.c_str(), &srs, ogr_type(layer.geometry), lco.List());
-  if (!out) fail(ds, "layer creation failed");
+  if (!out) fail("layer creation failed");
   for (const auto& f : layer.fields) {
     OGRFieldDefn def(f.name.c_str(), f.type == FieldType::integer ? OFTInteger64 : f.type == FieldType::real ? OFTReal : OFTString);
-    if (out->CreateField(&def) != OGRERR_NONE) fail(ds, "field creation failed");
+    if (out->CreateField(&def) != OGRERR_NONE) fail("field creation failed");
   }
-  if (!geojson) ds->StartTransaction();
   for (const auto& f : layer.features) {
     OGRFeature feature(out->GetLayerDefn());
     for (std::size_t i = 0; i < layer.fields.size() && i < f.values.size(); ++i) {
@@ -117,10 +100,82 @@ void write_vector(const std::string& path, const VectorLayer& layer, bool overwr
       geometry->assignSpatialReference(&srs);
       feature.SetGeometryDirectly(geometry.release());
     }
-    if (out->CreateFeature(&feature) != OGRERR_NONE) fail(ds, "feature write failed");
+    if (out->CreateFeature(&feature) != OGRERR_NONE) fail("feature write failed");
   }
-  if (!geojson && ds->CommitTransaction() != OGRERR_NONE) fail(ds, "commit failed");
+}
+
+/// The layer_styles table as QGIS writes it into a GeoPackage: QGIS applies the row whose
+/// f_table_name is a layer's and useAsDefault is set when it loads that layer.
+template <class Fail>
+void add_styles(GDALDataset* ds, const std::vector<LayerStyle>& styles, const Fail& fail) {
+  OGRLayer* table = ds->CreateLayer("layer_styles", nullptr, wkbNone, nullptr);
+  if (!table) fail("layer_styles creation failed");
+  const char* text_fields[] = {"f_table_catalog", "f_table_schema", "f_table_name", "f_geometry_column", "styleName",
+                               "styleQML",        "styleSLD",       "description",  "owner",             "ui"};
+  for (const char* name : text_fields) {
+    OGRFieldDefn def(name, OFTString);
+    if (table->CreateField(&def) != OGRERR_NONE) fail("layer_styles field creation failed");
+  }
+  OGRFieldDefn use("useAsDefault", OFTInteger);
+  use.SetSubType(OFSTBoolean);
+  OGRFieldDefn time("update_time", OFTDateTime);
+  if (table->CreateField(&use) != OGRERR_NONE || table->CreateField(&time) != OGRERR_NONE) fail("layer_styles field creation failed");
+  for (const LayerStyle& st : styles) {
+    OGRFeature row(table->GetLayerDefn());
+    row.SetField("f_table_catalog", "");
+    row.SetField("f_table_schema", "");
+    row.SetField("f_table_name", st.layer.c_str());
+    row.SetField("f_geometry_column", "geom");
+    row.SetField("styleName", st.layer.c_str());
+    row.SetField("styleQML", st.qml.c_str());
+    row.SetField("styleSLD", "");
+    row.SetField("description", st.description.c_str());
+    row.SetField("owner", "");
+    row.SetField("ui", "");
+    row.SetField("useAsDefault", 1);
+    row.SetField("update_time", 2000, 1, 1, 0, 0, 0.0f, 100);  // fixed: the same run gives the same bytes
+    if (table->CreateFeature(&row) != OGRERR_NONE) fail("layer_styles write failed");
+  }
+}
+
+}  // namespace
+
+void write_vector(const std::string& path, const VectorLayer& layer, bool overwrite) { write_vectors(path, {&layer}, {}, overwrite); }
+
+void write_vectors(const std::string& path, const std::vector<const VectorLayer*>& layers, const std::vector<LayerStyle>& styles,
+                   bool overwrite) {
+  init_gdal();
+  detail::check_output(path, overwrite);
+  const std::string ext = lower_extension(path);
+  const bool geojson = ext == ".geojson" || ext == ".json";
+  if (!geojson && ext != ".gpkg") throw bad_input(path + ": unknown vector format (use .geojson or .gpkg)");
+  if (geojson && (layers.size() != 1 || !styles.empty())) throw processing_error(path + ": a GeoJSON file holds one layer and no style");
+  GDALDriver* driver = GetGDALDriverManager()->GetDriverByName(geojson ? "GeoJSON" : "GPKG");
+  // OGR's GeoJSON writer does not check its writes: build the file in memory, then write its bytes
+  // with every write checked (a full disk fails the command instead of leaving a cut file).
+  static std::atomic<int> serial{0};
+  const std::string mem = "/vsimem/terrapolis-" + std::to_string(serial++) + ext;
+  std::optional<detail::QuietGdal> quiet(std::in_place);
+  // A GeoPackage records when each table changed (gpkg_contents.last_change): a fixed date, so
+  // the same run gives the same bytes.
+  CPLSetThreadLocalConfigOption("OGR_CURRENT_DATE", "2000-01-01T00:00:00.000Z");
+  GDALDataset* ds = nullptr;
+  auto fail = [&](const std::string& what) {
+    const std::string msg = detail::last_gdal_error(what);
+    if (ds) GDALClose(GDALDataset::ToHandle(ds));
+    CPLSetThreadLocalConfigOption("OGR_CURRENT_DATE", nullptr);
+    quiet.reset();
+    VSIUnlink(mem.c_str());
+    throw processing_error(path + ": cannot write output (" + msg + ")");
+  };
+  ds = driver->Create(mem.c_str(), 0, 0, 0, GDT_Unknown, nullptr);
+  if (!ds) fail("create failed");
+  if (!geojson) ds->StartTransaction();
+  for (const VectorLayer* layer : layers) add_layer(ds, *layer, geojson, fail);
+  if (!styles.empty()) add_styles(ds, styles, fail);
+  if (!geojson && ds->CommitTransaction() != OGRERR_NONE) fail("commit failed");
   GDALClose(GDALDataset::ToHandle(ds));
+  CPLSetThreadLocalConfigOption("OGR_CURRENT_DATE", nullptr);
   const bool closed = CPLGetLastErrorType() < CE_Failure;
   const std::string msg = detail::last_gdal_error("write failed");
   quiet.reset();

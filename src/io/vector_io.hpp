@@ -44,6 +44,19 @@ struct VectorLayer {
 /// right-hand rule, no crs member), ".gpkg" as GeoPackage in the layer's CRS. Temporary name, then rename.
 void write_vector(const std::string& path, const VectorLayer& layer, bool overwrite = false);
 
+/// A QGIS style for one layer of a GeoPackage (its layer_styles table).
+struct LayerStyle {
+  std::string layer;        ///< the layer's name
+  std::string qml;          ///< the whole .qml document
+  std::string description;
+};
+
+/// Writes several layers into one GeoPackage (".gpkg", each in its CRS), with `styles` in its
+/// layer_styles table as each layer's default QGIS style; a ".geojson" path takes one layer and no
+/// style. Temporary name, then rename; the same layers give the same bytes.
+void write_vectors(const std::string& path, const std::vector<const VectorLayer*>& layers, const std::vector<LayerStyle>& styles,
+                   bool overwrite = false);
+
 /// Reads the first layer of any OGR vector file with its coordinates transformed to `target`.
 /// Multi-geometries are split into single features (attributes repeated).
 VectorLayer read_vector(const std::string& path, const Crs& target);

@@ -260,6 +260,27 @@ std::string qgis_style_body(const OutputFile& o, const RunState& state) {
   return "";
 }
 
+std::string qgis_style(const OutputFile& output, const RunState& state) {
+  return "<!DOCTYPE qgis PUBLIC 'http://mrcc.com/qgis.dtd' 'SYSTEM'>\n<qgis version=\"3.22.16\" styleCategories=\"AllStyleCategories\">" +
+         qgis_style_body(output, state) + "<blendMode>0</blendMode></qgis>\n";
+}
+
+void write_geopackage(const RunState& state, const std::string& path) {
+  // Read back from the run's GeoJSON files, so a rerun that reuses saved stages (--from) writes the
+  // same GeoPackage as the run that saved them.
+  std::vector<VectorLayer> layers;
+  std::vector<LayerStyle> styles;
+  for (const OutputFile& o : state.outputs) {
+    if (o.raster) continue;
+    layers.push_back(read_vector((state.folder / o.name).string(), state.dem.georef().crs));
+    layers.back().name = stem(o.name);
+    styles.push_back({stem(o.name), qgis_style(o, state), o.description});
+  }
+  std::vector<const VectorLayer*> pointers;
+  for (const VectorLayer& l : layers) pointers.push_back(&l);
+  write_vectors(path, pointers, styles, true);
+}
+
 void write_qgis_styles_and_project(const RunState& state) {
   const std::string srs = spatialrefsys(crs_definition(state.dem.georef().crs));
   const std::string srs_lonlat = spatialrefsys(crs_definition(wgs84()));
@@ -290,9 +311,7 @@ void write_qgis_styles_and_project(const RunState& state) {
   }
   for (auto* o : layers) {
     const std::string body = qgis_style_body(*o, state);
-    const std::string qml = "<!DOCTYPE qgis PUBLIC 'http://mrcc.com/qgis.dtd' 'SYSTEM'>\n<qgis version=\"3.22.16\" styleCategories=\"AllStyleCategories\">" +
-                            body + "<blendMode>0</blendMode></qgis>\n";
-    write_text_file((state.folder / (stem(o->name) + ".qml")).string(), qml, true);
+    write_text_file((state.folder / (stem(o->name) + ".qml")).string(), qgis_style(*o, state), true);
     project_layers << "<maplayer type=\"" << (o->raster ? "raster" : "vector") << "\""
                    << (o->raster ? "" : " geometry=\"\"") << "><id>" << layer_id(*o) << "</id><datasource>./" << o->name
                    << "</datasource><layername>" << escape(stem(o->name)) << "</layername><srs>" << (o->raster ? srs : srs_lonlat)

@@ -46,6 +46,15 @@ if /usr/bin/python3 -c "import qgis.core" 2>/dev/null; then
 else
   fail "python3-qgis is not installed (scripts/setup installs it)"
 fi
+# outputs.geopackage: every vector layer in run.gpkg, styled by default in QGIS, the same bytes at
+# any thread count and from a rerun that reuses the saved stages.
+"$TP" --quiet run -o gpkg1 --set outputs.geopackage=true --set outputs.preview=false
+"$TP" --quiet --threads 1 run -o gpkg2 --set outputs.geopackage=true --set outputs.preview=false
+cmp -s gpkg1/run.gpkg gpkg2/run.gpkg || fail "run.gpkg differs between two runs of the same scenario"
+"$TP" --quiet run -o gpkg1 --from network --set outputs.geopackage=true --set outputs.preview=false
+cmp -s gpkg1/run.gpkg gpkg2/run.gpkg || fail "run.gpkg differs after a rerun --from network"
+[[ ! -e run1/run.gpkg ]] || fail "run.gpkg written by default"
+QT_QPA_PLATFORM=offscreen XDG_RUNTIME_DIR=$WORK /usr/bin/python3 "$SOURCE/tests/qgis/check_geopackage.py" gpkg1
 echo "run: ok"
 
 # Reruns from saved results: --from reads the earlier stages back, --only reruns just some.

@@ -7,24 +7,20 @@ and feature count (read from run.json), styles applied (renderer type), every la
 transformed to the project CRS inside the DEM's (vectors in degrees over rasters in metres on a
 projected run), the cities drawn over the rasters, and the project renders to a non-empty image.
 """
-import json
 import os
 import sys
 
 os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
-from qgis.core import (QgsApplication, QgsProject, QgsMapSettings, QgsMapRendererParallelJob,
+from qgis.core import (QgsMapSettings, QgsMapRendererParallelJob,
                        QgsRasterLayer, QgsVectorLayer, QgsCoordinateReferenceSystem, QgsRectangle,
                        QgsCoordinateTransform)
 from qgis.PyQt.QtCore import QSize
 from qgis.PyQt.QtGui import QColor
 
+from run_project import open_run
+
 run, png = sys.argv[1], sys.argv[2]
-manifest = json.load(open(os.path.join(run, "run.json")))
-app = QgsApplication([], False)
-app.initQgis()
-project = QgsProject.instance()
-if not project.read(os.path.join(run, "project.qgs")):
-    sys.exit("project.qgs does not open: " + project.error())
+manifest, project, app = open_run(run)
 
 expected = {os.path.splitext(o["file"])[0]: o for o in manifest["outputs"] if o["kind"] in ("raster", "vector")}
 layers = {l.name(): l for l in project.mapLayers().values()}
