@@ -3,10 +3,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <string>
 
 #include "core/error.hpp"
 #include "core/geodesy.hpp"
+#include "hydro/catchment.hpp"
 #include "io/crs.hpp"
 #include "roads/radix_heap.hpp"
 #include "roads/road_class.hpp"
@@ -202,6 +204,41 @@ Coverage coverage(const Raster<float>& minutes, const Raster<float>& people, con
       }
   }
   return c;
+}
+
+VectorLayer catchments_layer(const AccessResult& times, const Raster<float>& weight, const std::string& counted,
+                             const std::vector<Settlement>& settlements) {
+  struct Figures {
+    double people = 0, area_m2 = 0, minutes_people = 0;
+  };
+  std::map<std::int32_t, Figures> by_id;
+  const Raster<std::int32_t>& nearest = times.nearest;
+  const CellMetrics metrics = cell_metrics(nearest.georef(), nearest.cols(), nearest.rows());
+  for (int r = 0; r < nearest.rows(); ++r)
+    for (int c = 0; c < nearest.cols(); ++c) {
+      const std::int32_t id = nearest(c, r);
+      if (id < 0) continue;
+      Figures& f = by_id[id];
+      f.area_m2 += metrics.area_m2[std::size_t(r)];
+      const double p = weight(c, r);
+      if (p > 0) f.people += p, f.minutes_people += p * double(times.minutes(c, r));
+    }
+  std::map<std::int32_t, double> population;
+  for (const Settlement& s : settlements) population[s.at.id] = s.population;
+  VectorLayer layer;
+  layer.name = "access_catchments";
+  layer.geometry = GeometryType::polygon;
+  layer.crs = nearest.georef().crs;
+  layer.fields = {{"id", FieldType::integer}, {"population", FieldType::integer}, {counted, FieldType::real},
+                  {"area_km2", FieldType::real}, {"mean_minutes", FieldType::real}};
+  for (auto& [id, feature] : hydro::polygonize_labels(nearest)) {
+    const Figures& f = by_id[id];
+    feature.values = {std::int64_t(id), std::int64_t(std::llround(population[id])), std::round(f.people * 100) / 100,
+                      std::round(f.area_m2 / 1e4) / 100,
+                      f.people > 0 ? FieldValue(std::round(f.minutes_people / f.people * 10) / 10) : FieldValue(std::monostate{})};
+    layer.features.push_back(std::move(feature));
+  }
+  return layer;
 }
 
 void for_each_level(const Raster<float>& dem, const Raster<std::uint8_t>& passable, const RoadCells& roads,

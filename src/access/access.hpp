@@ -80,6 +80,15 @@ struct Settlement {
   double population = 0;
 };
 
+/// The catchment of each settlement reached (the cells nearest to it in time) as polygons, in the
+/// DEM's CRS: fields id (cities.geojson), population (the settlement's), `counted` (the sum of
+/// `weight` over the catchment: "people", or "land_km2" when the weight is each cell's land area),
+/// area_km2 (geodesic), mean_minutes (weighted by `weight`; null where it sums to 0). A catchment
+/// that water or an unreached area splits has one feature per part, each with the whole
+/// catchment's figures.
+VectorLayer catchments_layer(const AccessResult& times, const Raster<float>& weight, const std::string& counted,
+                             const std::vector<Settlement>& settlements);
+
 /// What one size level gives: the settlements of at least `level` people as destinations.
 struct LevelFigures {
   double level = 0;              ///< 0: every settlement

@@ -131,6 +131,7 @@ class AccessCommand final : public Command {
         w.description = "Id of the settlement nearest in time, -1 where none is reached";
         w.metadata[2] = {"UNIT", "id"};
         write_raster((dir / "access_nearest.tif").string(), f.times.nearest, w);
+        write_vector((dir / "access_catchments.geojson").string(), access::catchments_layer(f.times, weight, unit, places.all));
       }
       const access::Coverage& c = f.coverage;
       nlohmann::ordered_json within = nlohmann::ordered_json::object();

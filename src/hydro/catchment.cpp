@@ -17,35 +17,33 @@
 
 namespace terrapolis::hydro {
 
-std::vector<Feature> polygonize(const Raster<std::uint8_t>& mask) {
+std::vector<std::pair<std::int32_t, Feature>> polygonize_labels(const Raster<std::int32_t>& labels) {
   init_gdal();
   GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");
-  if (!mem) throw processing_error("catchment: GDAL's MEM driver is missing");
-  std::unique_ptr<GDALDataset> ds(mem->Create("", mask.cols(), mask.rows(), 1, GDT_Byte, nullptr));
-  GeoTransform gt = mask.georef().transform;
+  if (!mem) throw processing_error("polygonize: GDAL's MEM driver is missing");
+  std::unique_ptr<GDALDataset> ds(mem->Create("", labels.cols(), labels.rows(), 1, GDT_Int32, nullptr));
+  GeoTransform gt = labels.georef().transform;
   ds->SetGeoTransform(gt.data());
   GDALRasterBand* band = ds->GetRasterBand(1);
-  std::vector<std::uint8_t> binary(mask.size());
-  for (std::size_t i = 0; i < mask.size(); ++i) binary[i] = mask[i] == 1 ? 1 : 0;
-  if (band->RasterIO(GF_Write, 0, 0, mask.cols(), mask.rows(), binary.data(), mask.cols(), mask.rows(), GDT_Byte, 0, 0) !=
-      CE_None)
-    throw processing_error("catchment: cannot fill the in-memory mask");
+  if (band->RasterIO(GF_Write, 0, 0, labels.cols(), labels.rows(), const_cast<std::int32_t*>(labels.values().data()), labels.cols(),
+                     labels.rows(), GDT_Int32, 0, 0) != CE_None)
+    throw processing_error("polygonize: cannot fill the in-memory raster");
   GDALDriver* vmem = GetGDALDriverManager()->GetDriverByName("Memory");
   if (!vmem) vmem = GetGDALDriverManager()->GetDriverByName("MEM");
   std::unique_ptr<GDALDataset> vds(vmem->Create("", 0, 0, 0, GDT_Unknown, nullptr));
-  OGRLayer* layer = vds->CreateLayer("catchment", nullptr, wkbPolygon, nullptr);
+  OGRLayer* layer = vds->CreateLayer("labels", nullptr, wkbPolygon, nullptr);
   OGRFieldDefn field("value", OFTInteger);
   layer->CreateField(&field);
   char** options = CSLSetNameValue(nullptr, "8CONNECTED", "8");
-  const CPLErr err = GDALPolygonize(band, band, layer, 0, options, nullptr, nullptr);
+  const CPLErr err = GDALPolygonize(band, nullptr, layer, 0, options, nullptr, nullptr);
   CSLDestroy(options);
-  if (err != CE_None) throw processing_error("catchment: GDALPolygonize failed");
-  std::vector<Feature> out;
+  if (err != CE_None) throw processing_error("polygonize: GDALPolygonize failed");
+  std::vector<std::pair<std::int32_t, Feature>> out;
   layer->ResetReading();
   for (auto& feature : *layer) {
-    if (feature->GetFieldAsInteger(0) != 1) continue;
+    const std::int32_t value = feature->GetFieldAsInteger(0);
     const OGRGeometry* g = feature->GetGeometryRef();
-    if (!g || wkbFlatten(g->getGeometryType()) != wkbPolygon) continue;
+    if (value < 0 || !g || wkbFlatten(g->getGeometryType()) != wkbPolygon) continue;
     const auto* poly = g->toPolygon();
     Feature f;
     auto ring_points = [](const OGRLinearRing* ring) {
@@ -55,8 +53,17 @@ std::vector<Feature> polygonize(const Raster<std::uint8_t>& mask) {
     };
     f.parts.push_back(ring_points(poly->getExteriorRing()));
     for (int h = 0; h < poly->getNumInteriorRings(); ++h) f.parts.push_back(ring_points(poly->getInteriorRing(h)));
-    out.push_back(std::move(f));
+    out.emplace_back(value, std::move(f));
   }
+  return out;
+}
+
+std::vector<Feature> polygonize(const Raster<std::uint8_t>& mask) {
+  Raster<std::int32_t> labels = mask.like<std::int32_t>(-1);
+  for (std::size_t i = 0; i < mask.size(); ++i)
+    if (mask[i] == 1) labels[i] = 1;
+  std::vector<Feature> out;
+  for (auto& [value, f] : polygonize_labels(labels)) out.push_back(std::move(f));
   return out;
 }
 

@@ -2,6 +2,8 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 #include <cstdint>
+#include <utility>
+#include <vector>
 
 #include "core/geodesy.hpp"
 #include "core/progress.hpp"
@@ -22,6 +24,8 @@ struct Catchment {
 /// Polygons (outer ring, then holes; DEM CRS; 8-connected) of the cells of `mask` equal to 1,
 /// by GDALPolygonize. Fields are left empty. Also the lakes' shorelines.
 std::vector<Feature> polygonize(const Raster<std::uint8_t>& mask);
+/// Polygons of the regions of equal label (8-connected; labels < 0 are none), each with its label.
+std::vector<std::pair<std::int32_t, Feature>> polygonize_labels(const Raster<std::int32_t>& labels);
 
 /// The cells whose D8 path passes through the outlet. The outlet (x, y) in the DEM's CRS is
 /// snapped to the cell of highest upstream area whose centre lies within `snap_radius_m` metres

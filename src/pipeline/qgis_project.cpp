@@ -146,7 +146,7 @@ int draw_rank(Style s) {
     case Style::flow_direction: case Style::accumulation: case Style::unit_ramp: return 2;
     case Style::mask: case Style::water: return 3;
     case Style::density: case Style::access_minutes: return 4;
-    case Style::city_extents: return 5;
+    case Style::city_extents: case Style::access_catchments: return 5;
     case Style::streams: return 6;
     case Style::network: return 7;
     case Style::corridors: return 8;
@@ -252,6 +252,7 @@ std::string qgis_style_body(const OutputFile& o, const RunState& state) {
       return categorized("class", cats);
     }
     case Style::corridors: return roads::corridors_renderer();
+    case Style::access_catchments: return single(fill("0", "0,0,0,0", "37,37,37,255"));  // outlines over the travel times
     case Style::access_minutes:
       return pseudocolor({{15, "#1a9850", "15 min or less"}, {30, "#91cf60", "15-30 min"}, {60, "#fee08b", "30-60 min"},
                           {120, "#fc8d59", "1-2 h"}, {1e9, "#d73027", "over 2 h"}},

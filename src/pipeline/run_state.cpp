@@ -15,7 +15,8 @@ constexpr std::pair<Style, const char*> kStyleNames[] = {
     {Style::accumulation, "accumulation"}, {Style::streams, "streams"},   {Style::cities, "cities"},
     {Style::city_extents, "city_extents"}, {Style::network, "network"},   {Style::roads, "roads"},
     {Style::road_sections, "road_sections"}, {Style::sections, "sections"}, {Style::junctions, "junctions"}, {Style::existing_roads, "existing_roads"},
-    {Style::corridors, "corridors"}, {Style::access_minutes, "access_minutes"}};
+    {Style::corridors, "corridors"}, {Style::access_minutes, "access_minutes"},
+    {Style::access_catchments, "access_catchments"}};
 }  // namespace
 
 const char* style_name(Style style) {

@@ -22,7 +22,7 @@ namespace terrapolis::pipeline {
 /// How a layer is drawn in QGIS and in the preview.
 enum class Style { elevation, hillshade, unit_ramp, density, mask, water, flow_direction, accumulation,
                    streams, cities, city_extents, network, roads, road_sections, sections, junctions, corridors, access_minutes,
-                   existing_roads };
+                   existing_roads, access_catchments };
 
 /// Style names as recorded in run.json ("elevation", "road_sections"...), and back.
 const char* style_name(Style style);

@@ -465,9 +465,13 @@ void access_run(RunState& s, Progress& progress, const Log& log) {
     const std::string whom = all ? "the nearest settlement" : "a settlement of " + f.key + " people or more";
     s.write("access", all ? "access_minutes.tif" : "access_minutes_" + f.key + ".tif", f.times.minutes,
             "travel time to " + whom + ", minutes (on foot off the roads, by road on them)", Style::access_minutes, {{"UNIT", "min"}});
-    if (all)
+    if (all) {
       s.write("access", "access_nearest.tif", f.times.nearest, "id of the settlement nearest in time (cities.geojson), -1 where none is reached",
               Style::unit_ramp);
+      s.write("access", "access_catchments.geojson", access::catchments_layer(f.times, people, "people", settlements),
+              "catchment of each settlement (the land nearest to it in time): its people, area (km2) and mean time (minutes)",
+              Style::access_catchments);
+    }
     const access::Coverage& c = f.coverage;
     json within = json::object();
     for (std::size_t k = 0; k < a.thresholds_minutes.size(); ++k) {

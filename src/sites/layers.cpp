@@ -88,7 +88,8 @@ VectorLayer city_extents_layer(const SitesResult& result, const Crs& crs, int ve
 
 std::vector<Site> sites_from_layer(const VectorLayer& layer, const std::string& path) {
   if (!layer.features.empty() && layer.geometry != GeometryType::point) throw bad_input(path + ": cities must be points");
-  const int radius = layer.field_index("radius_m"), id = layer.field_index("id"), parent = layer.field_index("parent");
+  const int radius = layer.field_index("radius_m"), id = layer.field_index("id"), parent = layer.field_index("parent"),
+            population = layer.field_index("population");
   if (radius < 0) throw bad_input(path + ": no radius_m field (the radius of each city, metres)");
   auto number = [&](const Feature& f, int field, std::size_t k) -> std::optional<double> {
     const auto& v = f.values[std::size_t(field)];
@@ -113,6 +114,7 @@ std::vector<Site> sites_from_layer(const VectorLayer& layer, const std::string& 
     s.id = int(*given);
     if (!index_of.emplace(std::int64_t(*given), int(k)).second) throw bad_input(path + ": id " + std::to_string(s.id) + " is used twice");
     parents.push_back(parent >= 0 ? number(f, parent, k) : std::nullopt);
+    if (const auto p = population >= 0 ? number(f, population, k) : std::nullopt) s.population = std::llround(*p);
     sites.push_back(s);
   }
   for (std::size_t k = 0; k < sites.size(); ++k) {

@@ -19,7 +19,7 @@ VectorLayer city_extents_layer(const SitesResult& result, const Crs& crs, int ve
 
 /// Sites from a cities layer (a planner's own or `cities_layer`'s): points with radius_m
 /// (metres, > 0); optional id (unique integers, default the feature's position) and parent
-/// (an id, null or absent for roots). Parents become indices into the returned list.
+/// (an id, null or absent for roots), population (people, default 0). Parents become indices into the returned list.
 /// Throws bad_input naming `path` for a missing field, a bad value or an unknown parent.
 std::vector<Site> sites_from_layer(const VectorLayer& layer, const std::string& path);
 

@@ -28,6 +28,25 @@ z = d.GetRasterBand(1).ReadAsArray()
 assert all(math.isnan(t[i, j]) for i in range(z.shape[0]) for j in range(z.shape[1]) if z[i, j] < -50), "the sea has a travel time"
 assert (t == 0).sum() >= 30, "every settlement's cell is 0 minutes away"
 PY
+# The catchments: one per settlement reached, with the nearest raster's cells; their people add
+# up to the region's (less those who reach none) and their areas to the reached land.
+/usr/bin/python3 - <<'PY' || fail "access_catchments.geojson"
+import json
+import numpy as np
+from osgeo import gdal
+m = json.load(open("run/run.json"))
+a = m["summary"]["access"]
+features = json.load(open("run/access_catchments.geojson"))["features"]
+per_id = {f["properties"]["id"]: f["properties"] for f in features}
+nearest = gdal.Open("run/access_nearest.tif").ReadAsArray()
+assert sorted(per_id) == sorted(int(v) for v in np.unique(nearest) if v >= 0), "catchment ids are not the nearest raster's"
+people = sum(p["people"] for p in per_id.values())
+expected = a["people"] - a["levels"]["all"]["unreachable_people"]
+assert abs(people - expected) <= 0.001 * expected, (people, expected)
+cities = {f["properties"]["id"]: f["properties"]["population"] for f in json.load(open("run/cities.geojson"))["features"]}
+assert all(p["population"] == cities[i] for i, p in per_id.items()), "a catchment's population is not its city's"
+assert all(p["area_km2"] > 0 and p["mean_minutes"] is None or p["mean_minutes"] >= 0 for p in per_id.values())
+PY
 grep -q '"access_minutes.tif"' run/.terrapolis-outputs.json || fail "not in the manifest"
 grep -q 'access_minutes.tif' run/project.qgs || fail "not in the QGIS project"
 
@@ -47,6 +66,8 @@ PY
 gdal_calc.py --quiet -A run/density.tif --outfile people.tif --type Float32 --calc "(A>0)*100" --NoDataValue -1
 "$TP" -q access "$dem" counted --to run/cities.geojson --people people.tif
 grep -q '"unit": "people"' counted/access.json || fail "--people: not counted in people"
+grep -q '"people":' counted/access_catchments.geojson || fail "--people: catchments not counted in people"
+grep -q '"land_km2":' with/access_catchments.geojson || fail "catchments not counted in land km2"
 
 # What a scenario changes: more links kept (network.k 1.3) bring some cells closer.
 cp -r run denser
