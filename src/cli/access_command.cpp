@@ -86,7 +86,7 @@ class AccessCommand final : public Command {
                                                   "without it the figures are km2 of land"),
               FileKind::raster_in);
     schema_.setup(app, name());
-    app.add_flag("--overwrite", overwrite_, "Replace the outputs a previous terrapolis command wrote");
+    add_overwrite_flag(app, overwrite_);
   }
 
   void run(Context& context) override {

@@ -119,7 +119,7 @@ class CalibrateCommand final : public Command {
     app.add_option("--ridge", ridge_, "Ridge penalty on the weights (times the total weight)")->check(CLI::NonNegativeNumber)->capture_default_str();
     app.add_option("--terms", terms_, "Terms to fit, the others weigh 0 (default: every term: " + join(density::term_names()) + ")")->delimiter(',');
     app.add_option("--seed", seed_, "Seed of the background sample and of the folds")->capture_default_str();
-    app.add_flag("--overwrite", overwrite_, "Replace existing --fragment / --report files");
+    add_overwrite_flag(app, overwrite_);
   }
 
   void run(Context& context) override {

@@ -43,7 +43,7 @@ class CatchmentCommand final : public Command {
     app.add_option("--fill", fill_, "Depression handling: priority-flood, epsilon, breach, none")
         ->check(CLI::IsMember({"priority-flood", "epsilon", "breach", "none"}))->capture_default_str();
     app.add_option("--sea-level", sea_level_, "Cells at or below this elevation (m) are outlets (default: off)");
-    app.add_flag("--overwrite", overwrite_, "Replace the outputs a previous terrapolis command wrote");
+    add_overwrite_flag(app, overwrite_);
   }
 
   void run(Context& context) override {

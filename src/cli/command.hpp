@@ -31,6 +31,10 @@ class Command {
   virtual void run(Context& context) = 0;
 };
 
+/// Declares --overwrite, the same for every command: replace what a previous terrapolis command
+/// wrote (OutputSet's contract, docs/safety.md).
+void add_overwrite_flag(CLI::App& app, bool& overwrite);
+
 /// Parses the command line and runs its command; returns the exit code (errors printed on stderr).
 int run_command_line(int argc, char** argv);
 

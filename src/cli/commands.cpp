@@ -3,7 +3,14 @@
 #include "cli/command.hpp"
 #include "cli/commands_list.hpp"
 
+#include <CLI/CLI.hpp>
+
 namespace terrapolis::cli {
+
+void add_overwrite_flag(CLI::App& app, bool& overwrite) {
+  app.add_flag("--overwrite", overwrite,
+               "Replace the outputs a previous terrapolis command wrote (a file or folder it did not write is refused, never replaced)");
+}
 
 std::vector<std::unique_ptr<Command>> all_commands() {
   std::vector<std::unique_ptr<Command>> commands;

@@ -35,7 +35,7 @@ class CompareCommand final : public Command {
     file_kind(app.add_option("--save", save_, "Also write the comparison to this file (text, or JSON with --json)"), FileKind::file_out);
     file_kind(app.add_option("--changes", changes_, "Also write where the travel times changed (access_minutes*_change.tif: B - A, minutes) into this folder"),
               FileKind::folder_out);
-    app.add_flag("--overwrite", overwrite_, "Replace the --save file and the --changes folder if they exist");
+    add_overwrite_flag(app, overwrite_);
   }
   void run(Context&) override {
     const auto a = pipeline::load_manifest(a_);

@@ -23,7 +23,7 @@ class ConvertCommand final : public Command {
     input_.add_to(app);
     file_kind(app.add_option("OUT", out_, "Output GeoTIFF")->required(), FileKind::raster_out);
     app.add_flag("--cog", cog_, "Cloud Optimized GeoTIFF layout");
-    app.add_flag("--overwrite", overwrite_, "Replace OUT if it exists");
+    add_overwrite_flag(app, overwrite_);
   }
   void run(Context& context) override {
     OutputSet outputs("convert", {input_.path}, overwrite_);

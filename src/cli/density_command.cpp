@@ -97,7 +97,7 @@ class DensityCommand final : public Command {
     plugins_.setup(app, "adds its density factor, combined like a --layer of that weight, and its exclusions");
     app.add_flag("--report", report_, "Print the buildable share and the density histogram");
     app.add_flag("--cog", cog_, "Write Cloud Optimized GeoTIFFs");
-    app.add_flag("--overwrite", overwrite_, "Replace existing outputs");
+    add_overwrite_flag(app, overwrite_);
   }
 
   void run(Context& context) override {

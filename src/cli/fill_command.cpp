@@ -29,7 +29,7 @@ class FillCommand final : public Command {
     app.add_option("--max-void-km2", max_void_km2_, "Voids larger than this (km2, geodesic) stay nodata")->check(CLI::PositiveNumber);
     app.add_option("--sea-level", sea_level_m_, "Cells at or below this height (m) connected to the border are sea; voids touching the sea are not filled");
     app.add_flag("--fill-border-voids", fill_border_, "Also fill nodata connected to the grid border (by default it is outside the DEM)");
-    app.add_flag("--overwrite", overwrite_, "Replace OUT if it exists");
+    add_overwrite_flag(app, overwrite_);
   }
 
   void run(Context& context) override {

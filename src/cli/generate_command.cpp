@@ -85,7 +85,7 @@ class GenerateCommand final : public Command {
                                              "Warped onto the grid if it has a CRS, else it must have the grid's size"), FileKind::raster_in);
     options_.add(app, false, 1000.0);
     skeleton_options_.add(app);
-    app.add_flag("--overwrite", overwrite_, "Replace OUT if it exists");
+    add_overwrite_flag(app, overwrite_);
   }
 
   void run(Context& context) override {

@@ -55,7 +55,7 @@ class HydroCommand final : public Command {
     app.add_option("--outputs", outputs_, "Outputs to write, comma-separated: filled,flowdir,accumulation,hydrometry,streams,basins")
         ->capture_default_str();
     app.add_flag("--cog", cog_, "Write Cloud Optimized GeoTIFFs");
-    app.add_flag("--overwrite", overwrite_, "Replace the outputs a previous terrapolis command wrote in OUTDIR");
+    add_overwrite_flag(app, overwrite_);
   }
 
   void run(Context& context) override {

@@ -86,7 +86,7 @@ class LakeCommand final : public Command {
     app.add_option("--crest", crest_, "Dam crest elevation (m); the level defaults to it");
     file_kind(app.add_option("--run", run_dir_, "Run folder: report the flooded road length (roads.geojson) and the cities touched (cities.geojson)"), FileKind::folder_in);
     app.add_flag("--cog", cog_, "Write a Cloud Optimized GeoTIFF");
-    app.add_flag("--overwrite", overwrite_, "Replace existing outputs");
+    add_overwrite_flag(app, overwrite_);
   }
 
   void run(Context& context) override {

@@ -31,7 +31,7 @@ class NetworkCommand final : public Command {
               FileKind::vector_in);
     file_kind(app.add_option("OUTDIR", out_, "Output folder: network.geojson")->required(), FileKind::folder_out);
     schema_.setup(app, name());
-    app.add_flag("--overwrite", overwrite_, "Replace existing outputs");
+    add_overwrite_flag(app, overwrite_);
   }
 
   void run(Context& context) override {

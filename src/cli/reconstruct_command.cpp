@@ -69,7 +69,7 @@ class ReconstructCommand final : public Command {
     grid_.add(app, false);
     app.add_option("--z-field", z_field_, "Vector samples: the field holding the height in metres")->capture_default_str();
     options_.add(app, true, 0.0);
-    app.add_flag("--overwrite", overwrite_, "Replace OUT if it exists");
+    add_overwrite_flag(app, overwrite_);
   }
 
   void run(Context& context) override {

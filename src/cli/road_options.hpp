@@ -6,6 +6,7 @@
 #include <optional>
 #include <string>
 
+#include "cli/command.hpp"
 #include "cli/plugin_options.hpp"
 #include "cli/schema_options.hpp"
 #include "io/raster_io.hpp"
@@ -30,7 +31,7 @@ struct RoadOptions {
                              "Also write the DEM after cut-and-fill along the surface roads (GeoTIFF; carriageway --half-width, sides at the --material's angle)"),
               FileKind::raster_out);
     plugins.setup(app, "adds its road cost term (characteristic priced by its transfer functions; galin router)");
-    app.add_flag("--overwrite", overwrite, "Replace the outputs a previous terrapolis command wrote");
+    add_overwrite_flag(app, overwrite);
   }
 
   /// The command's scenario, read once (the first call validates the options and loads --costs).

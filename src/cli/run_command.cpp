@@ -33,7 +33,7 @@ class RunCommand final : public Command {
         ->check(CLI::Range(std::uint64_t(0), std::uint64_t(9007199254740991)));
     file_kind(app.add_option("-o,--output", output_, "Run folder (overrides the scenario's); batch: the folder holding a run folder per scenario, named by its file"),
               FileKind::folder_out);
-    app.add_flag("--overwrite", overwrite_, "Replace the run folder if it exists");
+    add_overwrite_flag(app, overwrite_);
     const std::vector<std::string> stages = pipeline::stage_names();
     app.add_option("--from", from_, "Rerun from this stage on, reading the earlier stages' results back from the run")
         ->check(CLI::IsMember(stages));

@@ -50,7 +50,7 @@ class SitesCommand final : public Command {
     file_kind(app.add_option("OUTDIR", out_, "Output folder: cities.geojson, city_extents.geojson")->required(), FileKind::folder_out);
     schema_.setup(app, name());
     app.add_flag("--report", report_, "Print the quota table");
-    app.add_flag("--overwrite", overwrite_, "Replace existing outputs");
+    add_overwrite_flag(app, overwrite_);
   }
 
   void run(Context& context) override {

@@ -37,7 +37,7 @@ class SkeletonCommand final : public Command {
               FileKind::folder_out);
     schema_.setup(app, name());
     app.add_flag("--cog", cog_, "Write Cloud Optimized GeoTIFFs");
-    app.add_flag("--overwrite", overwrite_, "Replace the outputs a previous terrapolis command wrote");
+    add_overwrite_flag(app, overwrite_);
   }
 
   void run(Context& context) override {
