@@ -12,6 +12,7 @@
 
 #include "cli/command.hpp"
 #include "cli/describe.hpp"
+#include "cli/schema_options.hpp"
 #include "core/error.hpp"
 #include "core/interrupt.hpp"
 #include "io/output_set.hpp"
@@ -104,7 +105,10 @@ int terrapolis::cli::run_command_line(int argc, char** argv) {
       std::fprintf(stderr, "terrapolis: %s: stopped, no output written\n", e.what());
       return 128 + interrupt_signal();
     }
-    std::fprintf(stderr, "terrapolis: error: %s\n", with_output_names(e.what()).c_str());
+    std::string message = e.what();
+    for (auto& [sub, command] : subs)
+      if (sub->parsed()) message = cli::with_flag_names(message, *sub);
+    std::fprintf(stderr, "terrapolis: error: %s\n", with_output_names(message).c_str());
     return e.exit_code();
   } catch (const std::bad_alloc&) {
     std::fprintf(stderr, "terrapolis: error: out of memory\n");

@@ -110,6 +110,20 @@ const OptionSource* option_source(const CLI::Option& option) {
   return it == sources().end() ? nullptr : &it->second;
 }
 
+std::string with_flag_names(const std::string& message, const CLI::App& command) {
+  if (message.empty() || message[0] != '/') return message;
+  std::size_t best = 0;
+  std::string flag;
+  for (const CLI::Option* option : command.get_options()) {
+    const OptionSource* source = option_source(*option);
+    if (!source || source->pointer.empty()) continue;
+    const std::string& p = source->pointer;
+    const bool ends = message.size() == p.size() || message[p.size()] == ':' || message[p.size()] == ' ';
+    if (p.size() > best && message.compare(0, p.size(), p) == 0 && ends) best = p.size(), flag = option->get_name();
+  }
+  return best ? flag + message.substr(best) : message;
+}
+
 std::vector<std::pair<std::string, json>> schema_fields_of(const std::string& command) {
   std::vector<std::pair<std::string, json>> out;
   collect(json::parse(pipeline::scenario_schema_text()), "", command, out);

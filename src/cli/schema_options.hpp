@@ -34,6 +34,9 @@ struct OptionSource {
 };
 /// The source of `option`, or nullptr for an option declared without either (a number, a flag).
 const OptionSource* option_source(const CLI::Option& option);
+/// A module's message names the setting by its pointer ("/roads/k: ..."); a command's user knows
+/// it as the command's flag: the leading pointer becomes the flag when `command` has one for it.
+std::string with_flag_names(const std::string& message, const CLI::App& command);
 
 /// The schema fields a command exposes: every field whose "x-cli" names the command, as
 /// `"x-cli": {"hydro": "--fill"}` (or {"flag": "--sea-level", "default": null} where the command's

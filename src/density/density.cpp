@@ -408,7 +408,7 @@ void ring_shares(const Dem& dem, const Grid& g, const DiscPlan& inner, const Dis
   // weighted by how far it is from a plain (cliffs and slopes count, flat tops do not). The
   // weight is quantised to `levels` steps so its sums stay exact integers in 32 bits.
   const double levels = std::min(1024.0, std::floor(double(UINT32_MAX) / std::max(1.0, outer.max_cells())));
-  if (levels < 16) throw bad_input("--r-max: the ring holds too many cells for this grid (" + std::to_string(outer.max_cells()) + ")");
+  if (levels < 16) throw bad_input("/density/r_max_m: the ring holds too many cells for this grid (" + std::to_string(outer.max_cells()) + ")");
   // An inland grid has no coast: its water sums are all 0 and need no table.
   const SummedArea<std::uint32_t> wet = g.any_water ? SummedArea<std::uint32_t>(win, g.cols, [&](std::size_t i) { return std::uint32_t(kind[i] == water); })
                                                     : SummedArea<std::uint32_t>();
@@ -645,7 +645,7 @@ DensityResult compute_density(const Dem& dem, const Raster<float>& hydrometry, c
 double raised_r_min(const CellMetrics& metrics, const DensityOptions& options) {
   const double r_min = std::max(options.r_min_m, largest_cell_step(metrics) * (1 + 1e-9));
   if (!(options.r_max_m > r_min))
-    throw bad_input("--r-max: must be larger than r_min (" + std::to_string(r_min) + " m once raised to the cell size)");
+    throw bad_input("/density/r_max_m: must be larger than r_min (" + std::to_string(r_min) + " m once raised to the cell size)");
   return r_min;
 }
 

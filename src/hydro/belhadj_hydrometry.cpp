@@ -252,8 +252,8 @@ double BelhadjModel::step() {
 
 BelhadjRun belhadj_hydrometry(const Dem& dem, const CellMetrics& metrics, const BelhadjOptions& options,
                               Progress& progress) {
-  if (options.max_iterations < 0) throw bad_input("--iterations: must be 0 (until convergence) or positive");
-  if (!(options.threshold > 0)) throw bad_input("--threshold: must be a positive number");
+  if (options.max_iterations < 0) throw bad_input("/hydro/iterations: must be 0 (until convergence) or positive");
+  if (!(options.threshold > 0)) throw bad_input("/hydro/threshold: must be a positive number");
   ProgressStep step(progress, "hydrometry (Belhadj)");
   BelhadjModel model(dem, metrics, options.vertical, options.sea_level, options.share);
   BelhadjRun run;

@@ -125,7 +125,7 @@ std::string describe(D8Codes convention) {
 FlowRouter::FlowRouter(const Dem& filled, const Raster<std::uint8_t>& d8, const CellMetrics& metrics, FlowMethod method,
                        double mfd_exponent)
     : z_(filled), d8_(d8), metrics_(metrics), method_(method), exponent_(mfd_exponent) {
-  if (!(mfd_exponent > 0) || !std::isfinite(mfd_exponent)) throw bad_input("--mfd-exponent: must be a positive number");
+  if (!(mfd_exponent > 0) || !std::isfinite(mfd_exponent)) throw bad_input("/hydro/mfd_exponent: must be a positive number");
 }
 
 void FlowRouter::split(int c, int r, FlowSplit& out) const {

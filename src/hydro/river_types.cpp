@@ -51,9 +51,9 @@ RiverType classify_reach(const ReachMeasures& m, const RiverTypeOptions& o) {
 }
 
 void check(const RiverTypeOptions& o) {
-  if (!(o.braided_discharge_m3s > 0) || !std::isfinite(o.braided_discharge_m3s)) throw bad_input("--braided-discharge: must be positive (m3/s)");
-  if (!(o.delta_discharge_m3s > 0) || !std::isfinite(o.delta_discharge_m3s)) throw bad_input("--delta-discharge: must be positive (m3/s)");
-  if (!(o.coast_distance_km >= 0) || !std::isfinite(o.coast_distance_km)) throw bad_input("--coast-distance: must be >= 0 km");
+  if (!(o.braided_discharge_m3s > 0) || !std::isfinite(o.braided_discharge_m3s)) throw bad_input("/hydro/braided_discharge_m3s: must be positive (m3/s)");
+  if (!(o.delta_discharge_m3s > 0) || !std::isfinite(o.delta_discharge_m3s)) throw bad_input("/hydro/delta_discharge_m3s: must be positive (m3/s)");
+  if (!(o.coast_distance_km >= 0) || !std::isfinite(o.coast_distance_km)) throw bad_input("/hydro/coast_distance_km: must be >= 0 km");
 }
 
 void classify_streams(VectorLayer& streams, const Dem& filled, const std::optional<double>& sea_level, const RiverTypeOptions& o) {

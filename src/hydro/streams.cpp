@@ -14,7 +14,7 @@ namespace terrapolis::hydro {
 VectorLayer extract_streams(const Raster<std::uint8_t>& d8, const Raster<double>& area, const CellMetrics& metrics,
                             const StreamOptions& options, Progress& progress) {
   if (!(options.threshold_km2 > 0) || !std::isfinite(options.threshold_km2))
-    throw bad_input("--streams-threshold: must be a positive number of km2");
+    throw bad_input("/hydro/streams_threshold_km2: must be a positive number of km2");
   const double threshold = options.threshold_km2 * 1e6;
   StreamCells cells{d8.cols(), d8.rows(), {}, {}, {}};
   for (std::size_t i = 0; i < d8.size(); ++i)

@@ -26,7 +26,7 @@ int sector_of(double angle_rad, int m) {
 
 RoadGraph::RoadGraph(const TerrainField& terrain, const CostModel& model, const GraphOptions& options)
     : terrain_(terrain), model_(model), options_(options) {
-  if (options.angles < 1 || options.angles > 64) throw bad_input("--angles: must be in 1..64, got " + std::to_string(options.angles));
+  if (options.angles < 1 || options.angles > 64) throw bad_input("/roads/angles: must be in 1..64, got " + std::to_string(options.angles));
   const int m = options.angles;
   for (int s = 0; s < 3; ++s) salt_[s] = splitmix64(options.seed * 3 + std::uint64_t(s));
   build_slope_tables();

@@ -22,7 +22,7 @@ double grid_angle(int dcol, int drow) {
 }  // namespace
 
 std::vector<MaskArc> segment_mask(int k) {
-  if (k < 1 || k > 16) throw bad_input("--k: mask size must be in 1..16, got " + std::to_string(k));
+  if (k < 1 || k > 16) throw bad_input("/roads/k: mask size must be in 1..16, got " + std::to_string(k));
   std::vector<MaskArc> arcs;
   for (int j = -k; j <= k; ++j)
     for (int i = -k; i <= k; ++i)

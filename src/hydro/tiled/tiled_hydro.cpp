@@ -248,7 +248,7 @@ int tile_size_for(int cols, int rows, double memory_limit_mb, int concurrent) {
     const double global = kGlobalBytesPerTileSide * double(grid.count()) * double(side) + 40.0 * rows;
     if (tile + global <= limit) return side;
   }
-  throw bad_input("--memory-limit: " + std::to_string(int(memory_limit_mb)) + " MB is too little for tiles of 64 x 64 cells on a " +
+  throw bad_input("/input/memory_limit_mb: " + std::to_string(int(memory_limit_mb)) + " MB is too little for tiles of 64 x 64 cells on a " +
                   std::to_string(cols) + " x " + std::to_string(rows) + " mosaic");
 }
 
