@@ -17,6 +17,8 @@
 #include "io/raster_io.hpp"
 #include "pipeline/compare.hpp"
 #include "pipeline/places.hpp"
+#include "core/geodesy.hpp"
+#include "density/tiled_density.hpp"
 #include "pipeline/publish.hpp"
 #include "pipeline/run_state.hpp"
 #include "pipeline/stage_options.hpp"
@@ -166,6 +168,11 @@ json run_scenario(const Scenario& scenario, const RunOptions& options, Progress&
     } catch (const Error& e) {
       throw Error(e.kind(), scenario.source + ": /roads/existing: " + e.what());
     }
+  }
+  try {  // r_max against r_min raised to this grid's cells, before the hydrology runs
+    density::raised_r_min(cell_metrics(dem.georef(), dem.cols(), dem.rows()), settings.density);
+  } catch (const Error& e) {
+    throw Error(e.kind(), scenario.source + ": " + e.what());
   }
   const std::string dem_sha256 = file_sha256(dem_path);
   plugin::PluginSet plugins = plugin::load_plugins(nlohmann::json::parse(scenario.resolved["plugins"].dump()), log,

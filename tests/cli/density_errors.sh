@@ -43,12 +43,14 @@ code=$?
 set -e
 [[ $code == 2 ]] || fail "existing output: exit $code"
 [[ $(md5sum "$tmp/done/density.tif") == "$before" ]] || fail "existing output was changed"
-# A module names the setting by its pointer; a command shows its own flag, a run the pointer.
+# A module names the setting by its pointer; a command shows its own flag, a run the pointer (and
+# refuses it before its first stage: r_min is raised to the cell size, read from the DEM).
 expect_error "error: --r-max: must be larger than r_min" "$dem" "$tmp/out" --r-max 100 --r-min 50
 set +e
-"$bin" --quiet run -o "$tmp/out" --set dem="$dem" --set density.r_max_m=100 --set density.r_min_m=50 2> "$tmp/err"
+"$bin" -v run -o "$tmp/out" --set dem="$dem" --set density.r_max_m=100 --set density.r_min_m=50 2> "$tmp/err"
 code=$?
 set -e
-[[ $code == 2 ]] && grep -q "error: /density/r_max_m: must be larger than r_min" "$tmp/err" || fail "run: exit $code, '$(cat "$tmp/err")'"
+[[ $code == 2 ]] && grep -q ": /density/r_max_m: must be larger than r_min" "$tmp/err" || fail "run: exit $code, '$(cat "$tmp/err")'"
 [[ ! -e $tmp/out ]] || fail "a refused run left an output"
+[[ $(wc -l < "$tmp/err") == 1 ]] || fail "the run started its stages before refusing r_max: $(cat "$tmp/err")"
 echo "density error cases passed"
