@@ -20,6 +20,7 @@
 #include "io/output_set.hpp"
 #include "io/raster_io.hpp"
 #include "io/vector_io.hpp"
+#include "pipeline/stage_options.hpp"
 #include "terrapolis/version.hpp"
 
 namespace terrapolis::cli {
@@ -40,9 +41,7 @@ class CatchmentCommand final : public Command {
         ->check(CLI::IsMember({"lonlat", "dem"}))->capture_default_str();
     app.add_option("--snap-radius", snap_m_, "Snap the outlet to the highest accumulation within this radius (m)")->capture_default_str();
     file_kind(app.add_option("--mask", mask_path_, "Also write the catchment mask (GeoTIFF: 1 inside, 0 outside, 255 nodata)"), FileKind::raster_out);
-    app.add_option("--fill", fill_, "Depression handling: priority-flood, epsilon, breach, none")
-        ->check(CLI::IsMember({"priority-flood", "epsilon", "breach", "none"}))->capture_default_str();
-    app.add_option("--sea-level", sea_level_, "Cells at or below this elevation (m) are outlets (default: off)");
+    schema_.setup(app, name());  // --fill, --sea-level (hydro.fill, water.sea_level_m; no sea unless given)
     add_overwrite_flag(app, overwrite_);
   }
 
@@ -64,12 +63,10 @@ class CatchmentCommand final : public Command {
       y = p[1];
       if (!std::isfinite(x) || !std::isfinite(y)) throw bad_input("--outlet: cannot be transformed to the DEM's CRS");
     }
-    std::optional<double> sea;
-    if (!std::isnan(sea_level_)) sea = sea_level_;
-    const FillMethod fill = fill_ == "epsilon" ? FillMethod::epsilon
-                            : fill_ == "breach" ? FillMethod::breach
-                            : fill_ == "none"   ? FillMethod::none
-                                                : FillMethod::priority_flood;
+    HydroOptions o = pipeline::hydro_options(schema_.scenario());
+    if (!schema_.given("/water/sea_level_m")) o.sea_level.reset();  // as `terrapolis hydro`: no sea unless told
+    const std::optional<double> sea = o.sea_level;
+    const FillMethod fill = o.fill;
     const CellMetrics metrics = cell_metrics(dem.georef(), dem.cols(), dem.rows());
     const Dem filled = fill_depressions(dem, {fill, sea}, context.progress);
     const auto d8 = d8_directions(filled, metrics, sea, context.progress);
@@ -95,8 +92,9 @@ class CatchmentCommand final : public Command {
 
  private:
   DemInput dem_;
-  std::string out_path_, outlet_, outlet_crs_ = "lonlat", mask_path_, fill_ = "priority-flood";
-  double snap_m_ = 0, sea_level_ = NAN;
+  SchemaOptions schema_;
+  std::string out_path_, outlet_, outlet_crs_ = "lonlat", mask_path_;
+  double snap_m_ = 0;
   bool overwrite_ = false;
 };
 

@@ -26,3 +26,9 @@ expect_fail 2 "--outlet" "$bin" -q catchment "$dem" --outlet abc "$work/bad2.geo
 expect_fail 2 "geojson" "$bin" -q catchment "$dem" --outlet=-72.8,44.1 "$work/bad3.shp"
 expect_fail 2 "exists" "$bin" -q catchment "$dem" --outlet=-72.8,44.1 "$work/vt.geojson"
 echo ok
+# --fill and --sea-level come from the schema (hydro.fill, water.sea_level_m), as for `hydro`: the
+# same catchment with the default Priority-Flood named, and bad values refused by the schema.
+"$bin" -q catchment "$dem" --outlet=-72.8,44.1 --snap-radius 500 --fill priority-flood "$work/vt_pf.geojson"
+cmp -s "$work/vt.geojson" "$work/vt_pf.geojson" || { echo "--fill priority-flood changed the catchment"; exit 1; }
+expect_refused "$work/vt_bad.geojson" "--fill" "$bin" -q catchment "$dem" --outlet=-72.8,44.1 --fill sideways "$work/vt_bad.geojson"
+expect_refused "$work/vt_bad.geojson" "--sea-level" "$bin" -q catchment "$dem" --outlet=-72.8,44.1 --sea-level 99999 "$work/vt_bad.geojson"
