@@ -27,7 +27,7 @@ class FillCommand final : public Command {
     file_kind(app.add_option("OUT", output_, "Output GeoTIFF (float32, same grid and CRS)")->required(), FileKind::raster_out);
     options_.add(app, true, 0.0);
     app.add_option("--max-void-km2", max_void_km2_, "Voids larger than this (km2, geodesic) stay nodata")->check(CLI::PositiveNumber);
-    app.add_option("--sea-level", sea_level_m_, "Cells at or below this height (m) connected to the border are sea; voids touching the sea are not filled");
+    schema_.setup(app, name());  // --sea-level (water.sea_level_m): cells at or below it connected to the border are sea, whose voids stay
     app.add_flag("--fill-border-voids", fill_border_, "Also fill nodata connected to the grid border (by default it is outside the DEM)");
     add_overwrite_flag(app, overwrite_);
   }
@@ -39,7 +39,7 @@ class FillCommand final : public Command {
     Dem dem = input_.read();
     terrain::VoidOptions voids_options;
     if (max_void_km2_ > 0) voids_options.max_area_km2 = max_void_km2_;
-    voids_options.sea_level_m = sea_level_m_;
+    if (schema_.given("/water/sea_level_m")) voids_options.sea_level_m = schema_.scenario().resolved["water"]["sea_level_m"].get<double>();
     voids_options.fill_border = fill_border_;
     terrain::VoidReport report;
     const auto voids = terrain::find_voids(dem, voids_options, &report);
@@ -59,7 +59,7 @@ class FillCommand final : public Command {
   std::string output_;
   TerrainOptions options_;
   double max_void_km2_ = 0;
-  std::optional<double> sea_level_m_;
+  SchemaOptions schema_;
   bool fill_border_ = false, overwrite_ = false;
 };
 

@@ -56,6 +56,13 @@ PY
 from osgeo import gdal; import sys
 ds = gdal.Open('$T/lim.tif'); b = ds.GetRasterBand(1); a = b.ReadAsArray()
 sys.exit(0 if a[45, 65] == b.GetNoDataValue() or a[45, 65] != a[45, 65] else 1)"
+# --sea-level (the schema's water.sea_level_m): with every cell below it the whole grid is sea,
+# and a void in the sea stays a void.
+"$BIN" --quiet fill "$T/src.tif" "$T/sea.tif" --sea-level 8000
+/usr/bin/python3 -c "
+from osgeo import gdal; import sys
+ds = gdal.Open('$T/sea.tif'); b = ds.GetRasterBand(1); a = b.ReadAsArray()
+sys.exit(0 if a[45, 65] == b.GetNoDataValue() or a[45, 65] != a[45, 65] else 1)" || { echo "a void in the sea was filled"; exit 1; }
 # Bad input: exit 2, one line naming the problem, no output left.
 set +e
 "$BIN" fill "$T/missing.tif" "$T/bad.tif" 2>"$T/err"; rc=$?
