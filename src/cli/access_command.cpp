@@ -20,6 +20,7 @@
 #include "io/raster_io.hpp"
 #include "io/text_io.hpp"
 #include "io/vector_io.hpp"
+#include "pipeline/inland_water.hpp"
 #include "pipeline/stage_options.hpp"
 #include "terrapolis/version.hpp"
 
@@ -92,13 +93,15 @@ class AccessCommand final : public Command {
   void run(Context& context) override {
     const pipeline::Scenario scenario = schema_.scenario();
     const pipeline::AccessSettings settings = schema_.settings([&] { return pipeline::access_settings(scenario); });
-    OutputSet outputs("access", {dem_.path, to_, roads_, people_}, overwrite_);  // refused before any work
+    OutputSet outputs("access", {dem_.path, to_, roads_, people_, scenario.path("/water/water_mask")}, overwrite_);  // refused before any work
     const fs::path dir = outputs.folder(out_dir_);
     const Dem dem = dem_.read();
     const Places places = read_places(to_, dem);
     const double sea_level = scenario.resolved["water"]["sea_level_m"].get<double>();
+    // Land as a run sees it: above the sea and off the inland water (flattened lakes, --water-mask).
+    const pipeline::InlandWater water = pipeline::inland_water(dem, pipeline::inland_water_settings(scenario), context.progress, context.log);
     Raster<std::uint8_t> land = dem.like<std::uint8_t>(0);
-    for (std::size_t i = 0; i < dem.size(); ++i) land[i] = !std::isnan(dem[i]) && dem[i] > sea_level;
+    for (std::size_t i = 0; i < dem.size(); ++i) land[i] = !std::isnan(dem[i]) && dem[i] > sea_level && !water.mask[i];
     const access::RoadCells roads = roads_.empty() ? access::RoadCells{dem.like<float>(0.0f), dem.like<std::uint8_t>(0)}
                                                    : access::road_cells(read_vector(roads_, dem.georef().crs), dem, settings.options);
     // Who is counted: the people raster, or each land cell's area (km2).

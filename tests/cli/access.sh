@@ -62,6 +62,27 @@ assert a["within"]["60_min"] > b["within"]["60_min"] and a["mean_minutes"] < b["
 assert w["settlements"] >= 30 and w["outside_the_dem"] == 0, w
 PY
 
+# --water-mask (water.water_mask, as in a run): masked land is water, walked on by no one.
+/usr/bin/python3 - "$dem" <<'PY'
+import sys
+import numpy as np
+from osgeo import gdal
+src = gdal.Open(sys.argv[1])
+band = np.zeros((src.RasterYSize, src.RasterXSize), np.uint8)
+band[:, 150:153] = 1
+out = gdal.GetDriverByName("GTiff").Create("band.tif", src.RasterXSize, src.RasterYSize, 1, gdal.GDT_Byte)
+out.SetGeoTransform(src.GetGeoTransform())
+out.SetProjection("EPSG:4326")
+out.GetRasterBand(1).WriteArray(band)
+PY
+"$TP" -q access "$dem" wet --to run/cities.geojson --water-mask band.tif
+/usr/bin/python3 - <<'PY' || fail "--water-mask"
+import numpy as np
+from osgeo import gdal
+dry = gdal.Open("without/access_minutes.tif").ReadAsArray(); wet = gdal.Open("wet/access_minutes.tif").ReadAsArray()
+assert np.isfinite(dry[:, 150:153]).sum() > 50 and not np.isfinite(wet[:, 150:153]).any(), "masked cells still walked on"
+PY
+
 # A people raster on the DEM's grid: the figures are people.
 gdal_calc.py --quiet -A run/density.tif --outfile people.tif --type Float32 --calc "(A>0)*100" --NoDataValue -1
 "$TP" -q access "$dem" counted --to run/cities.geojson --people people.tif
