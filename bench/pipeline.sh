@@ -14,7 +14,7 @@ dems=(sample_dems/gebco2022_15s_north_corsica_capcorse.asc ${EXTRA_DEMS:-../shar
 
 median() { sort -g | awk '{ v[NR] = $1 } END { print (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }'; }
 
-printf '%-44s %8s %8s  %s\n' dem wall_s peak_MB "stages (median s): terrain hydro density sites network roads"
+printf '%-44s %8s %8s  %s\n' dem wall_s peak_MB "stages (median s): terrain hydro density sites network roads access"
 for dem in "${dems[@]}"; do
   [[ -f $dem ]] || { echo "missing $dem (skipped)" >&2; continue; }
   : > "$tmp/wall" ; : > "$tmp/mem" ; : > "$tmp/stages"
@@ -26,10 +26,10 @@ for dem in "${dems[@]}"; do
     /usr/bin/python3 -c "import json; print(' '.join('%.3f' % t['seconds'] for t in json.load(open('$tmp/run/run.json'))['timings']))" >> "$tmp/stages"
   done
   stages=""
-  for k in 1 2 3 4 5 6; do stages+=" $(cut -d' ' -f$k "$tmp/stages" | median)"; done
+  for k in 1 2 3 4 5 6 7; do stages+=" $(cut -d' ' -f$k "$tmp/stages" | median)"; done
   printf '%-44s %8s %8s  %s\n' "$(basename "$dem")" "$(median < "$tmp/wall")" "$(median < "$tmp/mem")" "$stages"
   # Network quality of the last run (bench/network_quality.py: km, junctions, circuity, grades, water).
   /usr/bin/python3 bench/network_quality.py "$tmp/run" || true
-  # The last run's roads: count, links not routed within roads.max_seconds, lakes the DEM flattens.
-  /usr/bin/python3 -c "import json; r = json.load(open('$tmp/run/run.json'))['summary'].get('roads', {}); print('  roads:', {k: r.get(k) for k in ('roads', 'failed', 'not_routed_budget', 'redundant', 'junctions', 'flat_lakes', 'flat_lake_km2', 'length_km')})"
+  # The last run's roads: count, links not routed within roads.max_seconds; the lakes the DEM flattens.
+  /usr/bin/python3 -c "import json; r = json.load(open('$tmp/run/run.json'))['summary'].get('roads', {}); h = json.load(open('$tmp/run/run.json'))['summary'].get('hydro', {}); print('  roads:', {k: r.get(k) for k in ('roads', 'failed', 'not_routed_budget', 'redundant', 'junctions', 'length_km')}, 'flat lakes:', h.get('flat_lakes'), h.get('flat_lake_km2'), 'km2')"
 done
