@@ -107,7 +107,7 @@ int terrapolis::cli::run_command_line(int argc, char** argv) {
     }
     std::string message = e.what();
     for (auto& [sub, command] : subs)
-      if (sub->parsed()) message = cli::with_flag_names(message, *sub);
+      if (sub->parsed()) message = cli::with_flag_names(message, sub->get_name());
     std::fprintf(stderr, "terrapolis: error: %s\n", with_output_names(message).c_str());
     return e.exit_code();
   } catch (const std::bad_alloc&) {

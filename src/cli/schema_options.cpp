@@ -110,18 +110,17 @@ const OptionSource* option_source(const CLI::Option& option) {
   return it == sources().end() ? nullptr : &it->second;
 }
 
-std::string with_flag_names(const std::string& message, const CLI::App& command) {
-  if (message.empty() || message[0] != '/') return message;
-  std::size_t best = 0;
-  std::string flag;
-  for (const CLI::Option* option : command.get_options()) {
-    const OptionSource* source = option_source(*option);
-    if (!source || source->pointer.empty()) continue;
-    const std::string& p = source->pointer;
-    const bool ends = message.size() == p.size() || message[p.size()] == ':' || message[p.size()] == ' ';
-    if (p.size() > best && message.compare(0, p.size(), p) == 0 && ends) best = p.size(), flag = option->get_name();
-  }
-  return best ? flag + message.substr(best) : message;
+namespace {
+/// Each command's schema options, by command name (they live as long as their command).
+std::map<std::string, const SchemaOptions*>& by_command() {
+  static std::map<std::string, const SchemaOptions*> m;
+  return m;
+}
+}  // namespace
+
+std::string with_flag_names(const std::string& message, const std::string& command) {
+  const auto it = by_command().find(command);
+  return it == by_command().end() ? message : it->second->with_flags(message);
 }
 
 std::vector<std::pair<std::string, json>> schema_fields_of(const std::string& command) {
@@ -132,6 +131,7 @@ std::vector<std::pair<std::string, json>> schema_fields_of(const std::string& co
 
 void SchemaOptions::setup(CLI::App& app, const std::string& command) {
   command_ = command;
+  by_command()[command] = this;
   for (auto& [pointer, field] : schema_fields_of(command)) {
     const CliEntry cli = cli_entry(field, command);
     Entry& e = entries_.emplace_back();

@@ -34,9 +34,7 @@ struct OptionSource {
 };
 /// The source of `option`, or nullptr for an option declared without either (a number, a flag).
 const OptionSource* option_source(const CLI::Option& option);
-/// A module's message names the setting by its pointer ("/roads/k: ..."); a command's user knows
-/// it as the command's flag: the leading pointer becomes the flag when `command` has one for it.
-std::string with_flag_names(const std::string& message, const CLI::App& command);
+
 
 /// The schema fields a command exposes: every field whose "x-cli" names the command, as
 /// `"x-cli": {"hydro": "--fill"}` (or {"flag": "--sea-level", "default": null} where the command's
@@ -79,6 +77,11 @@ class SchemaOptions {
   std::vector<std::pair<std::string, std::string>> aliases_;  ///< (pointer, flag) of the command's own options
   std::deque<Entry> entries_;  // CLI11 binds to the members: addresses must stay put
 };
+
+/// A module's message names a setting by its JSON pointer ("/roads/k: ..."); the user of a command
+/// knows it by the command's flag: SchemaOptions::with_flags of `command` (the message unchanged
+/// when the command declares no schema options).
+std::string with_flag_names(const std::string& message, const std::string& command);
 
 /// The schema's fields of `command` as (JSON pointer, field with x-cli), in schema order.
 std::vector<std::pair<std::string, nlohmann::ordered_json>> schema_fields_of(const std::string& command);
