@@ -6,8 +6,12 @@
 # (minus the elevation, minus the slope, nearness to water), how many meet the issue's bar (>= 0.75
 # and above it), the mean in-sample AUC (not a criterion), each region's held-out AUC and the weights
 # fitted on all the regions (docs/benchmarks.md, "Held-out skill of the terrain terms").
-# Usage: bench/density_terms.sh [TERRAPOLIS] [DEMS_DIR] [PLACES_DIR] [KEEP_DIR]
+# With --models: the same table for the default logistic fit against gradient-boosted trees
+# (calibrate --model boosted) of several sizes (docs/benchmarks.md, "A boosted density model").
+# Usage: bench/density_terms.sh [--models] [TERRAPOLIS] [DEMS_DIR] [PLACES_DIR] [KEEP_DIR]
 set -euo pipefail
+models=false
+if [[ ${1:-} == --models ]]; then models=true; shift; fi
 source "$(dirname "$0")/realism_regions.sh" "$@"  # TP, DEMS, PLACES, SRC, OUT (and cd there), the regions
 
 four=altitude,slope,coast_near,position_5km
@@ -34,6 +38,18 @@ variants=(  # label|calibrate options
   "four + hydrometry, ridge 0.1|--terms $four,hydrometry --ridge 0.1"
   "four + position_1km, ridge 0.1|--terms $four,position_1km --ridge 0.1"
 )
+if $models; then
+  variants=(
+    "logistic, four terms, ridge 0.1 (the default)|--terms $four --ridge 0.1"
+    "boosted, ten terms, 200 trees of depth 3|--model boosted --depth 3 --trees 200 --min-leaf-weight 1"
+    "boosted, ten terms, 100 stumps (depth 1)|--model boosted --depth 1 --trees 100 --min-leaf-weight 1"
+    "boosted, ten terms, 100 trees of depth 2, leaf weight 20 (calibrate's defaults)|--model boosted"
+    "boosted, ten terms, 300 trees of depth 2, rate 0.03, leaf weight 20|--model boosted --depth 2 --trees 300 --learning-rate 0.03 --min-leaf-weight 20"
+    "boosted, four terms, 100 stumps|--model boosted --terms $four --depth 1 --trees 100 --min-leaf-weight 1"
+    "boosted, four terms, 100 trees of depth 2|--model boosted --terms $four --depth 2 --trees 100 --min-leaf-weight 1"
+    "boosted, four terms, 100 trees of depth 2, leaf weight 20|--model boosted --terms $four --depth 2 --trees 100 --min-leaf-weight 20"
+  )
+fi
 for k in "${!variants[@]}"; do
   IFS='|' read -r label options <<< "${variants[$k]}"
   # shellcheck disable=SC2086  # the options are words
@@ -57,7 +73,8 @@ for k in range(int(sys.argv[1])):
     fit = sum(r["fitted_in_sample"]["auc"] for r in regs) / len(regs)
     print(f"| {label} | {sum(held) / len(held):.4f} | {sum(weighted) / len(weighted):.4f} | {above} | {bar} | {fit:.4f} | "
           + " ".join(f"{h:.3f}" for h in held) + " |")
-    weights.append((label, {t: v for t, v in rep["weights"].items() if v}))
+    if rep.get("model") != "boosted":  # a boosted report's weights are its logistic comparison's
+        weights.append((label, {t: v for t, v in rep["weights"].items() if v}))
 print("\nregions:", ", ".join(r["region"] for r in regs))
 print("best baseline:", " ".join(f"{b:.3f}" for b in base))
 for label, w in weights:

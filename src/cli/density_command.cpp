@@ -42,7 +42,9 @@ struct Hydrometry {
   bool used = false;
 };
 
-bool hydrometry_used(const density::DensityOptions& options) { return options.weights[1] != 0 || options.river_bed_cap.has_value(); }
+bool hydrometry_used(const density::DensityOptions& options) {
+  return options.weights[1] != 0 || options.river_bed_cap.has_value() || options.model;  // boosted trees may read it
+}
 
 /// A --hydrometry file on a grid (the DEM's or a window of it), checked to lie in [0,1].
 Raster<float> read_hydrometry(const std::string& path, const Georef& grid, int cols, int rows) {

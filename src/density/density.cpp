@@ -16,6 +16,8 @@
 
 #include "core/error.hpp"
 #include "core/geodesy.hpp"
+#include "density/boosted.hpp"
+#include "density/calibration.hpp"
 #include "density/disc_sums.hpp"
 #include "density/tiled_density.hpp"
 
@@ -169,7 +171,7 @@ void check_settings(const DensityOptions& o, const std::vector<double>& layer_we
     if (!std::isfinite(layer_weights[i])) throw bad_input("/density/layers/" + std::to_string(i) + "/weight: must be a finite number");
     any = any || layer_weights[i] != 0;
   }
-  if (!any) throw bad_input("/density/weights: every weight is 0 (and every layer's), the density would be undefined");
+  if (!any && !o.model) throw bad_input("/density/weights: every weight is 0 (and every layer's), the density would be undefined");
 }
 
 std::vector<float> distance_to_m(const std::vector<std::uint8_t>& feature, const CellMetrics& metrics, int cols, int rows) {
@@ -531,14 +533,44 @@ void terrain_terms(const Dem& dem, const Grid& g, const DensityOptions& options,
 
 /// The density (§4.2.1, Fig. 4.3): the weighted combination of the characteristics, the user's
 /// factors and the terrain terms on habitable cells, 0 elsewhere on known ground.
+/// The boosted trees' density of every habitable cell of the core, in [0,1] (NaN elsewhere).
+std::vector<float> boosted_density(const Dem& dem, const Grid& g, const BoostedModel& model, const DensityResult& result) {
+  const auto names = term_names();
+  std::vector<std::size_t> columns;
+  for (const std::string& t : model.terms()) {
+    const auto at = std::find_if(names.begin(), names.end(), [&](const char* n) { return t == n; });
+    if (at == names.end()) throw bad_input("/density/model: unknown term '" + t + "'");
+    columns.push_back(std::size_t(at - names.begin()));
+  }
+  std::vector<std::size_t> cells;
+  for (int r = g.core.y0; r < g.core.y0 + g.core.rows; ++r)
+    for (int x = g.core.x0; x < g.core.x0 + g.core.cols; ++x)
+      if (const std::size_t i = dem.index(x, r); g.kind[i] != unknown && result.buildable[i] == 1) cells.push_back(i);
+  std::vector<float> rows(cells.size() * columns.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells.size(), 4096), [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t k = range.begin(); k < range.end(); ++k) {
+      const Terms t = terms_at(result, cells[k]);
+      for (std::size_t j = 0; j < columns.size(); ++j) rows[k * columns.size() + j] = float(t[columns[j]]);
+    }
+  });
+  const std::vector<float> margins = model.margins(rows);
+  std::vector<float> unit(dem.size(), nan_f);
+  for (std::size_t k = 0; k < cells.size(); ++k) unit[cells[k]] = float(std::clamp(model.unit(margins[k]), 0.0, 1.0));
+  return unit;
+}
+
 void combine_terms(const Dem& dem, const Grid& g, const DensityOptions& options, DensityResult& result, Progress& progress) {
   result.density = dem.like<float>(nan_f);
   ProgressStep step(progress, "density: combine");
+  // With boosted trees, their density is the one term before the factors (weight 1).
+  const std::vector<float> boosted = options.model ? boosted_density(dem, g, *options.model, result) : std::vector<float>();
   std::vector<double> weights(options.weights.begin(), options.weights.end());
+  if (options.model) weights = {1};
+  const std::size_t first_factor = weights.size();
   for (const auto& f : options.factors) weights.push_back(f.weight);
-  const std::size_t first_factor = 4, first_terrain = first_factor + options.factors.size();
+  const std::size_t first_terrain = first_factor + options.factors.size();
   // The terrain terms come last, and only when used: the thesis's model sums exactly what it always did.
-  const bool with_terrain = terrain_used(options);
+  const bool with_terrain = terrain_used(options) && !options.model;
   if (with_terrain) weights.insert(weights.end(), options.terrain_weights.begin(), options.terrain_weights.end());
   for_rows(g.core.rows, step, [&](int r0, int r1) {
     std::vector<double> values(weights.size()), cell_weights(weights);
@@ -550,10 +582,14 @@ void combine_terms(const Dem& dem, const Grid& g, const DensityOptions& options,
           result.density[i] = 0;
           continue;
         }
-        values[0] = result.coast[i];
-        values[1] = result.hydrometry[i];
-        values[2] = result.plateau[i];
-        values[3] = result.plain[i];
+        if (options.model) {
+          values[0] = boosted[i];
+        } else {
+          values[0] = result.coast[i];
+          values[1] = result.hydrometry[i];
+          values[2] = result.plateau[i];
+          values[3] = result.plain[i];
+        }
         // A factor with no value here (NaN) takes no part in this cell's combination.
         for (std::size_t f = 0; f < options.factors.size(); ++f) {
           const float v = options.factors[f].values[i];
@@ -620,7 +656,7 @@ void characteristics(const Dem& dem, const Grid& grid, const DiscPlan& inner, co
   const Window win = disc_window(grid, inner, outer);
   result.plain = plain_characteristic(dem, grid, inner, win, options.plain_max_variation_m, progress);
   ring_shares(dem, grid, inner, outer, win, options, maxima, result, progress);
-  if (terrain_used(options) || options.terrain_terms) terrain_terms(dem, grid, options, result, progress);
+  if (terrain_used(options) || options.terrain_terms || options.model) terrain_terms(dem, grid, options, result, progress);
   combine_terms(dem, grid, options, result, progress);
   gather_stats(dem, grid, result);
 }
@@ -660,7 +696,8 @@ std::array<float, 2> land_range(const Dem& dem, const DensityOptions& options) {
 DensityResult compute_density_window(const Dem& dem, const Raster<float>& hydrometry, const DensityOptions& options,
                                      const WholeGridFigures& whole, Progress& progress) {
   check_options(dem, hydrometry, options);
-  if (terrain_used(options) || options.terrain_terms) throw bad_input("density: the terrain terms are not computed on tiles yet");
+  if (terrain_used(options) || options.terrain_terms || options.model)
+    throw bad_input("density: the terrain terms (and the boosted model that reads them) are not computed on tiles yet");
   Grid grid = describe_grid(dem, options, whole.metrics);
   grid.core = whole.core;
   grid.land_min = whole.land_range[0], grid.land_max = whole.land_range[1];

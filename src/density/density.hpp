@@ -5,6 +5,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
@@ -26,6 +27,8 @@ namespace terrapolis::density {
 enum class TerrainTerm : std::size_t { altitude, slope, coast_near, river_near, position_1km, position_5km };
 inline constexpr std::array<const char*, 6> kTerrainTerms = {"altitude", "slope", "coast_near", "river_near", "position_1km", "position_5km"};
 inline constexpr std::size_t kTerrainCount = kTerrainTerms.size();
+
+class BoostedModel;
 
 /// Everything the density model needs besides the DEM and its hydrometry. Defaults are the
 /// thesis's (Belhadj 2007, §4.2.1 and §4.2.2.2, Corsica example) unless said otherwise.
@@ -73,6 +76,10 @@ struct DensityOptions {
   std::array<double, kTerrainCount> terrain_weights{};
   /// Computes the terrain terms even when their weights are 0 (calibration, realism figures).
   bool terrain_terms = false;
+  /// Boosted trees over the ten terms (`terrapolis calibrate --model boosted`): when set, their
+  /// density stands in for the weighted sum of the terms (the weights are not read), and the
+  /// user's factors combine with it as a term of weight 1.
+  std::shared_ptr<const BoostedModel> model;
   /// Cells of the river network on the DEM's grid (non-zero = river), for river_near; empty: no
   /// rivers known (river_near 0).
   Raster<std::uint8_t> rivers;

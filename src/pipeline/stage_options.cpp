@@ -9,6 +9,7 @@
 #include <map>
 
 #include "core/error.hpp"
+#include "density/boosted.hpp"
 #include "hydro/option_names.hpp"
 #include "io/mask_io.hpp"
 #include "io/raster_io.hpp"
@@ -115,6 +116,13 @@ density::DensityOptions density_options(const Scenario& scenario) {
   for (std::size_t k = 0; k < density::kTerrainTerms.size(); ++k) o.terrain_weights[k] = weights[density::kTerrainTerms[k]].get<double>();
   std::vector<double> layer_weights;
   for (const auto& layer : d["layers"]) layer_weights.push_back(layer["weight"].get<double>());
+  if (const std::string model = scenario.path("/density/model"); !model.empty()) {
+    try {  // read and checked now: a run refuses a bad model file before any stage
+      o.model = std::make_shared<const density::BoostedModel>(density::BoostedModel::load(model));
+    } catch (const Error& e) {
+      throw Error(e.kind(), std::string("/density/model: ") + e.what());
+    }
+  }
   density::check_settings(o, layer_weights);
   return o;
 }
@@ -141,7 +149,7 @@ void read_density_files(const Scenario& scenario, const Georef& grid, int cols, 
 
 std::vector<std::string> density_files(const Scenario& scenario) {
   const json& d = scenario.resolved["density"];
-  std::vector<std::string> files = {scenario.path("/water/water_mask")};
+  std::vector<std::string> files = {scenario.path("/water/water_mask"), scenario.path("/density/model")};
   for (const auto& layer : d["layers"]) files.push_back(scenario.file(layer["file"].get<std::string>()));
   for (const auto& file : d["exclusions"]) files.push_back(scenario.file(file.get<std::string>()));
   return files;
