@@ -8,15 +8,11 @@
 # all land (S46W066 is 98.6 % sea, which the model skips).
 # Usage: bench/density.sh [TERRAPOLIS_BIN] [RUNS]   (run from the repository root; THREADS=2)
 set -euo pipefail
-bin=${1:-build/src/cli/terrapolis}
 runs=${2:-5}
-threads=${THREADS:-2}
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
+# shellcheck source=bench/timing_setup.sh
+source "$(dirname "$0")/timing_setup.sh" "$@"  # bin, threads, tmp (removed at exit), median
 gdal_translate -q -outsize 3601 3601 -r bilinear ../shared/dems/N47E009.hgt "$tmp/N47E009_3601_land.tif"
 dems=(../shared/dems/S46W066.hgt ../shared/dems/N47E009.hgt "$tmp/N47E009_3601_land.tif")
-
-median() { sort -g | awk '{ v[NR] = $1 } END { print (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }'; }
 
 printf '%-22s %8s %8s %10s %10s %10s %10s\n' dem r_max_m r_min_m model_s model_cpu_s command_s cells
 for dem in "${dems[@]}"; do

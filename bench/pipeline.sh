@@ -5,14 +5,10 @@
 # (/usr/bin/time) and of each stage's wall time (run.json). No peer tool runs this pipeline.
 # Usage: bench/pipeline.sh [TERRAPOLIS_BIN] [RUNS]   (run from the repository root; THREADS=2)
 set -euo pipefail
-bin=${1:-build/src/cli/terrapolis}
 runs=${2:-3}
-threads=${THREADS:-2}
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
+# shellcheck source=bench/timing_setup.sh
+source "$(dirname "$0")/timing_setup.sh" "$@"  # bin, threads, tmp (removed at exit), median
 dems=(sample_dems/gebco2022_15s_north_corsica_capcorse.asc ${EXTRA_DEMS:-../shared/dems/gebco2022_15s_la_palma.asc ../shared/dems/N47E009.hgt ../shared/dems/N57E011.hgt})
-
-median() { sort -g | awk '{ v[NR] = $1 } END { print (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }'; }
 
 printf '%-44s %8s %8s  %s\n' dem wall_s peak_MB "stages (median s): terrain hydro density sites network roads access"
 for dem in "${dems[@]}"; do

@@ -6,18 +6,13 @@
 #include <vector>
 
 #include "core/raster.hpp"
+#include "support/local_grid.hpp"
 
 namespace terrapolis::hydro::test {
 
 /// A projected grid of square `cell` metre cells, values given row by row (row 0 north).
 inline Dem grid(int cols, int rows, std::vector<float> values, double cell = 1.0) {
-  Georef g;
-  g.transform = {500000, cell, 0, 5000000, 0, -cell};
-  g.crs.wkt = "LOCAL_CS[\"test\"]";
-  g.crs.name = "test metres";
-  g.crs.geographic = false;
-  g.crs.linear_unit_m = 1.0;
-  Dem d(cols, rows, g, 0.0f);
+  Dem d(cols, rows, support::local_metres(cell), 0.0f);
   d.values() = std::move(values);
   return d;
 }

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <utility>
 
 #include "roads/road_network.hpp"
 #include "roads_fixtures.hpp"
@@ -34,6 +35,31 @@ std::vector<Link> network(const Dem& dem, const std::vector<std::array<int, 4>>&
   return links;
 }
 
+/// The default cost model without bridges and tunnels: roads on the surface only.
+CostModel surface_model() {
+  CostModel model = default_cost_model();
+  model.bridge.enabled = model.tunnel.enabled = false;
+  return model;
+}
+
+/// What the network tests route on: a DEM, its terrain (sea at 0 m) and road graph, and routing
+/// options on that graph; each test states its DEM, graph, links and the options that differ.
+struct RoutingScene {
+  RoutingScene(Dem d, const GraphOptions& graph_options, const CostModel& model = surface_model())
+      : dem(std::move(d)), terrain(dem, 0.0, 10.0, 0.0), graph(terrain, model, graph_options) {
+    options.graph = graph_options;
+  }
+  RoutingScene(const RoutingScene&) = delete;  // the graph refers to this scene's terrain
+  RoutingScene& operator=(const RoutingScene&) = delete;
+  NetworkResult route(const std::vector<Link>& links) { return route_network(terrain, graph, links, options, silent); }
+
+  Dem dem;
+  TerrainField terrain;
+  RoadGraph graph;
+  RoutingOptions options;
+  SilentProgress silent;
+};
+
 std::string dump(const VectorLayer& l) {
   std::string s;
   char buf[64];
@@ -56,30 +82,25 @@ std::string dump(const VectorLayer& l) {
 }  // namespace
 
 TEST(RoadNetwork, SameOutputWithOneAndTwoThreadsAndFerriesBetweenIslands) {
-  const Dem dem = islands();
-  const TerrainField terrain(dem, 0.0, 10.0, 0.0);
   CostModel model = default_cost_model();
   model.bridge.max_length_cells = model.tunnel.max_length_cells = 8;
   model.bridge.samples = model.tunnel.samples = 20;
-  const RoadGraph graph(terrain, model, {4, 8, 9});
-  const std::vector<Link> net = network(dem, {{6, 20, 22, 20}, {14, 12, 14, 28}, {10, 17, 47, 20}, {42, 20, 52, 20}});
-  SilentProgress silent;
+  RoutingScene s(islands(), {4, 8, 9}, model);
+  const std::vector<Link> net = network(s.dem, {{6, 20, 22, 20}, {14, 12, 14, 28}, {10, 17, 47, 20}, {42, 20, 52, 20}});
+  s.options.max_grade_pct = {27, 27, 27, 27};  // the islands are steep: the default threshold's grade
   std::string outputs[2];
   for (int threads : {1, 2}) {
     for (Router router : {Router::galin, Router::bezier}) {
       tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
-      RoutingOptions o;
-      o.router = router;
-      o.graph = {4, 8, 9};
-      o.max_grade_pct = {27, 27, 27, 27};  // the islands are steep: the default threshold's grade
-      const NetworkResult r = route_network(terrain, graph, net, o, silent);
+      s.options.router = router;
+      const NetworkResult r = s.route(net);
       ASSERT_EQ(r.roads.size(), 4u);
       EXPECT_TRUE(r.roads[2].ferry);  // the two islands
       EXPECT_EQ(r.roads[2].router, "ferry");
       EXPECT_FALSE(r.roads[0].ferry);
       EXPECT_EQ(r.roads[0].router, router == Router::galin ? "galin" : "bezier");
-      outputs[threads - 1] += dump(roads_layer(terrain, r.roads, &r.layout)) + dump(sections_layer(terrain, r.roads)) +
-                              dump(network_sections_layer(terrain, r.layout)) + dump(junctions_layer(terrain, r.layout));
+      outputs[threads - 1] += dump(roads_layer(s.terrain, r.roads, &r.layout)) + dump(sections_layer(s.terrain, r.roads)) +
+                              dump(network_sections_layer(s.terrain, r.layout)) + dump(junctions_layer(s.terrain, r.layout));
     }
   }
   EXPECT_EQ(outputs[0], outputs[1]);
@@ -102,18 +123,12 @@ TEST(RoadNetwork, ClassFromTheSmallerEndsSizeClassByQuarters) {
 }
 
 TEST(RoadNetwork, LinksKeepTheirClassAndFerriesAreMaritime) {
-  const Dem dem = islands();
-  const TerrainField terrain(dem, 0.0, 10.0, 0.0);
-  CostModel model = default_cost_model();
-  model.bridge.enabled = model.tunnel.enabled = false;
-  const RoadGraph graph(terrain, model, {3, 1, 1});
-  std::vector<Link> net = network(dem, {{6, 20, 22, 20}, {10, 17, 47, 20}});
+  RoutingScene s(islands(), {3, 1, 1});
+  std::vector<Link> net = network(s.dem, {{6, 20, 22, 20}, {10, 17, 47, 20}});
   net[0].road_class = RoadClass::national;
   net[1].road_class = RoadClass::motorway;
-  SilentProgress silent;
-  RoutingOptions o;
-  o.max_grade_pct = {27, 27, 27, 27};  // the islands are steep: the default threshold's grade
-  const NetworkResult r = route_network(terrain, graph, net, o, silent);
+  s.options.max_grade_pct = {27, 27, 27, 27};  // the islands are steep: the default threshold's grade
+  const NetworkResult r = s.route(net);
   ASSERT_EQ(r.roads.size(), 2u);
   EXPECT_EQ(r.roads[0].road_class, RoadClass::national);
   EXPECT_EQ(r.roads[1].road_class, RoadClass::maritime);  // the two islands
@@ -169,31 +184,24 @@ TEST(BezierRouter, DeterministicAndNeverWorseThanTheStraightCurve) {
 }
 
 TEST(RoadNetwork, ABudgetMarksLinksNotRoutedAndKeepsTheOthers) {
-  const Dem dem = islands();
-  const TerrainField terrain(dem, 0.0, 10.0, 0.0);
-  CostModel model = default_cost_model();
-  model.bridge.enabled = model.tunnel.enabled = false;
-  const RoadGraph graph(terrain, model, {3, 8, 1});
-  const std::vector<Link> net = network(dem, {{6, 20, 22, 20}, {14, 12, 14, 28}, {10, 17, 47, 20}});
-  SilentProgress silent;
-  RoutingOptions o;
-  o.graph = {3, 8, 1};
-  o.max_grade_pct = {27, 27, 27, 27};  // the islands are steep: the default threshold's grade
-  o.max_seconds = 1e-9;  // every search runs out at its first check
-  const NetworkResult r = route_network(terrain, graph, net, o, silent);
+  RoutingScene s(islands(), {3, 8, 1});
+  const std::vector<Link> net = network(s.dem, {{6, 20, 22, 20}, {14, 12, 14, 28}, {10, 17, 47, 20}});
+  s.options.max_grade_pct = {27, 27, 27, 27};  // the islands are steep: the default threshold's grade
+  s.options.max_seconds = 1e-9;  // every search runs out at its first check
+  const NetworkResult r = s.route(net);
   EXPECT_EQ(r.over_budget.size(), 2u);  // the two land links
   ASSERT_EQ(r.roads.size(), 1u);        // the maritime link needs no search
   EXPECT_TRUE(r.roads[0].ferry);
   EXPECT_TRUE(r.failed.empty());
-  o.max_seconds = 3600;
-  EXPECT_TRUE(route_network(terrain, graph, net, o, silent).over_budget.empty());
+  s.options.max_seconds = 3600;
+  EXPECT_TRUE(s.route(net).over_budget.empty());
 }
 
 namespace {
 
-/// A flat valley floor 100 x 40 cells of 10 m between steep sides (rows < 6 and > 34).
-Dem valley() {
-  return test::make_dem(100, 40, 10.0, [](int, int r) { return r < 6 ? 100.0 + 30 * (6 - r) : r > 34 ? 100.0 + 30 * (r - 34) : 100.0; });
+/// A flat valley floor `cols` x 40 cells of 10 m between steep sides (rows < 6 and > 34).
+Dem valley(int cols = 100) {
+  return test::make_dem(cols, 40, 10.0, [](int, int r) { return r < 6 ? 100.0 + 30 * (6 - r) : r > 34 ? 100.0 + 30 * (r - 34) : 100.0; });
 }
 
 /// Share of a road's chain cells lying on `row`.
@@ -210,31 +218,23 @@ TEST(RoadNetwork, ASecondRoadJoinsTheFirstAlongTheValley) {
   // On its own the local road runs straight along row 24 (80 cells). With a 50 % discount on the
   // motorway's cells, going over to it (about 4 cells each way) and along it (72 cells at half
   // price, 36) costs about 45: the local road joins the motorway and leaves it near its end.
-  const Dem dem = valley();
-  const TerrainField terrain(dem, 0.0, 10.0, 0.0);
-  CostModel model = default_cost_model();
-  model.bridge.enabled = model.tunnel.enabled = false;
-  const RoadGraph graph(terrain, model, {4, 8, 1});
-  std::vector<Link> net = network(dem, {{10, 24, 90, 24}, {5, 20, 95, 20}});
+  RoutingScene s(valley(), {4, 8, 1});
+  std::vector<Link> net = network(s.dem, {{10, 24, 90, 24}, {5, 20, 95, 20}});
   net[0].road_class = RoadClass::local;
   net[1].road_class = RoadClass::motorway;  // routed first although listed second
-  SilentProgress silent;
-  RoutingOptions alone;
-  alone.graph = {4, 8, 1};
-  alone.reuse_discount = {0, 0, 0, 0};
-  const NetworkResult apart = route_network(terrain, graph, net, alone, silent);
+  s.options.reuse_discount = {0, 0, 0, 0};  // on its own: the roads ignore each other
+  const NetworkResult apart = s.route(net);
   ASSERT_EQ(apart.roads.size(), 2u);
-  EXPECT_GT(share_on_row(terrain, apart.roads[0], 24), 0.9);
-  EXPECT_EQ(share_on_row(terrain, apart.roads[0], 20), 0.0);
+  EXPECT_GT(share_on_row(s.terrain, apart.roads[0], 24), 0.9);
+  EXPECT_EQ(share_on_row(s.terrain, apart.roads[0], 20), 0.0);
   EXPECT_TRUE(apart.layout.junctions.empty());
   EXPECT_EQ(apart.layout.sections.size(), 2u);
 
-  RoutingOptions reuse = alone;
-  reuse.reuse_discount = {0.5, 0.5, 0.5, 0.5};
-  const NetworkResult joined = route_network(terrain, graph, net, reuse, silent);
+  s.options.reuse_discount = {0.5, 0.5, 0.5, 0.5};  // half price on the motorway
+  const NetworkResult joined = s.route(net);
   ASSERT_EQ(joined.roads.size(), 2u);  // not redundant: its ends were not on the network
   EXPECT_TRUE(joined.redundant.empty());
-  EXPECT_GT(share_on_row(terrain, joined.roads[0], 20), 0.75);
+  EXPECT_GT(share_on_row(s.terrain, joined.roads[0], 20), 0.75);
   EXPECT_LT(*joined.roads[0].cost, 0.7 * *apart.roads[0].cost);
   // Trunk: west part, shared part, east part; two spurs; two junctions where the spurs meet it.
   const RoadNetworkLayout& l = joined.layout;
@@ -243,7 +243,7 @@ TEST(RoadNetwork, ASecondRoadJoinsTheFirstAlongTheValley) {
     EXPECT_EQ(j.degree, 3);
     EXPECT_EQ(j.roads, 2u);
     EXPECT_EQ(j.classes, (std::vector<RoadClass>{RoadClass::motorway, RoadClass::local}));
-    EXPECT_EQ(j.cell / std::uint32_t(terrain.cols()), 20u);
+    EXPECT_EQ(j.cell / std::uint32_t(s.terrain.cols()), 20u);
   }
   ASSERT_EQ(l.sections.size(), 5u);
   std::size_t shared = 0;
@@ -262,57 +262,44 @@ TEST(RoadNetwork, ALinkRunningOnEarlierRoadsBetweenJoinedEndsIsDropped) {
   // A motorway A-B along row 20, a town C two cells off it. A-C joins the motorway and branches to
   // C (its end C is new: kept); C-B then runs on A-C's spur and the motorway only, between ends
   // the network already joins: redundant.
-  const Dem dem = valley();
-  const TerrainField terrain(dem, 0.0, 10.0, 0.0);
-  CostModel model = default_cost_model();
-  model.bridge.enabled = model.tunnel.enabled = false;
-  const RoadGraph graph(terrain, model, {4, 8, 1});
-  std::vector<Link> net = network(dem, {{10, 20, 90, 20}, {10, 20, 52, 22}, {52, 22, 90, 20}});
+  RoutingScene s(valley(), {4, 8, 1});
+  std::vector<Link> net = network(s.dem, {{10, 20, 90, 20}, {10, 20, 52, 22}, {52, 22, 90, 20}});
   net[0].road_class = RoadClass::motorway;
   net[1].road_class = net[2].road_class = RoadClass::local;
   net[2].from = 7;
-  SilentProgress silent;
-  RoutingOptions o;
-  o.graph = {4, 8, 1};
-  const NetworkResult r = route_network(terrain, graph, net, o, silent);
+  const NetworkResult r = s.route(net);
   EXPECT_EQ(r.roads.size(), 2u);
   ASSERT_EQ(r.redundant.size(), 1u);
   EXPECT_EQ(r.redundant[0], "7-3");
-  o.redundant_share = 1.01;  // keeps every link
-  EXPECT_EQ(route_network(terrain, graph, net, o, silent).roads.size(), 3u);
+  s.options.redundant_share = 1.01;  // keeps every link
+  EXPECT_EQ(s.route(net).roads.size(), 3u);
 }
 
 TEST(RoadNetwork, GradesNeverExceedTheClassLimitOnACone) {
   // A cone of 20 degree flanks (36 %) on a plain: every class climbs to a town half-way up within
   // its design grade (slanting across the flank), its surface never steeper; tighter classes climb longer.
-  const Dem dem = test::make_dem(80, 80, 10.0, [](int c, int r) {
+  const Dem cone = test::make_dem(80, 80, 10.0, [](int c, int r) {
     const double d = std::hypot(c - 39.5, r - 39.5) * 10.0;
     return 20.0 + std::max(0.0, 120.0 - d * std::tan(20.0 * std::numbers::pi / 180));
   });
-  const TerrainField terrain(dem, 0.0, 10.0, 0.0);
-  CostModel model = default_cost_model();
-  model.bridge.enabled = model.tunnel.enabled = false;
-  const RoadGraph graph(terrain, model, {5, 16, 3});
-  SilentProgress silent;
-  RoutingOptions o;
-  o.graph = {5, 16, 3};
-  o.reuse_discount = {0, 0, 0, 0};
-  o.max_grade_pct = {8, 10, 12, 16};
+  RoutingScene s(cone, {5, 16, 3});
+  s.options.reuse_discount = {0, 0, 0, 0};
+  s.options.max_grade_pct = {8, 10, 12, 16};
   double previous = 0;
   for (RoadClass c : {RoadClass::local, RoadClass::departmental, RoadClass::national, RoadClass::motorway}) {
-    std::vector<Link> net = network(dem, {{2, 40, 24, 40}});  // 60 m up at 16 cells from the top
+    std::vector<Link> net = network(s.dem, {{2, 40, 24, 40}});  // 60 m up at 16 cells from the top
     net[0].road_class = c;
-    const NetworkResult r = route_network(terrain, graph, net, o, silent);
+    const NetworkResult r = s.route(net);
     ASSERT_EQ(r.roads.size(), 1u) << name_of(c);
-    const RoadStats& s = r.roads[0].stats;
-    const double limit = o.max_grade_pct[std::size_t(c)];
-    EXPECT_NEAR(s.grade_limit_pct, limit, 1e-9);
-    EXPECT_LE(s.max_grade_pct, limit * (1 + 1e-6)) << name_of(c);
-    EXPECT_EQ(s.over_limit_m, 0.0) << name_of(c);
-    EXPECT_EQ(s.longest_over_limit_m, 0.0) << name_of(c);
-    EXPECT_EQ(s.water_m, 0.0);
-    EXPECT_GT(s.length_m, previous) << name_of(c);  // a gentler grade is a longer road
-    previous = s.length_m;
+    const RoadStats& stats = r.roads[0].stats;
+    const double limit = s.options.max_grade_pct[std::size_t(c)];
+    EXPECT_NEAR(stats.grade_limit_pct, limit, 1e-9);
+    EXPECT_LE(stats.max_grade_pct, limit * (1 + 1e-6)) << name_of(c);
+    EXPECT_EQ(stats.over_limit_m, 0.0) << name_of(c);
+    EXPECT_EQ(stats.longest_over_limit_m, 0.0) << name_of(c);
+    EXPECT_EQ(stats.water_m, 0.0);
+    EXPECT_GT(stats.length_m, previous) << name_of(c);  // a gentler grade is a longer road
+    previous = stats.length_m;
   }
 }
 
@@ -362,23 +349,17 @@ TEST(RoadNetwork, RoutingAheadGivesTheRoadsOfOneLinkAfterTheOther) {
   std::size_t rerouted = 0;
   for (int trial = 0; trial < 4; ++trial) {
     const RandomNetwork net = random_network(rng, 48, 9);
-    const TerrainField terrain(net.dem, 0.0, 10.0, 0.0);
-    CostModel model = default_cost_model();
-    model.bridge.enabled = model.tunnel.enabled = false;
-    const RoadGraph graph(terrain, model, {4, 8, 1});
-    SilentProgress silent;
-    RoutingOptions o;
-    o.graph = {4, 8, 1};
-    o.max_grade_pct = {30, 30, 30, 30};
+    RoutingScene s(net.dem, {4, 8, 1});
+    s.options.max_grade_pct = {30, 30, 30, 30};
     auto layers = [&](const NetworkResult& r) {
-      return dump(roads_layer(terrain, r.roads, &r.layout)) + dump(network_sections_layer(terrain, r.layout)) +
-             dump(junctions_layer(terrain, r.layout));
+      return dump(roads_layer(s.terrain, r.roads, &r.layout)) + dump(network_sections_layer(s.terrain, r.layout)) +
+             dump(junctions_layer(s.terrain, r.layout));
     };
-    o.lookahead = 1;  // one link after the other: each routed once
+    s.options.lookahead = 1;  // one link after the other: each routed once
     NetworkResult sequential;
     {
       tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
-      sequential = route_network(terrain, graph, net.links, o, silent);
+      sequential = s.route(net.links);
     }
     EXPECT_EQ(sequential.searches, net.links.size());
     ASSERT_GE(sequential.roads.size(), 3u);
@@ -387,8 +368,8 @@ TEST(RoadNetwork, RoutingAheadGivesTheRoadsOfOneLinkAfterTheOther) {
     for (std::size_t lookahead : {2, 3, 16})
       for (int threads : {1, 2}) {
         tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
-        o.lookahead = lookahead;
-        const NetworkResult r = route_network(terrain, graph, net.links, o, silent);
+        s.options.lookahead = lookahead;
+        const NetworkResult r = s.route(net.links);
         EXPECT_EQ(layers(r), expected) << "trial " << trial << ", look-ahead " << lookahead << ", " << threads << " threads";
         EXPECT_EQ(r.redundant, sequential.redundant);
         EXPECT_GE(r.searches, net.links.size());
@@ -403,19 +384,12 @@ TEST(RoadNetwork, ALinkRoutedAheadFarFromTheRoadsBeforeItIsKept) {
   // (searches 1 and 2, then 2 again). The third link, at the other end of a long valley, is routed
   // ahead of the second: its search never reads a cell of the second road, so it is kept (4
   // searches); crossing the second road instead, it is routed again (5).
-  const Dem dem = test::make_dem(220, 40, 10.0, [](int, int r) { return r < 6 ? 100.0 + 30 * (6 - r) : r > 34 ? 100.0 + 30 * (r - 34) : 100.0; });
-  const TerrainField terrain(dem, 0.0, 10.0, 0.0);
-  CostModel model = default_cost_model();
-  model.bridge.enabled = model.tunnel.enabled = false;
-  const RoadGraph graph(terrain, model, {4, 8, 1});
-  SilentProgress silent;
-  RoutingOptions o;
-  o.graph = {4, 8, 1};
-  o.lookahead = 2;
-  const NetworkResult apart = route_network(terrain, graph, network(dem, {{5, 20, 100, 20}, {10, 28, 90, 30}, {150, 20, 210, 22}}), o, silent);
+  RoutingScene s(valley(220), {4, 8, 1});
+  s.options.lookahead = 2;
+  const NetworkResult apart = s.route(network(s.dem, {{5, 20, 100, 20}, {10, 28, 90, 30}, {150, 20, 210, 22}}));
   EXPECT_EQ(apart.roads.size() + apart.redundant.size(), 3u);
   EXPECT_EQ(apart.searches, 4u);
-  const NetworkResult crossing = route_network(terrain, graph, network(dem, {{5, 20, 100, 20}, {10, 28, 90, 30}, {60, 30, 130, 10}}), o, silent);
+  const NetworkResult crossing = s.route(network(s.dem, {{5, 20, 100, 20}, {10, 28, 90, 30}, {60, 30, 130, 10}}));
   EXPECT_EQ(crossing.roads.size() + crossing.redundant.size(), 3u);
   EXPECT_EQ(crossing.searches, 5u);
 }

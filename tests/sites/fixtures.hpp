@@ -8,6 +8,7 @@
 
 #include "core/raster.hpp"
 #include "io/raster_io.hpp"
+#include "sites/sites.hpp"
 
 namespace terrapolis::fixtures {
 
@@ -39,6 +40,19 @@ inline SitesScenario flat_scenario(int cols, int rows, double cell_m) {
   g.crs.name = "WGS 84 / UTM zone 32N";
   g.crs.geographic = false;
   return {Raster<float>(cols, rows, g, 0.5f), Raster<std::uint8_t>(cols, rows, g, 1)};
+}
+
+/// Sites options with the thesis's quota table: the tests that start from them check Algorithms 13-15.
+inline sites::SitesOptions thesis_options() {
+  sites::SitesOptions o;
+  o.quotas = sites::SitesOptions::Quotas::belhadj2007;
+  return o;
+}
+
+/// The sites placed on a scenario, progress not reported.
+inline sites::SitesResult place(const SitesScenario& s, const sites::SitesOptions& o) {
+  SilentProgress progress;
+  return sites::place_sites(s.density, s.buildable, o, progress);
 }
 
 }  // namespace terrapolis::fixtures

@@ -13,11 +13,9 @@ using namespace terrapolis::sites;
 
 TEST(SitesLayers, FieldContractAndRoundTrip) {
   const auto s = fixtures::scenario_from_sample("gebco2022_15s_north_corsica_capcorse.asc");
-  SilentProgress progress;
-  SitesOptions o;
-  o.quotas = SitesOptions::Quotas::belhadj2007;  // the thesis's table: these tests check Algorithms 13-15
+  SitesOptions o = fixtures::thesis_options();
   o.seed = 21;
-  const SitesResult r = place_sites(s.density, s.buildable, o, progress);
+  const SitesResult r = fixtures::place(s, o);
   const Crs& crs = s.density.georef().crs;
   const VectorLayer cities = cities_layer(r, crs);
   const std::vector<std::string> names = {"id", "radius_m", "class", "population", "density", "parent", "depth", "seed"};

@@ -22,8 +22,7 @@ namespace {
 //   r = 1000: 4 + 1068 * 0.1296  = 142.4128 -> 142
 //   r =  500: 4 + 1068 * 0.4096  = 441.4528 -> 441
 TEST(Quotas, ThesisCorsicaTable) {
-  SitesOptions o;
-  o.quotas = SitesOptions::Quotas::belhadj2007;  // the thesis's table: these tests check Algorithms 13-15
+  SitesOptions o = fixtures::thesis_options();
   o.r_min_m = 500;
   o.r_max_m = 3000;
   const QuotaTable t = compute_quotas(500.0, o);
@@ -41,8 +40,7 @@ TEST(Quotas, ThesisCorsicaTable) {
 // The same table scaled to Corsica (8680 km2 of the 543940 km2 the census fit describes):
 //   scale 0.015958 x (4, 5.7088, 31.3408, 142.4128, 441.4528) = (0.064, 0.091, 0.500, 2.273, 7.045)
 TEST(Quotas, ScaledToARegion) {
-  SitesOptions o;
-  o.quotas = SitesOptions::Quotas::belhadj2007;  // the thesis's table: these tests check Algorithms 13-15
+  SitesOptions o = fixtures::thesis_options();
   o.r_min_m = 500;
   o.r_max_m = 3000;
   o.quota_scale = 8680.0 / 543940.0;
@@ -54,8 +52,7 @@ TEST(Quotas, ScaledToARegion) {
 }
 
 TEST(Quotas, StepAndAutomaticRange) {
-  SitesOptions o;
-  o.quotas = SitesOptions::Quotas::belhadj2007;  // the thesis's table: these tests check Algorithms 13-15
+  SitesOptions o = fixtures::thesis_options();
   EXPECT_EQ(class_step_m(30.85, o), 50.0);    // dr_min wins on fine grids
   EXPECT_EQ(class_step_m(463.7, o), 463.0);   // floor(1/e) on coarse ones
   const QuotaTable t = compute_quotas(30.0, o);
@@ -69,15 +66,13 @@ TEST(Quotas, StepAndAutomaticRange) {
 }
 
 TEST(Quotas, PastXmaxStaysAtUmin) {
-  SitesOptions o;
-  o.quotas = SitesOptions::Quotas::belhadj2007;  // the thesis's table: these tests check Algorithms 13-15
+  SitesOptions o = fixtures::thesis_options();
   EXPECT_EQ(units_for_people(2e6, o), 4.0);
   EXPECT_EQ(units_for_people(0, o), 1072.0);
 }
 
 TEST(Quotas, EmptyRangeIsBadInput) {
-  SitesOptions o;
-  o.quotas = SitesOptions::Quotas::belhadj2007;  // the thesis's table: these tests check Algorithms 13-15
+  SitesOptions o = fixtures::thesis_options();
   o.r_min_m = 1000;
   o.r_max_m = 1020;
   try {
@@ -149,6 +144,14 @@ void check_invariants(const fixtures::SitesScenario& s, const SitesResult& r, co
   }
 }
 
+/// The sites of `s` placed with `o`, checked: more than `more_than` of them, every invariant.
+SitesResult checked_placement(const fixtures::SitesScenario& s, const SitesOptions& o, std::size_t more_than, bool exact) {
+  const SitesResult r = fixtures::place(s, o);
+  EXPECT_GT(r.sites.size(), more_than);
+  check_invariants(s, r, o, exact);
+  return r;
+}
+
 bool same_sites(const std::vector<Site>& a, const std::vector<Site>& b) {
   if (a.size() != b.size()) return false;
   for (std::size_t i = 0; i < a.size(); ++i)
@@ -160,19 +163,15 @@ bool same_sites(const std::vector<Site>& a, const std::vector<Site>& b) {
 
 TEST(Placement, CorsicaGeographicInvariants) {
   const auto s = fixtures::scenario_from_sample("gebco2022_15s_north_corsica_capcorse.asc");
-  SilentProgress progress;
   for (auto [mode, refill] : {std::pair{SitesOptions::Mode::paris, 8}, {SitesOptions::Mode::manhattan, 8}, {SitesOptions::Mode::paris, 0}}) {
-    SitesOptions o;
-    o.quotas = SitesOptions::Quotas::belhadj2007;  // the thesis's table: these tests check Algorithms 13-15
+    SitesOptions o = fixtures::thesis_options();
     o.seed = 7;
     o.mode = mode;
     o.refill_rounds = refill;
-    const SitesResult r = place_sites(s.density, s.buildable, o, progress);
-    EXPECT_GT(r.sites.size(), 20u);
-      EXPECT_EQ(r.dr_m, 462.0);  // 15" GEBCO at 43 N: cells 462.9 m north-south
-    check_invariants(s, r, o, true);
+    const SitesResult r = checked_placement(s, o, 20u, true);
+    EXPECT_EQ(r.dr_m, 462.0);  // 15" GEBCO at 43 N: cells 462.9 m north-south
     if (refill == 0) {
-      const auto with_refill = [&] { SitesOptions f = o; f.refill_rounds = 8; return place_sites(s.density, s.buildable, f, progress); }();
+      const auto with_refill = [&] { SitesOptions f = o; f.refill_rounds = 8; return fixtures::place(s, f); }();
       EXPECT_GT(with_refill.sites.size(), r.sites.size()) << "refill adds sites";
     }
     if (mode == SitesOptions::Mode::paris) {
@@ -185,38 +184,28 @@ TEST(Placement, CorsicaGeographicInvariants) {
 
 TEST(Placement, VermontProjectedInvariants) {
   const auto s = fixtures::scenario_from_sample("whiteboxR_DEM_vermont.tif");
-  SilentProgress progress;
-  SitesOptions o;
-  o.quotas = SitesOptions::Quotas::belhadj2007;  // the thesis's table: these tests check Algorithms 13-15
+  SitesOptions o = fixtures::thesis_options();
   o.seed = 3;
   o.r_max_m = 800;
-  const SitesResult r = place_sites(s.density, s.buildable, o, progress);
-  EXPECT_GT(r.sites.size(), 10u);
-  check_invariants(s, r, o, true);
+  checked_placement(s, o, 10u, true);
 }
 
 TEST(Placement, PerimeterModeKeepsQuotas) {
   const auto s = fixtures::scenario_from_sample("gebco2022_15s_north_corsica_capcorse.asc");
-  SilentProgress progress;
-  SitesOptions o;
-  o.quotas = SitesOptions::Quotas::belhadj2007;  // the thesis's table: these tests check Algorithms 13-15
+  SitesOptions o = fixtures::thesis_options();
   o.disc_test = SitesOptions::DiscTest::perimeter;
-  const SitesResult r = place_sites(s.density, s.buildable, o, progress);
-  EXPECT_GT(r.sites.size(), 20u);
-  check_invariants(s, r, o, false);
+  checked_placement(s, o, 20u, false);
 }
 
 TEST(Placement, SameSeedSameSitesOtherSeedOtherSites) {
   const auto s = fixtures::scenario_from_sample("gebco2022_15s_north_corsica_capcorse.asc");
-  SilentProgress progress;
-  SitesOptions o;
-  o.quotas = SitesOptions::Quotas::belhadj2007;  // the thesis's table: these tests check Algorithms 13-15
+  SitesOptions o = fixtures::thesis_options();
   o.seed = 11;
-  const SitesResult a = place_sites(s.density, s.buildable, o, progress);
-  const SitesResult b = place_sites(s.density, s.buildable, o, progress);
+  const SitesResult a = fixtures::place(s, o);
+  const SitesResult b = fixtures::place(s, o);
   EXPECT_TRUE(same_sites(a.sites, b.sites));
   o.seed = 12;
-  const SitesResult c = place_sites(s.density, s.buildable, o, progress);
+  const SitesResult c = fixtures::place(s, o);
   EXPECT_FALSE(same_sites(a.sites, c.sites));
 }
 
@@ -229,15 +218,13 @@ TEST(Placement, ExactDiscSeesTheHolePerimeterMissesIt) {
     auto s = fixtures::flat_scenario(41, 41, 100.0);
     s.density(20, 20) = 1.0f;
     s.buildable(22, 19) = 0;
-    SitesOptions o;
-    o.quotas = SitesOptions::Quotas::belhadj2007;  // the thesis's table: these tests check Algorithms 13-15
+    SitesOptions o = fixtures::thesis_options();
     o.r_min_m = 100;
     o.r_max_m = 1000;
     o.dr_min_m = 300;
     o.candidates = 41 * 41;  // every buildable cell
     o.disc_test = test;
-    SilentProgress progress;
-    const SitesResult r = place_sites(s.density, s.buildable, o, progress);
+    const SitesResult r = fixtures::place(s, o);
     ASSERT_EQ(r.quotas.size(), 3u);
     bool found = false;
     for (const Site& t : r.sites)
