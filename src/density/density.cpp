@@ -531,8 +531,6 @@ void terrain_terms(const Dem& dem, const Grid& g, const DensityOptions& options,
   for (TerrainTerm t : {TerrainTerm::altitude, TerrainTerm::slope, TerrainTerm::position_1km, TerrainTerm::position_5km}) to_land_rank(term(t));
 }
 
-/// The density (§4.2.1, Fig. 4.3): the weighted combination of the characteristics, the user's
-/// factors and the terrain terms on habitable cells, 0 elsewhere on known ground.
 /// The boosted trees' density of every habitable cell of the core, in [0,1] (NaN elsewhere).
 std::vector<float> boosted_density(const Dem& dem, const Grid& g, const BoostedModel& model, const DensityResult& result) {
   const auto names = term_names();
@@ -559,6 +557,8 @@ std::vector<float> boosted_density(const Dem& dem, const Grid& g, const BoostedM
   return unit;
 }
 
+/// The density (§4.2.1, Fig. 4.3): the weighted combination of the characteristics, the user's
+/// factors and the terrain terms on habitable cells, 0 elsewhere on known ground.
 void combine_terms(const Dem& dem, const Grid& g, const DensityOptions& options, DensityResult& result, Progress& progress) {
   result.density = dem.like<float>(nan_f);
   ProgressStep step(progress, "density: combine");

@@ -75,7 +75,7 @@ std::vector<Action> plan_stages(const RunOptions& options) {
 /// A saved stage is read back only for the same DEM and the same parameters of its own (those of
 /// the stages before it are checked too when they are read back; a rerun one makes it stale).
 void check_reusable(const std::filesystem::path& folder, const json& saved, const Scenario& scenario, const std::string& dem_sha256,
-                    const std::vector<Action>& plan) {
+                    const json& files, const std::vector<Action>& plan) {
   if (saved["input"].value("sha256", "") != dem_sha256)
     throw bad_input(folder.string() + ": the saved run was made from another DEM; run the whole scenario");
   for (std::size_t i = 0; i < plan.size(); ++i) {
@@ -86,10 +86,17 @@ void check_reusable(const std::filesystem::path& folder, const json& saved, cons
     if (!saved["summary"].contains(stage.name))
       throw bad_input(folder.string() + ": the saved run has no " + stage.name + " stage; rerun from it");
     if (plan[i] != Action::load) continue;
-    for (const auto& key : stage.sections)
+    for (const auto& key : stage.sections) {
       if (!saved["scenario"].contains(key) || saved["scenario"][key] != scenario.resolved[key])
         throw bad_input(folder.string() + ": the saved run used other '" + key + "' parameters; rerun from " + stage.name +
                         " (--from " + stage.name + ")");
+      // The same settings may name a file whose content changed since (a new mask, refitted trees).
+      const json& before = saved["input"].contains("files") ? saved["input"]["files"] : files;
+      for (const auto& [pointer, sha256] : files.items())
+        if (pointer.rfind("/" + key + "/", 0) == 0 && before.value(pointer, "") != sha256)
+          throw bad_input(folder.string() + ": " + pointer + " names a file changed since the saved run; rerun from " + stage.name +
+                          " (--from " + stage.name + ")");
+    }
   }
 }
 
@@ -109,6 +116,26 @@ void reuse_saved(RunState& state, const json& saved, const std::string& stage, j
       entry["reused"] = true;
       timings.push_back(entry);
     }
+}
+
+/// The checksum of every file the scenario names besides the DEM (which input.sha256 holds), by the
+/// JSON pointer of its setting: a rerun reuses a saved stage only if the files it read are unchanged.
+json input_files(const Scenario& scenario) {
+  json files = json::object();
+  std::function<void(const json&, const std::string&)> walk = [&](const json& j, const std::string& pointer) {
+    if (j.is_object()) {
+      for (const auto& [key, value] : j.items())
+        if (!(pointer.empty() && (key == "output" || key == "dem"))) walk(value, pointer + "/" + key);
+    } else if (j.is_array()) {
+      for (std::size_t k = 0; k < j.size(); ++k) walk(j[k], pointer + "/" + std::to_string(k));
+    } else if (j.is_string() && !j.get<std::string>().empty()) {
+      std::error_code ec;
+      if (const std::string path = scenario.file(j.get<std::string>()); std::filesystem::is_regular_file(path, ec))
+        files[pointer] = file_sha256(path);
+    }
+  };
+  walk(scenario.resolved, "");
+  return files;
 }
 
 /// Every file the scenario names (its strings that name an existing file, resolved as its paths
@@ -177,7 +204,8 @@ json run_scenario(const Scenario& scenario, const RunOptions& options, Progress&
   const std::string dem_sha256 = file_sha256(dem_path);
   plugin::PluginSet plugins = plugin::load_plugins(nlohmann::json::parse(scenario.resolved["plugins"].dump()), log,
                                                    scenario.base_dir.string());
-  if (rerun) check_reusable(output, saved, scenario, dem_sha256, plan);
+  const json files = input_files(scenario);
+  if (rerun) check_reusable(output, saved, scenario, dem_sha256, files, plan);
   {
     RunState state(scenario, temp, dem_sha256, std::move(dem));
     state.plugins = std::move(plugins);
@@ -212,7 +240,7 @@ json run_scenario(const Scenario& scenario, const RunOptions& options, Progress&
     manifest["scenario_source"] = scenario.source;
     manifest["input"] = {{"dem", dem_path}, {"sha256", state.dem_sha256}, {"bytes", fs::file_size(dem_path)},
                          {"crs", state.dem.georef().crs.name},
-                         {"epsg", state.dem.georef().crs.epsg ? json(*state.dem.georef().crs.epsg) : json(nullptr)}};
+                         {"epsg", state.dem.georef().crs.epsg ? json(*state.dem.georef().crs.epsg) : json(nullptr)}, {"files", files}};
     json libs = json::object();
     for (const auto& [name, version] : io_library_versions()) libs[name] = version;
     manifest["libraries"] = libs;

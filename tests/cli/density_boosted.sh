@@ -44,6 +44,11 @@ assert m["scenario"]["density"]["model"] == "fit.boosted.json", m["scenario"]["d
 assert m["summary"]["sites"]["cities"] > 0
 PY
 
+# Refitted trees under the same name: a rerun does not reuse the density made with the old ones.
+"$TP" -q calibrate "$dem" --settlements "$places" --model boosted --trees 41 --depth 2 --fragment fit.json --overwrite > /dev/null
+expect_fail 2 "/density/model names a file changed since the saved run; rerun from density" "$TP" run boosted.json -o one --from sites
+"$TP" -q run boosted.json -o one --from density 2> /dev/null
+
 # The density command takes it as --model.
 "$TP" -q density "$dem" d --model fit.boosted.json
 "$TP" -q density "$dem" d_weighted
