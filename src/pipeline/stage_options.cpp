@@ -273,27 +273,11 @@ hydro::FlatWaterOptions flat_water_options(const Scenario& scenario) {
   return o;
 }
 
-namespace {
-
-/// Runs `make`, naming `pointer` in its errors unless they name a field already.
-template <class Make>
-auto at(const std::string& pointer, Make&& make) -> decltype(make()) {
-  try {
-    return make();
-  } catch (const Error& e) {
-    const std::string message = e.what();
-    throw Error(e.kind(), message.starts_with('/') ? message : pointer + ": " + message);
-  }
-}
-
-/// A file the scenario names must exist before the run starts (GDAL's /vsi paths are its to check).
 void check_file(const std::string& pointer, const std::string& path) {
   std::error_code ec;
   if (path.empty() || path.starts_with("/vsi") || std::filesystem::is_regular_file(path, ec)) return;
   throw bad_input(pointer + ": " + path + ": no such file");
 }
-
-}  // namespace
 
 AccessSettings access_settings(const Scenario& scenario) {
   const json& a = scenario.resolved["access"];
@@ -314,38 +298,5 @@ AccessSettings access_settings(const Scenario& scenario) {
   return s;
 }
 
-StageSettings prepare_stages(const Scenario& scenario) {
-  try {
-    StageSettings s;
-    // Only the hydro and density commands work tile by tile yet (docs/scale.md): a run refuses it.
-    if (const TileSettings t = tile_settings(scenario); t.tile_size > 0 || t.memory_limit_mb > 0)
-      throw bad_input(std::string(t.tile_size > 0 ? "/input/tile_size" : "/input/memory_limit_mb") +
-                      ": a run does not work tile by tile yet (only the hydro and density commands do)");
-    s.water = inland_water_settings(scenario);
-    s.hydro = hydro_options(scenario);
-    s.river_types = river_type_options(scenario);
-    s.d8_codes = d8_codes(scenario);
-    s.density = density_options(scenario);
-    s.sites = sites_options(scenario);
-    s.network = network_options(scenario);
-    s.roads = at("/roads/costs", [&] { return roads_settings(scenario); });
-    s.corridor = corridor_settings(scenario);
-    s.access = access_settings(scenario);
-    check_file("/roads/corridor/side_angles", s.corridor.side_angles);
-    check_file("/water/water_mask", scenario.path("/water/water_mask"));
-    check_file("/roads/vegetation", s.roads.vegetation);
-    check_file("/roads/existing", s.roads.existing);
-    check_file("/sites/reference", scenario.path("/sites/reference"));
-    check_file("/sites/existing", scenario.path("/sites/existing"));
-    const json& density = scenario.resolved["density"];
-    for (std::size_t i = 0; i < density["layers"].size(); ++i)
-      check_file("/density/layers/" + std::to_string(i) + "/file", scenario.file(density["layers"][i]["file"].get<std::string>()));
-    for (std::size_t i = 0; i < density["exclusions"].size(); ++i)
-      check_file("/density/exclusions/" + std::to_string(i), scenario.file(density["exclusions"][i].get<std::string>()));
-    return s;
-  } catch (const Error& e) {
-    throw Error(e.kind(), scenario.source + ": " + e.what());
-  }
-}
 
 }  // namespace terrapolis::pipeline

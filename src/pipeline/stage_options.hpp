@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "access/access.hpp"
+#include "core/error.hpp"
 #include "density/density.hpp"
 #include "hydro/hydro.hpp"
 #include "hydro/river_types.hpp"
@@ -85,8 +86,6 @@ CorridorSettings corridor_settings(const Scenario& scenario);
 /// The water section's detection of lakes the DEM flattens (water.flat_water_*, water.sea_level_m).
 hydro::FlatWaterOptions flat_water_options(const Scenario& scenario);
 
-/// Every stage's typed settings, built once before the first stage runs (as PDAL prepares every
-/// stage before executing any): the commands build theirs with the same functions.
 /// access.*: the friction surface and what is measured.
 struct AccessSettings {
   bool enabled = true;
@@ -105,6 +104,8 @@ struct InlandWaterSettings {
 /// Errors name the setting's pointer.
 InlandWaterSettings inland_water_settings(const Scenario& scenario);
 
+/// Every stage's typed settings, built by each stage's `prepare` before the first stage runs (as
+/// PDAL prepares every stage before executing any): the commands build theirs with the same functions.
 struct StageSettings {
   InlandWaterSettings water;
   hydro::HydroOptions hydro;
@@ -117,8 +118,18 @@ struct StageSettings {
   CorridorSettings corridor;
   AccessSettings access;
 };
-/// Builds every stage's settings, loads the cost model and checks that every file the scenario
-/// names exists. Throws bad_input as "SCENARIO: /json/pointer: problem".
-StageSettings prepare_stages(const Scenario& scenario);
+/// A file the scenario names must exist before the run starts (GDAL's /vsi paths are GDAL's to
+/// check): throws bad_input "POINTER: PATH: no such file".
+void check_file(const std::string& pointer, const std::string& path);
+/// Runs `make`, naming `pointer` in its errors unless they name a setting already.
+template <class Make>
+auto at_pointer(const std::string& pointer, Make&& make) -> decltype(make()) {
+  try {
+    return make();
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    throw Error(e.kind(), message.starts_with('/') ? message : pointer + ": " + message);
+  }
+}
 
 }  // namespace terrapolis::pipeline

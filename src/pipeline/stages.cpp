@@ -9,6 +9,7 @@
 
 #include "core/error.hpp"
 #include "core/geodesy.hpp"
+#include "density/tiled_density.hpp"
 #include "io/raster_io.hpp"
 #include "network/layers.hpp"
 #include "pipeline/density_folder.hpp"
@@ -26,6 +27,7 @@ namespace terrapolis::pipeline {
 namespace {
 
 using json = nlohmann::ordered_json;
+using Settings = StageSettings;
 
 double round_to(double v, double step) { return std::round(v / step) * step; }
 
@@ -49,6 +51,19 @@ void terrain_run(RunState& s, Progress&, const Log&) {
 }
 
 void terrain_load(RunState&) {}  // the DEM is always read from the input
+
+void terrain_prepare(const Scenario& scenario, const Dem&, Settings&) {
+  // Only the hydro and density commands work tile by tile yet (docs/scale.md): a run refuses it.
+  if (const TileSettings t = tile_settings(scenario); t.tile_size > 0 || t.memory_limit_mb > 0)
+    throw bad_input(std::string(t.tile_size > 0 ? "/input/tile_size" : "/input/memory_limit_mb") +
+                    ": a run does not work tile by tile yet (only the hydro and density commands do)");
+}
+
+void terrain_summary(const json& figures, SummaryText& out) {
+  const json& t = figures["terrain"];
+  out.line("  terrain  %d x %d cells, %.0f .. %.0f m, %.1f%% nodata\n", t["cols"].get<int>(), t["rows"].get<int>(), t["min_m"].get<double>(),
+           t["max_m"].get<double>(), 100 * t["nodata_share"].get<double>());
+}
 
 // ---- inland water (docs/lakes.md, docs/roads.md) -----------------------------------------
 
@@ -114,6 +129,20 @@ void hydro_load(RunState& s) {
   s.rivers = river_cells(m2, s.scenario);
 }
 
+void hydro_prepare(const Scenario& scenario, const Dem&, Settings& s) {
+  s.water = inland_water_settings(scenario);
+  s.hydro = hydro_options(scenario);
+  s.river_types = river_type_options(scenario);
+  s.d8_codes = d8_codes(scenario);
+  check_file("/water/water_mask", s.water.water_mask);
+}
+
+void hydro_summary(const json& figures, SummaryText& out) {
+  const json& h = figures["hydro"];
+  out.line("  hydro    %d stream reaches, %.1f km, Strahler up to %d, largest catchment %.1f km2\n", h["stream_reaches"].get<int>(),
+           h["stream_length_km"].get<double>(), h["max_strahler"].get<int>(), h["largest_catchment_km2"].get<double>());
+}
+
 // ---- density (Belhadj 2007 §4.2; docs/density.md) -----------------------------------------
 
 /// The density model's inputs in a run: the settings, the scenario's layers and exclusions, and
@@ -151,6 +180,22 @@ void density_load(RunState& s) {
     throw bad_input(saved(s, "density.tif") + ": not on the DEM's grid");
   s.density = std::move(saved_outputs.density);
   s.buildable = std::move(saved_outputs.buildable);
+}
+
+void density_prepare(const Scenario& scenario, const Dem& dem, Settings& s) {
+  s.density = density_options(scenario);
+  const json& density = scenario.resolved["density"];
+  for (std::size_t i = 0; i < density["layers"].size(); ++i)
+    check_file("/density/layers/" + std::to_string(i) + "/file", scenario.file(density["layers"][i]["file"].get<std::string>()));
+  for (std::size_t i = 0; i < density["exclusions"].size(); ++i)
+    check_file("/density/exclusions/" + std::to_string(i), scenario.file(density["exclusions"][i].get<std::string>()));
+  density::raised_r_min(cell_metrics(dem.georef(), dem.cols(), dem.rows()), s.density);  // r_max against r_min raised to this grid's cells
+}
+
+void density_summary(const json& figures, SummaryText& out) {
+  const json& d = figures["density"];
+  out.line("  density  %.1f%% water, %.1f%% of the land buildable, mean density %.3f\n", 100 * d["water_share"].get<double>(),
+           100 * d["buildable_land_share"].get<double>(), d["mean_density"].get<double>());
 }
 
 // ---- sites (Belhadj 2007 §4.3.1, Algorithms 13-15; docs/sites.md) --------------------------
@@ -283,6 +328,74 @@ void sites_load(RunState& s) {
   }
 }
 
+void sites_prepare(const Scenario& scenario, const Dem& dem, Settings& s) {
+  s.sites = sites_options(scenario);
+  check_file("/sites/reference", scenario.path("/sites/reference"));
+  if (const std::string existing = scenario.path("/sites/existing"); !existing.empty()) {
+    check_file("/sites/existing", existing);
+    // Its format and figures now (whether each place finds land needs the density).
+    try {
+      check_existing_places(existing, dem.georef().crs);
+    } catch (const Error& e) {
+      throw Error(e.kind(), "/sites/existing: " + std::string(e.what()));
+    }
+  }
+}
+
+/// sites.reference: the settlements against the real places (pipeline::realism_figures).
+void realism_summary(const json& r, SummaryText& out) {
+  out.line("  realism  against %zu real places: %d settlements of min_population or more for %d, %.0f people for %.0f, largest %.0f for %.0f\n",
+           r["places"].get<std::size_t>(), r["count"]["generated"].get<int>(), r["count"]["reference"].get<int>(),
+           r["total"]["generated"].get<double>(), r["total"]["reference"].get<double>(), r["largest"]["generated"].get<double>(),
+           r["largest"]["reference"].get<double>());
+  if (r.contains("skill")) {
+    const json& k = r["skill"];
+    out.line("           density AUC %.3f (population-weighted %.3f); baselines:", k["auc"].get<double>(), k["weighted_auc"].get<double>());
+    for (const auto& [name, b] : k["baselines"].items()) out.line(" %s %.3f", name.c_str(), b["auc"].get<double>());
+    out.line("\n           ten largest real places with a top-10 settlement within 10 km: %d (random land points: %.1f)\n",
+             r["top10"]["within_10km"].get<int>(), r["top10"]["random_within_10km"].get<double>());
+  }
+}
+
+void sites_summary(const json& figures, SummaryText& out) {
+  const json& c = figures["sites"];
+  out.line("  sites    %d cities (%d roots, %d suburbs), %.0f people\n", c["cities"].get<int>(), c["roots"].get<int>(),
+           c["suburbs"].get<int>(), c["population"].get<double>());
+  if (c.contains("population_source"))
+    out.line("           %.0f people in the region, %s; largest %.0f\n", c["target_population"].get<double>(),
+             c["population_source"].get<std::string>().c_str(), c["largest"].get<double>());
+  if (c.contains("growth"))
+    out.line("           %.0f of them in the settlements (the existing places grown by %g%%), the new ones split by a rank-size law of exponent %.2f\n",
+             c["settled_population"].get<double>(), 100 * c["growth"]["share"].get<double>(), c["sizes_exponent"].get<double>());
+  else if (c.contains("settled_population"))
+    out.line("           %.0f of them in the settlements (sites.urban_share %g), split by a rank-size law of exponent %.2f (%s)\n",
+             c["settled_population"].get<double>(), c["urban_share"].get<double>(), c["sizes_exponent"].get<double>(),
+             c["sizes"] == "catchment" ? "read from the catchments" : "sites.zipf_exponent");
+  if (c.value("count_limited_by_spacing", false))
+    out.line("           count held to the %lld settlements the land holds at sites.spacing_km (closer where denser than an urban centre)\n",
+             c["room"].get<long long>());
+  if (c.value("crowded", 0) > 0)
+    out.line("           %d placed without a disc clear of water and steep land (their built-up area reaches over it)\n", c["crowded"].get<int>());
+  if (c.contains("growth")) {
+    const json& g = c["growth"];
+    out.line("           growth +%g%%: %lld new settled people, %lld to the existing places, %lld in %d new settlements\n",
+             100 * g["share"].get<double>(), g["people"].get<long long>(), g["to_existing"].get<long long>(),
+             g["to_new_settlements"].get<long long>(), g["new_settlements"].get<int>());
+    int shown = 0;
+    for (const auto& [name, gain] : g["gained"].items())
+      if (shown++ < 3) out.line("             %s +%lld\n", name.c_str(), gain.get<long long>());
+    for (const auto& [rank, n] : g["new_largest"].items())
+      if (n.contains("near"))
+        out.line("             new settlement of %lld people %.1f km from %s\n", n["people"].get<long long>(), n["near_km"].get<double>(),
+                 n["near"].get<std::string>().c_str());
+  }
+  for (const auto& [k, v] : c["per_class"].items())
+    out.line("           class %s (radius %.0f m): %d\n", k.c_str(), v["radius_m"].get<double>(), v["cities"].get<int>());
+  if (c.contains("warnings"))
+    for (const auto& w : c["warnings"]) out.line("           warning: %.200s\n", w.get<std::string>().c_str());
+  if (figures.contains("realism")) realism_summary(figures["realism"], out);
+}
+
 // ---- network (Belhadj 2007 §4.3.2; docs/sites.md) -------------------------------------------
 
 void network_run(RunState& s, Progress& progress, const Log&) {
@@ -300,6 +413,14 @@ void network_run(RunState& s, Progress& progress, const Log&) {
 }
 
 void network_load(RunState& s) { s.network = read_vector(saved(s, "network.geojson"), s.dem.georef().crs); }
+
+void network_prepare(const Scenario& scenario, const Dem&, Settings& s) { s.network = network_options(scenario); }
+
+void network_summary(const json& figures, SummaryText& out) {
+  const json& n = figures["network"];
+  out.line("  network  %d of %d candidate links kept, %.1f km\n", n["kept_edges"].get<int>(), n["candidate_edges"].get<int>(),
+           n["kept_length_km"].get<double>());
+}
 
 // ---- roads (Galin et al. 2010, Peytavie 2010 ch. 4; Belhadj 2007 Alg. 16; docs/roads.md) ----
 
@@ -422,6 +543,42 @@ void roads_run(RunState& s, Progress& progress, const Log& log) {
 
 void roads_load(RunState&) {}  // the access stage reads the saved layers
 
+void roads_prepare(const Scenario& scenario, const Dem& dem, Settings& s) {
+  s.roads = at_pointer("/roads/costs", [&] { return roads_settings(scenario); });
+  s.corridor = corridor_settings(scenario);
+  check_file("/roads/corridor/side_angles", s.corridor.side_angles);
+  check_file("/roads/vegetation", s.roads.vegetation);
+  if (const std::string& lines = s.roads.existing; !lines.empty()) {
+    check_file("/roads/existing", lines);
+    // Its CRS and geometry now (which roads lie on the DEM needs its grid).
+    try {
+      roads::check_existing_roads(lines, dem.georef().crs);
+    } catch (const Error& e) {
+      throw Error(e.kind(), "/roads/existing: " + std::string(e.what()));
+    }
+  }
+}
+
+void roads_summary(const json& figures, SummaryText& out) {
+  const json& r = figures["roads"];
+  out.line("  roads    %d roads (%d not routable, %d redundant), bridges %.0f m, tunnels %.0f m\n", r["roads"].get<int>(),
+           r["failed"].get<int>(), r.value("redundant", 0), r["bridge_m"].get<double>(), r["tunnel_m"].get<double>());
+  if (r.contains("network_km"))
+    out.line("           network %.1f km drawn once, %d sections, %d junctions\n", r["network_km"].get<double>(), r.value("sections", 0),
+             r.value("junctions", 0));
+  if (r.contains("existing")) {
+    const json& e = r["existing"];
+    out.line("           existing roads %.1f km given (%d lines, %d outside the DEM); the new links run %.1f km on them, %.1f km new\n",
+             e["total_km"].get<double>(), e["lines"].get<int>(), e["outside_dem"].get<int>(), r["on_existing_km"].get<double>(),
+             r["new_network_km"].get<double>());
+    out.line("           %-13s %9s %9s %9s   (links; new, drawn once; existing given)\n", "", "links", "new", "existing");
+    for (const auto& [cls, km] : r["length_km"].items())
+      out.line("           %-13s %9.1f %9.1f %9.1f km\n", cls.c_str(), km.get<double>(), r["new_km"].value(cls, 0.0), e["km"].value(cls, 0.0));
+  } else {
+    for (const auto& [cls, km] : r["length_km"].items()) out.line("           %-13s %9.1f km\n", cls.c_str(), km.get<double>());
+  }
+}
+
 // ---- access (Tobler 1993; Weiss et al. 2018; docs/access.md) ---------------------------------
 
 /// The run's road sections with their road's class (roads.geojson) and structure: bridges and
@@ -489,17 +646,31 @@ void access_run(RunState& s, Progress& progress, const Log& log) {
 
 void access_load(RunState&) {}  // nothing downstream
 
+void access_prepare(const Scenario& scenario, const Dem&, Settings& s) { s.access = access_settings(scenario); }
+
+void access_summary(const json& figures, SummaryText& out) {
+  const json& a = figures["access"];
+  out.line("  access   of %.0f people, within reach of\n", a["people"].get<double>());
+  for (const auto& [level, v] : a["levels"].items()) {
+    const std::string whom = level == "all" ? "any settlement" : "settlements of " + level + "+";
+    out.line("           %-22s (%3d)", whom.c_str(), v["destinations"].get<int>());
+    for (const auto& [minutes, share] : v["share_within"].items())
+      out.line(" %5.1f%% in %s", 100 * share.get<double>(), minutes.substr(0, minutes.find('_')).c_str());
+    out.line(" min; mean %.1f min, p90 %.1f min\n", v["mean_minutes"].get<double>(), v["p90_minutes"].get<double>());
+  }
+}
+
 }  // namespace
 
 const std::vector<StageDef>& stages() {
   static const std::vector<StageDef> list = {
-      {"terrain", {"dem", "input"}, terrain_run, terrain_load},
-      {"hydro", {"water", "hydro"}, hydro_run, hydro_load},
-      {"density", {"density", "plugins"}, density_run, density_load},
-      {"sites", {"sites", "seed"}, sites_run, sites_load},
-      {"network", {"network"}, network_run, network_load},
-      {"roads", {"roads"}, roads_run, roads_load},
-      {"access", {"access"}, access_run, access_load},
+      {"terrain", {"dem", "input"}, terrain_prepare, terrain_run, terrain_load, terrain_summary},
+      {"hydro", {"water", "hydro"}, hydro_prepare, hydro_run, hydro_load, hydro_summary},
+      {"density", {"density", "plugins"}, density_prepare, density_run, density_load, density_summary},
+      {"sites", {"sites", "seed"}, sites_prepare, sites_run, sites_load, sites_summary},
+      {"network", {"network"}, network_prepare, network_run, network_load, network_summary},
+      {"roads", {"roads"}, roads_prepare, roads_run, roads_load, roads_summary},
+      {"access", {"access"}, access_prepare, access_run, access_load, access_summary},
   };
   return list;
 }

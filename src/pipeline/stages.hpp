@@ -1,23 +1,50 @@
-// The stages of a run, in data-flow order: what each reads from the scenario, computes and writes.
+// The stages of a run, in data-flow order: what each checks, reads from the scenario, computes,
+// writes and says in the summary.
 // SPDX-License-Identifier: MIT
 #pragma once
+#include <cstdio>
 #include <string>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "core/progress.hpp"
 #include "pipeline/run_state.hpp"
 
 namespace terrapolis::pipeline {
 
+/// The run summary's text, built a line at a time with printf formats.
+class SummaryText {
+ public:
+  template <class... Values>
+  void line(const char* format, Values... values) {
+    char buf[512];
+    std::snprintf(buf, sizeof buf, format, values...);
+    text += buf;
+  }
+  std::string text;
+};
+
+/// One stage of a run. Its life (docs/architecture.md): every stage's `prepare` runs before the
+/// first stage starts, then each stage's `run` (or `load`, on a rerun that reuses its saved files),
+/// which writes its files through RunState::write and its figures into RunState::summary; the
+/// summary printed at the end is each stage's `summary` of those figures.
 struct StageDef {
   const char* name;
   /// Scenario keys the stage reads (besides those of the stages before it): a saved result of
   /// the stage can be reused only when they are unchanged.
   std::vector<std::string> sections;
+  /// Builds the stage's settings into `settings` and makes every check that needs no earlier
+  /// stage's result (the settings against each other and the DEM's grid, the files the stage reads).
+  /// Throws bad_input naming the setting's JSON pointer ("/sites/u_max: must be >= /sites/u_min").
+  void (*prepare)(const Scenario&, const Dem&, StageSettings& settings);
   /// Computes the stage from the state and writes its files into state.folder.
   void (*run)(RunState&, Progress&, const Log&);
   /// Reads the stage's typed results back from its saved files in state.folder (reruns).
   void (*load)(RunState&);
+  /// The stage's lines of the run summary, from the run's figures (run.json's `summary`, which
+  /// holds this stage's entry).
+  void (*summary)(const nlohmann::ordered_json& figures, SummaryText&);
 };
 
 /// The stages, in data-flow order: the one list the runner, --help and the docs read.
