@@ -2,7 +2,12 @@
 // SPDX-License-Identifier: MIT
 #include "roads/cost_model.hpp"
 
+#define VALIJSON_USE_EXCEPTIONS 1  // report invalid schemas as exceptions, not aborts
 #include <nlohmann/json.hpp>
+#include <valijson/adapters/nlohmann_json_adapter.hpp>
+#include <valijson/schema.hpp>
+#include <valijson/schema_parser.hpp>
+#include <valijson/validator.hpp>
 
 #include <algorithm>
 #include <fstream>
@@ -10,6 +15,7 @@
 
 #include "core/error.hpp"
 #include "core/json_input.hpp"
+#include "core/schema_error.hpp"
 
 namespace terrapolis::roads {
 
@@ -84,90 +90,80 @@ CostModel default_cost_model() {
 
 namespace {
 
+using nlohmann::json;
+
 /// JSON text bounded (size, depth, number range) then parsed; one-line errors naming `origin`.
-nlohmann::json parse_bounded(const std::string& text, const std::string& origin) {
+json parse_bounded(const std::string& text, const std::string& origin) {
   check_json_text(text, origin);
   try {
-    return nlohmann::json::parse(text);
-  } catch (const nlohmann::json::exception& e) {
+    return json::parse(text);
+  } catch (const json::exception& e) {
     throw bad_input(origin + ": not valid JSON (" + json_error_text(e.what()) + ")");
   }
 }
 
-using nlohmann::json;
+/// A schema parsed once: schemas/road_costs.schema.json, or the definition `definition` of it.
+struct ParsedSchema {
+  explicit ParsedSchema(const char* definition) : document(json::parse(road_costs_schema_text())) {
+    const json& root = definition ? document["definitions"][definition] : document;
+    valijson::SchemaParser parser;
+    valijson::adapters::NlohmannJsonAdapter adapter(root);
+    parser.populateSchema(adapter, schema);
+  }
+  json document;
+  valijson::Schema schema;
+};
 
-[[noreturn]] void fail(const std::string& origin, const std::string& key, const std::string& problem) {
-  throw bad_input(origin + ": " + key + ": " + problem);
+/// `doc` against the cost file's schema (or its transfer function definition): throws bad_input
+/// "ORIGIN: /json/pointer: problem".
+void validate(const json& doc, const std::string& origin, bool transfer_only) {
+  static const ParsedSchema whole(nullptr), transfer("transfer");
+  valijson::Validator validator;
+  valijson::ValidationResults results;
+  valijson::adapters::NlohmannJsonAdapter target(doc);
+  if (validator.validate((transfer_only ? transfer : whole).schema, target, &results)) return;
+  const auto [pointer, problem] = schema_error(results);
+  throw bad_input(origin + ": " + pointer + ": " + problem);
 }
 
-double number(const json& j, const std::string& origin, const std::string& key) {
-  if (!j.is_number()) fail(origin, key, "expected a number");
-  return j.get<double>();
-}
+// The readers below take documents the schema accepted: types and ranges are its to check,
+// only the rules it cannot state are checked here.
 
-void read_transfer(const json& j, TransferFunction& f, const std::string& origin, const std::string& key) {
-  if (!j.is_object()) fail(origin, key, "expected an object with \"points\" and \"threshold\"");
-  for (auto it = j.begin(); it != j.end(); ++it) {
-    const std::string k = key + "." + it.key();
-    if (it.key() == "points") {
-      if (!it->is_array()) fail(origin, k, "expected an array of [kappa, cost] pairs");
-      f.points.clear();
-      for (const auto& p : *it) {
-        if (!p.is_array() || p.size() != 2) fail(origin, k, "expected [kappa, cost] pairs");
-        const double x = number(p[0], origin, k), y = number(p[1], origin, k);
-        if (!std::isfinite(x) || !std::isfinite(y) || y < 0) fail(origin, k, "costs must be finite and >= 0");
-        if (!f.points.empty() && x <= f.points.back()[0]) fail(origin, k, "kappa values must increase");
-        f.points.push_back({x, y});
-      }
-    } else if (it.key() == "threshold") {
-      f.threshold = it->is_null() ? kInfinity : number(*it, origin, k);
-    } else {
-      fail(origin, k, "unknown key");
+void read_transfer(const json& j, TransferFunction& f, const std::string& origin, const std::string& pointer) {
+  if (j.contains("points")) {
+    f.points.clear();
+    for (const auto& p : j["points"]) {
+      const double x = p[0].get<double>(), y = p[1].get<double>();
+      if (!f.points.empty() && x <= f.points.back()[0]) throw bad_input(origin + ": " + pointer + "/points: kappa values must increase");
+      f.points.push_back({x, y});
     }
   }
+  if (j.contains("threshold")) f.threshold = j["threshold"].is_null() ? kInfinity : j["threshold"].get<double>();
+}
+
+std::optional<double> optional_number(const json& j) { return j.is_null() ? std::nullopt : std::optional<double>(j.get<double>()); }
+
+void read_structure(const json& j, StructureCosts& s, const std::string& origin, const std::string& pointer) {
+  const std::pair<const char*, TransferFunction*> terms[] = {{"slope_deg", &s.slope_deg},         {"water_depth_m", &s.water_depth_m},
+                                                             {"curvature_deg", &s.curvature_deg}, {"vegetation", &s.vegetation},
+                                                             {"height_m", &s.height_m},           {"depth_m", &s.depth_m}};
+  for (const auto& [name, term] : terms)
+    if (j.contains(name)) read_transfer(j[name], *term, origin, pointer + "/" + name);
+  if (j.contains("enabled")) s.enabled = j["enabled"].get<bool>();
+  if (j.contains("longest_m")) s.longest_m = optional_number(j["longest_m"]);
+  if (j.contains("min_length_m")) s.min_length_m = optional_number(j["min_length_m"]);
+  if (j.contains("max_length_m")) s.max_length_m = optional_number(j["max_length_m"]);
+  if (j.contains("min_length_cells")) s.min_length_cells = j["min_length_cells"].get<double>();
+  if (j.contains("max_length_cells")) s.max_length_cells = j["max_length_cells"].get<double>();
+  if (j.contains("samples")) s.samples = j["samples"].get<int>();
+  if (s.min_length_cells > s.max_length_cells || (s.min_length_m && s.max_length_m && *s.min_length_m > *s.max_length_m))
+    throw bad_input(origin + ": " + pointer + ": a minimum length exceeds its maximum");
 }
 
 json transfer_json(const TransferFunction& f) {
   json pts = json::array();
   for (const auto& p : f.points) pts.push_back({p[0], p[1]});
   return {{"points", pts}, {"threshold", f.threshold == kInfinity ? json(nullptr) : json(f.threshold)}};
-}
-
-void read_structure(const json& j, StructureCosts& s, const std::string& origin, const std::string& key, bool long_arcs) {
-  if (!j.is_object()) fail(origin, key, "expected an object");
-  for (auto it = j.begin(); it != j.end(); ++it) {
-    const std::string k = key + "." + it.key();
-    const std::string& name = it.key();
-    if (name == "slope_deg") read_transfer(*it, s.slope_deg, origin, k);
-    else if (name == "water_depth_m") read_transfer(*it, s.water_depth_m, origin, k);
-    else if (name == "curvature_deg") read_transfer(*it, s.curvature_deg, origin, k);
-    else if (name == "vegetation") read_transfer(*it, s.vegetation, origin, k);
-    else if (name == "height_m" && key == "bridge") read_transfer(*it, s.height_m, origin, k);
-    else if (name == "depth_m" && key == "tunnel") read_transfer(*it, s.depth_m, origin, k);
-    else if (name == "enabled" && long_arcs) {
-      if (!it->is_boolean()) fail(origin, k, "expected true or false");
-      s.enabled = it->get<bool>();
-    } else if (long_arcs && name == "longest_m") {
-      std::optional<double> v;
-      if (!it->is_null()) v = number(*it, origin, k);
-      if (v && !(*v > 0)) fail(origin, k, "must be > 0");
-      s.longest_m = v;
-    } else if (long_arcs && (name == "min_length_m" || name == "max_length_m")) {
-      std::optional<double> v;
-      if (!it->is_null()) v = number(*it, origin, k);
-      if (v && !(*v > 0)) fail(origin, k, "must be > 0");
-      (name == "min_length_m" ? s.min_length_m : s.max_length_m) = v;
-    } else if (long_arcs && (name == "min_length_cells" || name == "max_length_cells")) {
-      const double v = number(*it, origin, k);
-      if (!(v >= 1)) fail(origin, k, "must be >= 1");
-      (name == "min_length_cells" ? s.min_length_cells : s.max_length_cells) = v;
-    } else if (long_arcs && name == "samples") {
-      if (!it->is_number_integer() || it->get<long long>() < 0) fail(origin, k, "expected an integer >= 0");
-      s.samples = int(std::min<long long>(it->get<long long>(), 1 << 20));
-    } else {
-      fail(origin, k, "unknown key");
-    }
-  }
 }
 
 json structure_json(const StructureCosts& s, bool bridge, bool tunnel) {
@@ -194,33 +190,23 @@ json structure_json(const StructureCosts& s, bool bridge, bool tunnel) {
 
 TransferFunction parse_transfer_function(const std::string& text, const std::string& origin) {
   const json j = parse_bounded(text, origin);
+  validate(j, origin, true);
   TransferFunction f;
-  read_transfer(j, f, origin, "transfer function");
+  read_transfer(j, f, origin, "");
   return f;
 }
 
 CostModel parse_cost_model(const std::string& text, const std::string& origin, CostModel m) {
   const json j = parse_bounded(text, origin);
-  if (!j.is_object()) throw bad_input(origin + ": expected a JSON object");
-  for (auto it = j.begin(); it != j.end(); ++it) {
-    const std::string& key = it.key();
-    if (key == "road") read_structure(*it, m.road, origin, key, false);
-    else if (key == "bridge") read_structure(*it, m.bridge, origin, key, true);
-    else if (key == "tunnel") read_structure(*it, m.tunnel, origin, key, true);
-    else if (key == "sample_step_m") m.sample_step_m = number(*it, origin, key);
-    else if (key == "unknown_water_depth_m") m.unknown_water_depth_m = number(*it, origin, key);
-    else if (key == "structure_min_m") m.structure_min_m = number(*it, origin, key);
-    else if (key == "road_radius_m") m.road_radius_m = number(*it, origin, key);
-    else if (key == "smoothing_tolerance_cells") m.smoothing_tolerance_cells = number(*it, origin, key);
-    else if (key == "$comment") continue;
-    else fail(origin, key, "unknown key");
-  }
-  if (m.sample_step_m < 0 || m.unknown_water_depth_m < 0 || m.structure_min_m < 0 || m.road_radius_m < 0 ||
-      m.smoothing_tolerance_cells < 0)
-    throw bad_input(origin + ": lengths must be >= 0");
-  for (const StructureCosts* s : {&m.bridge, &m.tunnel})
-    if (s->min_length_cells > s->max_length_cells || (s->min_length_m && s->max_length_m && *s->min_length_m > *s->max_length_m))
-      throw bad_input(origin + ": a minimum length exceeds its maximum");
+  validate(j, origin, false);
+  const std::pair<const char*, StructureCosts*> structures[] = {{"road", &m.road}, {"bridge", &m.bridge}, {"tunnel", &m.tunnel}};
+  for (const auto& [name, structure] : structures)
+    if (j.contains(name)) read_structure(j[name], *structure, origin, std::string("/") + name);
+  const std::pair<const char*, double*> lengths[] = {{"sample_step_m", &m.sample_step_m}, {"unknown_water_depth_m", &m.unknown_water_depth_m},
+                                                     {"structure_min_m", &m.structure_min_m}, {"road_radius_m", &m.road_radius_m},
+                                                     {"smoothing_tolerance_cells", &m.smoothing_tolerance_cells}};
+  for (const auto& [name, value] : lengths)
+    if (j.contains(name)) *value = j[name].get<double>();
   return m;
 }
 

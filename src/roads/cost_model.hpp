@@ -5,6 +5,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace terrapolis::roads {
@@ -68,13 +69,15 @@ struct CostModel {
 /// 150 m high, tunnels linear to 15 m depth then constant, at most 1000 m deep.
 CostModel default_cost_model();
 
-/// Applies the JSON document in `path` over `base` (only the keys present change; unknown keys
-/// are refused). Throws bad_input naming the file and the key.
+/// Applies the JSON document in `path` over `base` (only the keys present change), checked against
+/// schemas/road_costs.schema.json. Throws bad_input "PATH: /json/pointer: problem".
 CostModel load_cost_model(const std::string& path, CostModel base = default_cost_model());
 /// Same, from JSON text (`origin` names it in errors).
 CostModel parse_cost_model(const std::string& text, const std::string& origin, CostModel base = default_cost_model());
 /// The model as JSON (the format load_cost_model reads).
 std::string cost_model_json(const CostModel& model);
+/// schemas/road_costs.schema.json, the format of the cost file (embedded at build time).
+std::string_view road_costs_schema_text();
 /// One transfer function from its JSON text {"points": [[kappa, cost], ...], "threshold": x|null}
 /// (the format of the cost model file); `origin` names it in errors. Throws bad_input.
 TransferFunction parse_transfer_function(const std::string& text, const std::string& origin);

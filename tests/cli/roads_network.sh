@@ -47,7 +47,7 @@ set +e
 "$bin" -q roads "$dem" "$out/none.geojson" "$out/o3" 2>/dev/null; [[ $? -eq 2 ]] || exit 1
 echo '{"road": {"slope": 3}}' > "$out/costs.json"
 err=$("$bin" -q roads "$dem" "$out/net/network.geojson" "$out/o4" --costs "$out/costs.json" 2>&1); [[ $? -eq 2 ]] || exit 1
-grep -q "road.slope" <<<"$err" || { echo "$err"; exit 1; }
+grep -q "costs.json: /road/slope: unknown key" <<<"$err" || { echo "$err"; exit 1; }
 sed 's/9.10, 42.60/2.0, 42.60/; s/"kept": 0/"kept": 1/' "$out/net/network.geojson" > "$out/outside.geojson"
 err=$("$bin" -q roads "$dem" "$out/outside.geojson" "$out/o5" 2>&1); [[ $? -eq 2 ]] || { echo "$err"; exit 1; }
 grep -q "outside the DEM" <<<"$err" || { echo "$err"; exit 1; }

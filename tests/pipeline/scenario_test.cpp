@@ -59,6 +59,10 @@ TEST(Scenario, EveryFieldHasDescriptionUnitDefaultAndRange) {
       for (const auto& [k, sub] : s["properties"].items()) closed(sub, p + "/" + k);
   };
   closed(schema, "");
+  // An unknown key is named by its own pointer.
+  nlohmann::json typo = schema_defaults();
+  typo["density"]["weigths"] = 1;
+  EXPECT_EQ(validate_scenario(typo), "/density/weigths: unknown key");
 }
 
 TEST(Scenario, DefaultScenarioIsTheSchemaDefaults) {

@@ -48,17 +48,55 @@ TEST(CostModel, JsonOverridesOnlyWhatItNames) {
   EXPECT_EQ(cost_model_json(again), cost_model_json(m));
 }
 
-TEST(CostModel, BadFilesAreRefusedWithTheKey) {
+/// The message parse_cost_model throws for `text` (exit code 2), "" when it parses.
+std::string refusal(const std::string& text) {
   try {
-    parse_cost_model(R"({"road": {"slope": {}}})", "costs.json");
-    FAIL();
+    parse_cost_model(text, "costs.json");
   } catch (const terrapolis::Error& e) {
     EXPECT_EQ(e.exit_code(), 2);
-    EXPECT_NE(std::string(e.what()).find("road.slope"), std::string::npos);
+    return e.what();
   }
+  return "";
+}
+
+TEST(CostModel, BadFilesAreRefusedNamingTheSetting) {
+  // Checked against schemas/road_costs.schema.json: the errors name the file and the pointer.
+  EXPECT_EQ(refusal(R"({"road": {"slope": {}}})"), "costs.json: /road/slope: unknown key");
+  EXPECT_EQ(refusal(R"({"colour": 1})"), "costs.json: /colour: unknown key");
+  EXPECT_NE(refusal(R"({"bridge": {"samples": -1}})").find("costs.json: /bridge/samples: "), std::string::npos);
+  EXPECT_NE(refusal(R"({"tunnel": {"enabled": "yes"}})").find("costs.json: /tunnel/enabled: "), std::string::npos);
+  EXPECT_NE(refusal(R"({"road": {"slope_deg": {"points": [[0, -1]]}}})").find("costs.json: /road/slope_deg/points/0/1: "), std::string::npos);
+  EXPECT_EQ(refusal(R"({"road": {"height_m": {}}})"), "costs.json: /road/height_m: unknown key");  // a bridge's term only
+  EXPECT_NE(refusal(R"({"sample_step_m": -2})").find("costs.json: /sample_step_m: "), std::string::npos);
+  // The rules the schema cannot state.
+  EXPECT_EQ(refusal(R"({"road": {"slope_deg": {"points": [[5, 1], [2, 1]]}}})"), "costs.json: /road/slope_deg/points: kappa values must increase");
+  EXPECT_EQ(refusal(R"({"bridge": {"min_length_cells": 40}})"), "costs.json: /bridge: a minimum length exceeds its maximum");
+  EXPECT_EQ(refusal(R"({"$comment": "mine", "bridge": {"samples": 3}})"), "");
   EXPECT_THROW(parse_cost_model("{not json", "costs.json"), terrapolis::Error);
-  EXPECT_THROW(parse_cost_model(R"({"road": {"slope_deg": {"points": [[5, 1], [2, 1]]}}})", "c"), terrapolis::Error);
   EXPECT_THROW(load_cost_model("/nonexistent/costs.json"), terrapolis::Error);
+}
+
+TEST(CostModel, TheWrittenModelIsValidAgainstTheSchema) {
+  // cost_model_json writes every key: a document the schema accepts, read back to the same model.
+  CostModel m = default_cost_model();
+  m.bridge.min_length_m = 60;
+  m.tunnel.longest_m.reset();
+  m.road.slope_deg.threshold = kInfinity;
+  const CostModel again = parse_cost_model(cost_model_json(m), "written");
+  EXPECT_EQ(cost_model_json(again), cost_model_json(m));
+  EXPECT_EQ(again.road.slope_deg.threshold, kInfinity);
+  EXPECT_EQ(*again.bridge.min_length_m, 60);
+  EXPECT_FALSE(again.tunnel.longest_m);
+}
+
+TEST(CostModel, OneTransferFunctionIsCheckedByTheSameDefinition) {
+  EXPECT_EQ(parse_transfer_function(R"({"points": [[0, 1], [1, 3]], "threshold": null})", "f")(0.5), 2);
+  try {
+    parse_transfer_function(R"({"points": [[0, 1]], "cap": 2})", "plugin/road");
+    FAIL();
+  } catch (const terrapolis::Error& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("plugin/road: /", 0), 0u) << e.what();
+  }
 }
 
 TEST(CostModel, DocumentedDefaultsAreTheCodeDefaults) {
