@@ -1,6 +1,6 @@
 // `terrapolis generate OUT.tif --size WxH --cell M [--method M]`: synthetic terrain. dmmc: fractal terrain
 // constrained by a sketch; the other methods build a skeleton (rivers, ridges) first, each in its own
-// source file (terrain/generate_*.cpp), and write it beside the DEM with the checks of its rivers.
+// source file (generate/generate_*.cpp), and write it beside the DEM with the checks of its rivers.
 // SPDX-License-Identifier: MIT
 #include <CLI/CLI.hpp>
 
@@ -18,14 +18,14 @@
 #include "io/raster_io.hpp"
 #include "io/text_io.hpp"
 #include "io/vector_io.hpp"
-#include "terrain/generators.hpp"
+#include "generate/generators.hpp"
 #include "terrain/subdivision.hpp"
 
 namespace terrapolis::cli {
 namespace {
 
-terrain::GeneratedTerrain generate_dmmc(const terrain::GenerateRequest& request) {
-  terrain::GeneratedTerrain out;
+generate::GeneratedTerrain generate_dmmc(const generate::GenerateRequest& request) {
+  generate::GeneratedTerrain out;
   out.dem = request.grid;
   const auto t0 = std::chrono::steady_clock::now();
   terrain::dmmc(out.dem, request.dmmc, request.progress);
@@ -36,14 +36,14 @@ terrain::GeneratedTerrain generate_dmmc(const terrain::GenerateRequest& request)
 /// The generators, by --method name.
 struct Method {
   const char* name;
-  terrain::GeneratedTerrain (*generate)(const terrain::GenerateRequest&);
+  generate::GeneratedTerrain (*generate)(const generate::GenerateRequest&);
 };
 constexpr Method kMethods[] = {
     {"dmmc", generate_dmmc},
-    {"flow", terrain::generate_flow},
-    {"tectonic", terrain::generate_tectonic},
-    {"coast", terrain::generate_coast},
-    {"planar", terrain::generate_planar},
+    {"flow", generate::generate_flow},
+    {"tectonic", generate::generate_tectonic},
+    {"coast", generate::generate_coast},
+    {"planar", generate::generate_planar},
 };
 
 std::string method_names() {
@@ -59,7 +59,7 @@ std::string stem_of(const std::string& path) {
 }
 
 /// A vector file's coordinates in the cell coordinates of `grid` (centre of cell (c,r) at (c,r)).
-terrain::GridPoint to_cell(const Georef& g, const std::array<double, 2>& p) {
+generate::GridPoint to_cell(const Georef& g, const std::array<double, 2>& p) {
   const auto& t = g.transform;
   return {(p[0] - t[0]) / t[1] - 0.5, (p[1] - t[3]) / t[5] - 0.5};
 }
@@ -124,7 +124,7 @@ class GenerateCommand final : public Command {
       context.log.info("generate: " + std::to_string(fixed) + " cells fixed by the sketch");
     }
     params.dmmc.low_pass = false;  // generation wants the fractal detail, not the smoothest surface
-    terrain::GenerateRequest request;
+    generate::GenerateRequest request;
     request.cell_m = grid_.cell_m;
     request.seed = options_.seed;
     request.relief_m = relief_m_;
@@ -135,7 +135,7 @@ class GenerateCommand final : public Command {
     if (!skeleton_options_.coast_path.empty()) request.polygons = read_rings(skeleton_options_.coast_path, grid.georef());
     skeleton_options_.apply(request);
     request.grid = std::move(grid);
-    const terrain::GeneratedTerrain terrain = method->generate(request);
+    const generate::GeneratedTerrain terrain = method->generate(request);
     for (const auto& [phase, seconds] : terrain.timings)
       context.log.detail("generate: " + phase + " in " + std::to_string(seconds) + " s");
 
@@ -146,7 +146,7 @@ class GenerateCommand final : public Command {
     if (skeleton_method) write.metadata.emplace_back("TERRAPOLIS_RELIEF_M", std::to_string(relief_m_));
     write_raster(out, terrain.dem, write);
     if (skeleton_method) {
-      write_vector(skeleton_out, terrain::skeleton_layer(terrain.skeleton, terrain.dem.georef(), grid_.cell_m));
+      write_vector(skeleton_out, generate::river_ridge_layer(terrain.plan, terrain.dem.georef(), grid_.cell_m));
       write_text_file(report_out, skeleton_report(terrain, grid_.cell_m, method_, context.log, context.progress), false);
     }
     outputs.commit();
@@ -192,26 +192,26 @@ class GenerateCommand final : public Command {
     }
     grid_.origin = std::to_string(4321000.0 - cols * grid_.cell_m / 2) + "," + std::to_string(3210000.0 + rows * grid_.cell_m / 2);
   }
-  static std::vector<std::vector<terrain::GridPoint>> read_lines(const std::string& path, const Georef& georef) {
+  static std::vector<std::vector<generate::GridPoint>> read_lines(const std::string& path, const Georef& georef) {
     const VectorLayer layer = read_vector(path, georef.crs);
-    std::vector<std::vector<terrain::GridPoint>> lines;
+    std::vector<std::vector<generate::GridPoint>> lines;
     for (const auto& f : layer.features) {
       if (layer.geometry != GeometryType::line_string || f.parts.empty() || f.parts[0].size() < 2)
         throw bad_input(path + ": expected lines of at least 2 points");
-      std::vector<terrain::GridPoint> line;
+      std::vector<generate::GridPoint> line;
       for (const auto& p : f.parts[0]) line.push_back(to_cell(georef, p));
       lines.push_back(std::move(line));
     }
     if (lines.empty()) throw bad_input(path + ": holds no line");
     return lines;
   }
-  static std::vector<std::vector<terrain::GridPoint>> read_rings(const std::string& path, const Georef& georef) {
+  static std::vector<std::vector<generate::GridPoint>> read_rings(const std::string& path, const Georef& georef) {
     const VectorLayer layer = read_vector(path, georef.crs);
     if (layer.geometry != GeometryType::polygon) throw bad_input(path + ": expected polygons (the land)");
-    std::vector<std::vector<terrain::GridPoint>> rings;
+    std::vector<std::vector<generate::GridPoint>> rings;
     for (const auto& f : layer.features)
       for (const auto& part : f.parts) {
-        std::vector<terrain::GridPoint> ring;
+        std::vector<generate::GridPoint> ring;
         for (const auto& p : part) ring.push_back(to_cell(georef, p));
         if (ring.size() > 1 && ring.front() == ring.back()) ring.pop_back();
         if (ring.size() >= 3) rings.push_back(std::move(ring));
@@ -219,9 +219,9 @@ class GenerateCommand final : public Command {
     if (rings.empty()) throw bad_input(path + ": holds no polygon");
     return rings;
   }
-  static std::vector<terrain::GridPoint> read_points(const std::string& path, const Georef& georef) {
+  static std::vector<generate::GridPoint> read_points(const std::string& path, const Georef& georef) {
     const VectorLayer layer = read_vector(path, georef.crs);
-    std::vector<terrain::GridPoint> points;
+    std::vector<generate::GridPoint> points;
     for (const auto& f : layer.features) {
       if (layer.geometry != GeometryType::point || f.parts.empty() || f.parts[0].empty()) throw bad_input(path + ": expected points");
       points.push_back(to_cell(georef, f.parts[0][0]));

@@ -46,7 +46,7 @@ void CoastPlanarOptions::add(CLI::App& app) {
       ->capture_default_str()->check(CLI::NonNegativeNumber);
 }
 
-void CoastPlanarOptions::apply(terrain::GenerateRequest& request) const {
+void CoastPlanarOptions::apply(generate::GenerateRequest& request) const {
   double pc = 0, ps = 0, pa = 0;
   char tail = 0;
   if (std::sscanf(grammar.c_str(), "%lf,%lf,%lf%c", &pc, &ps, &pa, &tail) != 3 || pc < 0 || ps < 0 || pa < 0 ||

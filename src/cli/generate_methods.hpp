@@ -6,18 +6,18 @@
 
 #include <string>
 
-#include "terrain/generator.hpp"
+#include "generate/generator.hpp"
 
 namespace terrapolis::cli {
 
 struct CoastPlanarOptions {
-  terrain::CoastParams coast;
-  terrain::PlanarParams planar;
+  generate::CoastParams coast;
+  generate::PlanarParams planar;
   std::string coast_path, grammar = "0.2,0.7,0.1", tree_law = "increasing";
 
   void add(CLI::App& app);
   /// Copies the parameters into `request`; throws bad_input naming the option at fault.
-  void apply(terrain::GenerateRequest& request) const;
+  void apply(generate::GenerateRequest& request) const;
 };
 
 }  // namespace terrapolis::cli

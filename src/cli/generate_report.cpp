@@ -7,7 +7,7 @@
 
 #include "core/geodesy.hpp"
 #include "hydro/hydro.hpp"
-#include "terrain/skeleton_checks.hpp"
+#include "generate/river_checks.hpp"
 
 namespace terrapolis::cli {
 namespace {
@@ -26,9 +26,9 @@ std::string fixed(double v, int digits) {
 
 }  // namespace
 
-std::string skeleton_report(const terrain::GeneratedTerrain& terrain, double cell_m, const std::string& method,
+std::string skeleton_report(const generate::GeneratedTerrain& terrain, double cell_m, const std::string& method,
                             const Log& log, Progress& progress) {
-  const terrain::Skeleton& skeleton = terrain.skeleton;
+  const generate::RiverRidgePlan& plan = terrain.plan;
   const Dem& dem = terrain.dem;
   hydro::HydroOptions options;
   options.sea_level = terrain.sea_level_m;
@@ -37,19 +37,19 @@ std::string skeleton_report(const terrain::GeneratedTerrain& terrain, double cel
   const hydro::HydroResult d8 = hydro::run_hydro(dem, options, progress);
 
   double river_m = 0;
-  for (const auto& r : skeleton.rivers) river_m += terrain::line_length_m(r.line, cell_m);
-  const double threshold_m2 = terrain.channel_head_m2 ? *terrain.channel_head_m2 : terrain::channel_head_threshold_m2(skeleton, d8.accumulation);
+  for (const auto& r : plan.rivers) river_m += generate::line_length_m(r.line, cell_m);
+  const double threshold_m2 = terrain.channel_head_m2 ? *terrain.channel_head_m2 : generate::channel_head_threshold_m2(plan, d8.accumulation);
   const VectorLayer streams = hydro::extract_streams(d8.d8, d8.accumulation, cell_metrics(dem.georef(), dem.cols(), dem.rows()),
                                                      {threshold_m2 / 1e6}, progress);
-  const auto order = terrain::stream_order_raster(streams, dem.georef(), dem.cols(), dem.rows());
-  const terrain::D8Consistency consistency = terrain::d8_consistency(skeleton, order, dem, cell_m, 2.0, terrain.sea_level_m);
-  const terrain::HortonRatios horton = terrain::horton_ratios(skeleton, cell_m);
-  const double density = terrain::drainage_density(skeleton, dem, cell_m, terrain.sea_level_m);
+  const auto order = generate::stream_order_raster(streams, dem.georef(), dem.cols(), dem.rows());
+  const generate::D8Consistency consistency = generate::d8_consistency(plan, order, dem, cell_m, 2.0, terrain.sea_level_m);
+  const generate::HortonRatios horton = generate::horton_ratios(plan, cell_m);
+  const double density = generate::drainage_density(plan, dem, cell_m, terrain.sea_level_m);
   int top = 0;
-  for (const auto& r : skeleton.rivers) top = std::max(top, r.strahler);
+  for (const auto& r : plan.rivers) top = std::max(top, r.strahler);
 
-  log.info("generate: " + std::to_string(skeleton.rivers.size()) + " river reaches (" + fixed(river_m / 1000, 1) +
-           " km, Strahler order up to " + std::to_string(top) + "), " + std::to_string(skeleton.ridges.size()) + " ridge lines");
+  log.info("generate: " + std::to_string(plan.rivers.size()) + " river reaches (" + fixed(river_m / 1000, 1) +
+           " km, Strahler order up to " + std::to_string(top) + "), " + std::to_string(plan.ridges.size()) + " ridge lines");
   log.info("generate: " + fixed(100 * consistency.share(), 1) + " % of the river length within 2 cells of a D8 stream of the same or adjacent order" +
            " (D8 streams from " + fixed(threshold_m2 / 1e6, 3) + " km2); " + std::to_string(consistency.ending_in_pit) + " of " +
            std::to_string(consistency.mouths) + " mouths end in a pit");
@@ -59,8 +59,8 @@ std::string skeleton_report(const terrain::GeneratedTerrain& terrain, double cel
 
   json report;
   report["method"] = method;
-  report["river_reaches"] = skeleton.rivers.size();
-  report["ridge_lines"] = skeleton.ridges.size();
+  report["river_reaches"] = plan.rivers.size();
+  report["ridge_lines"] = plan.ridges.size();
   report["river_length_km"] = rounded(river_m / 1000);
   report["max_strahler_order"] = top;
   report["d8_consistency"] = {{"share_within_2_cells", rounded(consistency.share(), 1e-4)},

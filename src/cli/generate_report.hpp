@@ -4,14 +4,14 @@
 #include <string>
 
 #include "core/progress.hpp"
-#include "terrain/generator.hpp"
+#include "generate/generator.hpp"
 
 namespace terrapolis::cli {
 
 /// Runs the hydro stage's D8 (priority-flood fill, D8, upstream area, streams from the generator's
 /// channel-head area) on `terrain.dem`, checks the skeleton against
-/// it (terrain/skeleton_checks.hpp), logs the summary and returns the report as JSON text.
-std::string skeleton_report(const terrain::GeneratedTerrain& terrain, double cell_m, const std::string& method,
+/// it (generate/river_checks.hpp), logs the summary and returns the report as JSON text.
+std::string skeleton_report(const generate::GeneratedTerrain& terrain, double cell_m, const std::string& method,
                             const Log& log, Progress& progress);
 
 }  // namespace terrapolis::cli

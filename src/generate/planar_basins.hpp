@@ -11,9 +11,9 @@
 
 #include "core/progress.hpp"
 #include "core/raster.hpp"
-#include "terrain/plan_geometry.hpp"
+#include "generate/plan_geometry.hpp"
 
-namespace terrapolis::terrain {
+namespace terrapolis::generate {
 
 /// A binary tree: node 0 is the root (the first confluence above the mouth); -1: no child.
 struct BinaryTree {
@@ -85,4 +85,4 @@ PlanarMap build_planar_map(const BinaryTree& tree, double width_m, double height
 /// Rasterises the facets onto `grid` (cell centres inside a facet take its plane; NaN outside the map).
 void rasterise(const PlanarMap& map, Raster<float>& grid, Progress* progress = nullptr);
 
-}  // namespace terrapolis::terrain
+}  // namespace terrapolis::generate

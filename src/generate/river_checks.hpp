@@ -7,9 +7,9 @@
 
 #include "core/raster.hpp"
 #include "io/vector_io.hpp"
-#include "terrain/skeleton.hpp"
+#include "generate/river_ridge_plan.hpp"
 
-namespace terrapolis::terrain {
+namespace terrapolis::generate {
 
 /// Horton's laws (Horton 1945; Strahler 1957) on a Strahler-ordered network. A stream of order w
 /// is a maximal chain of reaches of order w. Rb and Rl are the antilogs of the least-squares
@@ -21,7 +21,7 @@ struct HortonRatios {
   std::optional<double> bifurcation;  ///< Rb; none with fewer than 2 orders
   std::optional<double> length;       ///< Rl; none with fewer than 2 orders
 };
-HortonRatios horton_ratios(const Skeleton& skeleton, double cell_m);
+HortonRatios horton_ratios(const RiverRidgePlan& plan, double cell_m);
 
 /// The generated rivers against the D8 streams `terrapolis hydro` extracts from the generated DEM.
 struct D8Consistency {
@@ -35,7 +35,7 @@ struct D8Consistency {
 /// `stream_order`: Strahler order of the D8 stream through each cell, 0 off-stream (see
 /// stream_order_raster). `dem`: the generated DEM (NaN nodata); cells at or below `sea_level_m`
 /// are sea. A mouth must end within one cell of the border, a nodata or a sea cell.
-D8Consistency d8_consistency(const Skeleton& skeleton, const Raster<std::uint8_t>& stream_order, const Raster<float>& dem,
+D8Consistency d8_consistency(const RiverRidgePlan& plan, const Raster<std::uint8_t>& stream_order, const Raster<float>& dem,
                              double cell_m, double radius_cells = 2.0, std::optional<double> sea_level_m = std::nullopt);
 
 /// Rasterises a D8 streams layer (hydro/streams.hpp: vertices at cell centres, field `strahler`)
@@ -45,10 +45,10 @@ Raster<std::uint8_t> stream_order_raster(const VectorLayer& streams, const Geore
 /// The D8 stream threshold (m²) that starts D8 streams where the generator starts its rivers: the
 /// median D8 upstream area at the first point of the source reaches (those nothing flows into).
 /// 1 m² when there is no source.
-double channel_head_threshold_m2(const Skeleton& skeleton, const Raster<double>& area_m2);
+double channel_head_threshold_m2(const RiverRidgePlan& plan, const Raster<double>& area_m2);
 
 /// Total river length (km) per land area (km²): cells that are finite and above `sea_level_m`.
-double drainage_density(const Skeleton& skeleton, const Raster<float>& dem, double cell_m,
+double drainage_density(const RiverRidgePlan& plan, const Raster<float>& dem, double cell_m,
                         std::optional<double> sea_level_m = std::nullopt);
 
-}  // namespace terrapolis::terrain
+}  // namespace terrapolis::generate

@@ -1,6 +1,6 @@
 // Génévaux et al., river networks from a coastline (seeds/002 §4-7). See river_grammar.hpp.
 // SPDX-License-Identifier: MIT
-#include "terrain/river_grammar.hpp"
+#include "generate/river_grammar.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -10,10 +10,10 @@
 
 #include "core/error.hpp"
 #include "core/interrupt.hpp"
-#include "terrain/generators.hpp"
+#include "generate/generators.hpp"
 #include "terrain/subdivision.hpp"
 
-namespace terrapolis::terrain {
+namespace terrapolis::generate {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
@@ -41,8 +41,8 @@ double value_noise(std::uint64_t seed, Point2 p, double wavelength) {
     const double fu = u - i, fv = v - j;
     const double su = fu * fu * (3 - 2 * fu), sv = fv * fv * (3 - 2 * fv);
     const std::uint64_t s = seed + 7919 * std::uint64_t(octave);
-    const double top = (1 - su) * position_noise(s, i, j) + su * position_noise(s, i + 1, j);
-    const double bottom = (1 - su) * position_noise(s, i, j + 1) + su * position_noise(s, i + 1, j + 1);
+    const double top = (1 - su) * terrain::position_noise(s, i, j) + su * terrain::position_noise(s, i + 1, j);
+    const double bottom = (1 - su) * terrain::position_noise(s, i, j + 1) + su * terrain::position_noise(s, i + 1, j + 1);
     sum += amplitude * ((1 - sv) * top + sv * bottom);
     total += amplitude;
   }
@@ -348,14 +348,14 @@ void refine_courses(std::vector<RiverNode>& nodes, const CoastParams& params) {
     double amplitude = 0.03;
     if (n.type == hydro::RiverType::E) amplitude = 0.12;
     else if (n.type == hydro::RiverType::D || n.type == hydro::RiverType::delta) amplitude = 0.06;
-    const double phase = position_noise(params.seed ^ 0x5EEDull, int(i), 0) > 0 ? 1 : -1;
+    const double phase = terrain::position_noise(params.seed ^ 0x5EEDull, int(i), 0) > 0 ? 1 : -1;
     n.course.clear();
     n.course_z.clear();
     for (int k = 0; k <= pieces; ++k) {
       const double t = double(k) / pieces;
       const double wiggle = (k == 0 || k == pieces) ? 0
           : amplitude * length * (phase * std::sin(2 * kPi * t) * (n.type == hydro::RiverType::E ? 1.0 : 0.3) +
-                                  0.5 * position_noise(params.seed ^ 0xC0u, int(i), k));
+                                  0.5 * terrain::position_noise(params.seed ^ 0xC0u, int(i), k));
       n.course.push_back(a + t * ab + wiggle * normal);
       n.course_z.push_back(n.z + t * (down.z - n.z));
     }
@@ -534,8 +534,8 @@ class CoastPrimitives {
     const int pc = int(std::ceil(width / spacing)), pr = int(std::ceil(height / spacing));
     for (int j = 0; j < pr; ++j)
       for (int i = 0; i < pc; ++i) {
-        const Point2 c{(i + 0.5 + 0.5 * position_noise(params_.seed ^ 0x7E11ull, i, 2 * j)) * spacing,
-                       (j + 0.5 + 0.5 * position_noise(params_.seed ^ 0x7E11ull, i, 2 * j + 1)) * spacing};
+        const Point2 c{(i + 0.5 + 0.5 * terrain::position_noise(params_.seed ^ 0x7E11ull, i, 2 * j)) * spacing,
+                       (j + 0.5 + 0.5 * terrain::position_noise(params_.seed ^ 0x7E11ull, i, 2 * j + 1)) * spacing};
         if (!domain.inside(c)) continue;
         // c_z = d_a/(d_a+d_b) b_z + d_b/(d_a+d_b) a_z (§7.2): a on the rivers, b on the ridges.
         const Nearest a = nearest_anywhere(piece_bins_, c, width + height, [&](int id) { return piece_ends(id); });
@@ -638,17 +638,17 @@ GeneratedTerrain generate_coast(const GenerateRequest& request) {
   // out at a mouth. Width: the channel the primitives carve (Leopold & Maddock, see above).
   std::vector<int> reach_of(t.nodes.size(), -1);
   for (std::size_t i = 0; i < t.nodes.size(); ++i)
-    if (t.nodes[i].parent >= 0) reach_of[i] = int(out.skeleton.rivers.size()), out.skeleton.rivers.emplace_back();
+    if (t.nodes[i].parent >= 0) reach_of[i] = int(out.plan.rivers.size()), out.plan.rivers.emplace_back();
   for (std::size_t i = 0; i < t.nodes.size(); ++i) {
     const RiverNode& n = t.nodes[i];
     if (n.parent < 0) continue;
-    RiverReach& reach = out.skeleton.rivers[std::size_t(reach_of[i])];
+    RiverReach& reach = out.plan.rivers[std::size_t(reach_of[i])];
     for (Point2 p : n.course) reach.line.push_back(grid_point(p));
     reach.downstream = reach_of[std::size_t(n.parent)];
     reach.width_m = 2.5 * std::sqrt(std::max(n.discharge_m3s, 0.01));
   }
-  assign_strahler(out.skeleton);
-  for (const RidgeSegment& s : t.ridges) out.skeleton.ridges.push_back({{grid_point(s.a), grid_point(s.b)}, {float(s.za), float(s.zb)}});
+  assign_strahler(out.plan);
+  for (const RidgeSegment& s : t.ridges) out.plan.ridges.push_back({{grid_point(s.a), grid_point(s.b)}, {float(s.za), float(s.zb)}});
   out.timings = {{"grammar graph", t.graph_s}, {"analysis", t.analysis_s}, {"terrain", t.terrain_s}};
   std::size_t streams = 0, low = 0;
   for (const RiverNode& n : t.nodes)
@@ -672,4 +672,4 @@ GeneratedTerrain generate_coast(const GenerateRequest& request) {
   return out;
 }
 
-}  // namespace terrapolis::terrain
+}  // namespace terrapolis::generate

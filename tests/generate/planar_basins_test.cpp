@@ -7,10 +7,10 @@
 #include <cstring>
 
 #include "core/error.hpp"
-#include "terrain/planar_basins.hpp"
+#include "generate/planar_basins.hpp"
 
 using namespace terrapolis;
-using namespace terrapolis::terrain;
+using namespace terrapolis::generate;
 
 TEST(PlanarBasins, ParsesTreesAndOrders) {
   const BinaryTree t = parse_tree("((..).)", "--tree");

@@ -8,9 +8,9 @@
 #include <map>
 
 #include "core/error.hpp"
-#include "terrain/planar_basins.hpp"
+#include "generate/planar_basins.hpp"
 
-namespace terrapolis::terrain {
+namespace terrapolis::generate {
 
 std::vector<double> solve_min_sum(const std::vector<int>& variables, const std::vector<LinearRow>& rows) {
   std::map<int, int> column;
@@ -36,4 +36,4 @@ std::vector<double> solve_min_sum(const std::vector<int>& variables, const std::
   return z;
 }
 
-}  // namespace terrapolis::terrain
+}  // namespace terrapolis::generate

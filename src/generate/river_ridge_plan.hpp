@@ -1,4 +1,6 @@
-// The skeleton a terrain generator builds its DEM from: river reaches as a tree, ridge lines.
+// The plan a terrain generator builds its DEM from: river reaches as a tree, ridge lines (what
+// `generate` writes as <stem>.skeleton.geojson; not the ridges and valleys that src/skeleton/ traces
+// on a DEM).
 // SPDX-License-Identifier: MIT
 #pragma once
 #include <array>
@@ -7,7 +9,7 @@
 #include "core/raster.hpp"
 #include "io/vector_io.hpp"
 
-namespace terrapolis::terrain {
+namespace terrapolis::generate {
 
 /// A position in cell coordinates: (col, row) as reals, the centre of cell (c,r) at (c,r), row 0 north.
 using GridPoint = std::array<double, 2>;
@@ -29,7 +31,7 @@ struct RidgeLine {
 };
 
 /// What a generator produced besides the DEM, on the DEM's grid.
-struct Skeleton {
+struct RiverRidgePlan {
   std::vector<RiverReach> rivers;
   std::vector<RidgeLine> ridges;
 };
@@ -50,13 +52,13 @@ std::vector<RiverReach> reaches_from_paths(const std::vector<RiverPath>& paths);
 /// Sets every reach's Strahler order from the tree: 1 for a reach nothing flows into, else the
 /// highest order flowing in, +1 when two or more inflows share it (Strahler 1952). Throws
 /// std::logic_error on a cycle or a `downstream` out of range.
-void assign_strahler(Skeleton& skeleton);
+void assign_strahler(RiverRidgePlan& plan);
 
 /// Length of a line in metres on a grid of square `cell_m` cells.
 double line_length_m(const std::vector<GridPoint>& line, double cell_m);
 
-/// The skeleton as one line layer in the grid's CRS: fields `kind` ("river" | "ridge"), `id`,
+/// The plan as one line layer in the grid's CRS: fields `kind` ("river" | "ridge"), `id`,
 /// `strahler`, `width_m`, `downstream_id` (0 at an outlet or for a ridge), `length_m`.
-VectorLayer skeleton_layer(const Skeleton& skeleton, const Georef& georef, double cell_m);
+VectorLayer river_ridge_layer(const RiverRidgePlan& plan, const Georef& georef, double cell_m);
 
-}  // namespace terrapolis::terrain
+}  // namespace terrapolis::generate

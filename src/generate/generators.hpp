@@ -1,9 +1,9 @@
 // The terrain generators behind `terrapolis generate --method`, one source file each.
 // SPDX-License-Identifier: MIT
 #pragma once
-#include "terrain/generator.hpp"
+#include "generate/generator.hpp"
 
-namespace terrapolis::terrain {
+namespace terrapolis::generate {
 
 /// Belhadj 2007 §2.2 (generate_flow.cpp): ridges (random from the seed, or request.lines), basins,
 /// river particles, then DMMC constrained by the ridge and river cells.
@@ -21,4 +21,4 @@ GeneratedTerrain generate_coast(const GenerateRequest& request);
 /// ridge altitudes by linear programming, fractalised facets.
 GeneratedTerrain generate_planar(const GenerateRequest& request);
 
-}  // namespace terrapolis::terrain
+}  // namespace terrapolis::generate

@@ -9,11 +9,11 @@
 #include <numbers>
 
 #include "core/neighbours.hpp"
-#include "terrain/distance_field.hpp"
-#include "terrain/generators.hpp"
+#include "generate/distance_field.hpp"
+#include "generate/generators.hpp"
 #include "core/random.hpp"
 
-namespace terrapolis::terrain {
+namespace terrapolis::generate {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
@@ -602,12 +602,12 @@ GeneratedTerrain generate_flow(const GenerateRequest& request) {
       const double d = std::min({c + 0.5, r + 0.5, cols - c - 0.5, rows - r - 0.5});
       f.a[f.at(c, r)] = float(base_m * std::min(1.0, d / (size / 2)));
     }
-  Skeleton skeleton;
+  RiverRidgePlan plan;
   if (request.lines.empty()) {
     const int pairs = std::max(2, int(std::lround(double(cols) * rows / 60000.0)));
-    skeleton.ridges = random_ridges(f, pairs, request.relief_m, rp, rng);
+    plan.ridges = random_ridges(f, pairs, request.relief_m, rp, rng);
   } else {
-    skeleton.ridges = given_ridges(f, request.lines, request.relief_m, rp);
+    plan.ridges = given_ridges(f, request.lines, request.relief_m, rp);
   }
   smooth_basins(f);
 
@@ -615,19 +615,19 @@ GeneratedTerrain generate_flow(const GenerateRequest& request) {
   // A particle stands for the water of its strip of slope, `spacing` cells wide: its channel head
   // is `spacing` cells down its track, where it drains spacing² cells (see channels()).
   const double spacing = std::max(3.0, size / 20);
-  seed_particles(rivers, skeleton.ridges, spacing);
+  seed_particles(rivers, plan.ridges, spacing);
   rivers.run();
   std::vector<RiverPath> paths = rivers.paths();
   const auto masses = path_masses(paths);
   for (std::size_t i = 0; i < paths.size(); ++i)
     for (double m : masses[i]) paths[i].width_m.push_back(std::max(1.0, std::log2(m)) * request.cell_m);
-  skeleton.rivers = reaches_from_paths(channels(paths, std::size_t(std::lround(spacing))));
+  plan.rivers = reaches_from_paths(channels(paths, std::size_t(std::lround(spacing))));
   const double skeleton_s = std::chrono::duration<double>(clock::now() - t0).count();
 
   // The skeleton DEM: ridge and river cells keep their altitude, everything else is unknown.
   GeneratedTerrain out;
   out.dem = request.grid;
-  out.skeleton = std::move(skeleton);
+  out.plan = std::move(plan);
   Raster<float>& dem = out.dem;
   for (int r = 0; r < rows; ++r)
     for (int c = 0; c < cols; ++c)
@@ -635,11 +635,11 @@ GeneratedTerrain generate_flow(const GenerateRequest& request) {
   const std::vector<char> centre = burn_beds(dem, f, paths, masses, 1e-3 * request.cell_m);
   fix_interfluves(dem, f, centre, request.cell_m, request.relief_m);
   const auto t1 = clock::now();
-  dmmc(dem, request.dmmc, request.progress);
+  terrain::dmmc(dem, request.dmmc, request.progress);
   out.timings.emplace_back("skeleton", skeleton_s);
   out.channel_head_m2 = spacing * spacing * request.cell_m * request.cell_m;
   out.timings.emplace_back("dmmc", std::chrono::duration<double>(clock::now() - t1).count());
   return out;
 }
 
-}  // namespace terrapolis::terrain
+}  // namespace terrapolis::generate

@@ -12,11 +12,11 @@
 #include <queue>
 
 #include "core/neighbours.hpp"
-#include "terrain/distance_field.hpp"
-#include "terrain/generators.hpp"
+#include "generate/distance_field.hpp"
+#include "generate/generators.hpp"
 #include "core/random.hpp"
 
-namespace terrapolis::terrain {
+namespace terrapolis::generate {
 namespace {
 
 using Vec = std::array<double, 2>;
@@ -30,8 +30,8 @@ double fbm(std::uint64_t seed, double x, double y, int octaves, double hurst = 0
     auto s = [](double t) { return t * t * (3 - 2 * t); };
     const double tx = s(x - fx), ty = s(y - fy);
     const std::uint64_t so = seed + 0x9e37u * std::uint64_t(o);
-    const double v00 = position_noise(so, ix, iy), v10 = position_noise(so, ix + 1, iy);
-    const double v01 = position_noise(so, ix, iy + 1), v11 = position_noise(so, ix + 1, iy + 1);
+    const double v00 = terrain::position_noise(so, ix, iy), v10 = terrain::position_noise(so, ix + 1, iy);
+    const double v01 = terrain::position_noise(so, ix, iy + 1), v11 = terrain::position_noise(so, ix + 1, iy + 1);
     sum += amplitude * ((v00 * (1 - tx) + v10 * tx) * (1 - ty) + (v01 * (1 - tx) + v11 * tx) * ty);
     norm += amplitude;
     amplitude *= std::pow(2.0, -hurst);
@@ -202,7 +202,7 @@ DrainageTree drainage_tree(const std::vector<double>& folds, int cols, int rows,
       const std::size_t j = std::size_t(nr) * std::size_t(cols) + std::size_t(nc);
       if (done[j]) continue;
       // Folds steer the growth: rivers grow more easily where the folds are low (the valleys).
-      const double resistance = position_noise(seed ^ 0xa5u, nc, nr) + 1 + 3 * folds[j];
+      const double resistance = terrain::position_noise(seed ^ 0xa5u, nc, nr) + 1 + 3 * folds[j];
       if (resistance < cost[j]) cost[j] = resistance, tree.receiver[j] = i, queue.push({resistance, j});
     }
   }
@@ -295,10 +295,10 @@ GeneratedTerrain generate_tectonic(const GenerateRequest& request) {
   for (auto& p : paths)
     for (const auto& q : p.line)
       p.width_m.push_back(std::max(1.0, std::log2(area[std::size_t(q[1]) * std::size_t(cols) + std::size_t(q[0])] / channel_cells)) * request.cell_m);
-  out.skeleton.rivers = reaches_from_paths(paths);
+  out.plan.rivers = reaches_from_paths(paths);
   out.channel_head_m2 = channel_cells * request.cell_m * request.cell_m;
   out.timings.emplace_back("tectonic", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   return out;
 }
 
-}  // namespace terrapolis::terrain
+}  // namespace terrapolis::generate

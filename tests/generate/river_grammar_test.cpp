@@ -6,10 +6,10 @@
 #include <cmath>
 #include <cstring>
 
-#include "terrain/river_grammar.hpp"
+#include "generate/river_grammar.hpp"
 
 using namespace terrapolis;
-using namespace terrapolis::terrain;
+using namespace terrapolis::generate;
 
 namespace {
 

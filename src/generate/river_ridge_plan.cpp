@@ -1,15 +1,15 @@
 // SPDX-License-Identifier: MIT
-#include "terrain/skeleton.hpp"
+#include "generate/river_ridge_plan.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
-namespace terrapolis::terrain {
+namespace terrapolis::generate {
 
-void assign_strahler(Skeleton& skeleton) {
-  auto& rivers = skeleton.rivers;
+void assign_strahler(RiverRidgePlan& plan) {
+  auto& rivers = plan.rivers;
   const int n = int(rivers.size());
   std::vector<int> pending(std::size_t(n), 0);  // inflows not yet ordered
   for (const auto& r : rivers) {
@@ -71,7 +71,7 @@ std::vector<RiverReach> reaches_from_paths(const std::vector<RiverPath>& paths) 
       }
     }
   }
-  Skeleton s;
+  RiverRidgePlan s;
   s.rivers = std::move(reaches);
   assign_strahler(s);
   return std::move(s.rivers);
@@ -84,7 +84,7 @@ double line_length_m(const std::vector<GridPoint>& line, double cell_m) {
   return length * cell_m;
 }
 
-VectorLayer skeleton_layer(const Skeleton& skeleton, const Georef& georef, double cell_m) {
+VectorLayer river_ridge_layer(const RiverRidgePlan& plan, const Georef& georef, double cell_m) {
   VectorLayer layer;
   layer.name = "skeleton";
   layer.geometry = GeometryType::line_string;
@@ -98,15 +98,15 @@ VectorLayer skeleton_layer(const Skeleton& skeleton, const Georef& georef, doubl
     for (const auto& p : line) out.push_back(georef.cell_centre(p[0], p[1]));
     return out;
   };
-  for (std::size_t i = 0; i < skeleton.rivers.size(); ++i) {
-    const auto& r = skeleton.rivers[i];
+  for (std::size_t i = 0; i < plan.rivers.size(); ++i) {
+    const auto& r = plan.rivers[i];
     if (r.line.size() < 2) continue;
     layer.features.push_back({{to_crs(r.line)},
                               {std::string("river"), std::int64_t(i + 1), std::int64_t(r.strahler), r.width_m,
                                std::int64_t(r.downstream + 1), line_length_m(r.line, cell_m)}});
   }
-  for (std::size_t i = 0; i < skeleton.ridges.size(); ++i) {
-    const auto& r = skeleton.ridges[i];
+  for (std::size_t i = 0; i < plan.ridges.size(); ++i) {
+    const auto& r = plan.ridges[i];
     if (r.line.size() < 2) continue;
     layer.features.push_back({{to_crs(r.line)},
                               {std::string("ridge"), std::int64_t(i + 1), std::monostate{}, std::monostate{},
@@ -115,4 +115,4 @@ VectorLayer skeleton_layer(const Skeleton& skeleton, const Georef& georef, doubl
   return layer;
 }
 
-}  // namespace terrapolis::terrain
+}  // namespace terrapolis::generate

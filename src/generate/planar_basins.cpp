@@ -1,6 +1,6 @@
 // Binary-tree basins on planar maps (seeds/003 §6.2-6.3). See planar_basins.hpp.
 // SPDX-License-Identifier: MIT
-#include "terrain/planar_basins.hpp"
+#include "generate/planar_basins.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -10,9 +10,9 @@
 #include <numeric>
 
 #include "core/error.hpp"
-#include "terrain/generators.hpp"
+#include "generate/generators.hpp"
 
-namespace terrapolis::terrain {
+namespace terrapolis::generate {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
@@ -497,11 +497,11 @@ GeneratedTerrain generate_planar(const GenerateRequest& request) {
     reach.line = {grid_point(e.up), grid_point(e.down)};
     const auto next = leaving.find(e.down);
     reach.downstream = next == leaving.end() ? -1 : next->second;
-    out.skeleton.rivers.push_back(reach);
+    out.plan.rivers.push_back(reach);
   }
-  assign_strahler(out.skeleton);
+  assign_strahler(out.plan);
   for (auto [a, b] : map.ridges)
-    out.skeleton.ridges.push_back({{grid_point(a), grid_point(b)}, {float(map.z[std::size_t(a)]), float(map.z[std::size_t(b)])}});
+    out.plan.ridges.push_back({{grid_point(a), grid_point(b)}, {float(map.z[std::size_t(a)]), float(map.z[std::size_t(b)])}});
   out.figures = {{"tree_nodes", double(tree.size())},
                  {"map_vertices", double(map.p.size())},
                  {"facets", double(map.facets.size())},
@@ -511,4 +511,4 @@ GeneratedTerrain generate_planar(const GenerateRequest& request) {
   return out;
 }
 
-}  // namespace terrapolis::terrain
+}  // namespace terrapolis::generate

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "terrain/skeleton_checks.hpp"
+#include "generate/river_checks.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 
 #include "core/neighbours.hpp"
 
-namespace terrapolis::terrain {
+namespace terrapolis::generate {
 namespace {
 
 /// Antilog of the least-squares slope of log10(y) over x = 1, 2, ...
@@ -28,8 +28,8 @@ int nearest(double v) { return int(std::lround(v)); }
 
 }  // namespace
 
-HortonRatios horton_ratios(const Skeleton& skeleton, double cell_m) {
-  const auto& rivers = skeleton.rivers;
+HortonRatios horton_ratios(const RiverRidgePlan& plan, double cell_m) {
+  const auto& rivers = plan.rivers;
   std::vector<char> continues(rivers.size(), 0);  // an inflow of the same order continues into it
   int top = 0;
   for (const auto& r : rivers) {
@@ -57,7 +57,7 @@ HortonRatios horton_ratios(const Skeleton& skeleton, double cell_m) {
   return h;
 }
 
-D8Consistency d8_consistency(const Skeleton& skeleton, const Raster<std::uint8_t>& stream_order, const Raster<float>& dem,
+D8Consistency d8_consistency(const RiverRidgePlan& plan, const Raster<std::uint8_t>& stream_order, const Raster<float>& dem,
                              double cell_m, double radius_cells, std::optional<double> sea_level_m) {
   std::vector<std::array<int, 2>> disc;
   const int reach = int(std::ceil(radius_cells));
@@ -83,7 +83,7 @@ D8Consistency d8_consistency(const Skeleton& skeleton, const Raster<std::uint8_t
     return false;
   };
   D8Consistency out;
-  for (const auto& river : skeleton.rivers) {
+  for (const auto& river : plan.rivers) {
     for (std::size_t i = 1; i < river.line.size(); ++i) {
       const auto& a = river.line[i - 1];
       const auto& b = river.line[i];
@@ -120,14 +120,14 @@ Raster<std::uint8_t> stream_order_raster(const VectorLayer& streams, const Geore
   return order;
 }
 
-double channel_head_threshold_m2(const Skeleton& skeleton, const Raster<double>& area_m2) {
-  std::vector<char> fed(skeleton.rivers.size(), 0);
-  for (const auto& r : skeleton.rivers)
+double channel_head_threshold_m2(const RiverRidgePlan& plan, const Raster<double>& area_m2) {
+  std::vector<char> fed(plan.rivers.size(), 0);
+  for (const auto& r : plan.rivers)
     if (r.downstream >= 0) fed[std::size_t(r.downstream)] = 1;
   std::vector<double> heads;
-  for (std::size_t i = 0; i < skeleton.rivers.size(); ++i) {
-    if (fed[i] || skeleton.rivers[i].line.empty()) continue;
-    const int c = nearest(skeleton.rivers[i].line.front()[0]), r = nearest(skeleton.rivers[i].line.front()[1]);
+  for (std::size_t i = 0; i < plan.rivers.size(); ++i) {
+    if (fed[i] || plan.rivers[i].line.empty()) continue;
+    const int c = nearest(plan.rivers[i].line.front()[0]), r = nearest(plan.rivers[i].line.front()[1]);
     if (area_m2.inside(c, r) && std::isfinite(area_m2(c, r))) heads.push_back(area_m2(c, r));
   }
   if (heads.empty()) return 1.0;
@@ -135,12 +135,12 @@ double channel_head_threshold_m2(const Skeleton& skeleton, const Raster<double>&
   return std::max(1.0, heads[heads.size() / 2]);
 }
 
-double drainage_density(const Skeleton& skeleton, const Raster<float>& dem, double cell_m, std::optional<double> sea_level_m) {
+double drainage_density(const RiverRidgePlan& plan, const Raster<float>& dem, double cell_m, std::optional<double> sea_level_m) {
   double length_m = 0;
-  for (const auto& r : skeleton.rivers) length_m += line_length_m(r.line, cell_m);
+  for (const auto& r : plan.rivers) length_m += line_length_m(r.line, cell_m);
   std::size_t land = 0;
   for (std::size_t i = 0; i < dem.size(); ++i) land += std::isfinite(dem[i]) && !(sea_level_m && dem[i] <= *sea_level_m) ? 1 : 0;
   return land ? (length_m / 1000.0) / (double(land) * cell_m * cell_m / 1e6) : 0.0;
 }
 
-}  // namespace terrapolis::terrain
+}  // namespace terrapolis::generate

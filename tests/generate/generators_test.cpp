@@ -6,9 +6,9 @@
 #include <cmath>
 #include <cstring>
 
-#include "terrain/generators.hpp"
+#include "generate/generators.hpp"
 
-namespace terrapolis::terrain {
+namespace terrapolis::generate {
 namespace {
 
 GenerateRequest request(std::uint64_t seed) {
@@ -25,16 +25,16 @@ GenerateRequest request(std::uint64_t seed) {
 }
 
 void expect_sound(const GeneratedTerrain& t, const char* what) {
-  ASSERT_FALSE(t.skeleton.rivers.empty()) << what;
+  ASSERT_FALSE(t.plan.rivers.empty()) << what;
   for (std::size_t i = 0; i < t.dem.size(); ++i) ASSERT_TRUE(std::isfinite(t.dem[i])) << what;
   int mouths = 0;
-  for (const auto& r : t.skeleton.rivers) {
+  for (const auto& r : t.plan.rivers) {
     ASSERT_GE(r.line.size(), 2u) << what;
     mouths += r.downstream < 0;
     if (r.downstream >= 0) {  // a reach ends on the first point of the reach it flows into
-      const auto& d = t.skeleton.rivers[std::size_t(r.downstream)].line.front();
+      const auto& d = t.plan.rivers[std::size_t(r.downstream)].line.front();
       EXPECT_EQ(r.line.back(), d) << what;
-      EXPECT_GE(t.skeleton.rivers[std::size_t(r.downstream)].strahler, r.strahler) << what;
+      EXPECT_GE(t.plan.rivers[std::size_t(r.downstream)].strahler, r.strahler) << what;
     }
     // The bed never rises downstream (cells are visited once each; a confluence point is the
     // receiving river's cell).
@@ -53,7 +53,7 @@ TEST(Generators, SameSeedSameBytesOtherSeedOtherTerrain) {
   for (auto* generate : {&generate_flow, &generate_tectonic}) {
     const GeneratedTerrain a = generate(request(5)), b = generate(request(5)), c = generate(request(6));
     EXPECT_EQ(std::memcmp(a.dem.values().data(), b.dem.values().data(), a.dem.size() * sizeof(float)), 0);
-    EXPECT_EQ(a.skeleton.rivers.size(), b.skeleton.rivers.size());
+    EXPECT_EQ(a.plan.rivers.size(), b.plan.rivers.size());
     EXPECT_NE(std::memcmp(a.dem.values().data(), c.dem.values().data(), a.dem.size() * sizeof(float)), 0);
   }
 }
@@ -68,4 +68,4 @@ TEST(Generators, GivenRidgeIsTheCrest) {
 }
 
 }  // namespace
-}  // namespace terrapolis::terrain
+}  // namespace terrapolis::generate

@@ -9,7 +9,7 @@
 
 #include "core/random.hpp"
 
-namespace terrapolis::terrain {
+namespace terrapolis::generate {
 
 /// Plan coordinates in metres from the grid's north-west corner: x east, y south (as rows grow).
 struct Point2 {
@@ -77,4 +77,4 @@ class SpatialBins {
 inline double between(Rng& rng, double lo, double hi) { return lo + (hi - lo) * rng.uniform(); }
 inline int integer(Rng& rng, int lo, int hi) { return lo + int(rng.uniform() * (hi - lo + 1)); }  ///< [lo,hi]
 
-}  // namespace terrapolis::terrain
+}  // namespace terrapolis::generate

@@ -9,19 +9,19 @@
 
 #include "core/progress.hpp"
 #include "core/raster.hpp"
-#include "terrain/planar_basins.hpp"
-#include "terrain/river_grammar.hpp"
-#include "terrain/skeleton.hpp"
+#include "generate/planar_basins.hpp"
+#include "generate/river_grammar.hpp"
+#include "generate/river_ridge_plan.hpp"
 #include "terrain/subdivision.hpp"
 
-namespace terrapolis::terrain {
+namespace terrapolis::generate {
 
 struct GenerateRequest {
   Raster<float> grid;            ///< the empty grid (NaN), georeferenced; square cells of cell_m
   double cell_m = 30;
   std::uint64_t seed = 1;
   double relief_m = 1000;        ///< height of the highest crest above the outlets
-  DmmcParams dmmc;               ///< the DMMC that fills between the skeleton's cells
+  terrain::DmmcParams dmmc;      ///< the DMMC that fills between the skeleton's cells
   std::vector<std::vector<GridPoint>> lines;  ///< user lines (flow: ridges), cell coordinates
   std::vector<GridPoint> points;               ///< user points (tectonic: mountain points)
   std::vector<std::vector<GridPoint>> polygons;  ///< user polygon rings (coast: the land; empty: a seeded island)
@@ -32,7 +32,7 @@ struct GenerateRequest {
 
 struct GeneratedTerrain {
   Raster<float> dem;                  ///< metres, on the request's grid
-  Skeleton skeleton;                  ///< what the DEM was built from (empty for plain DMMC)
+  RiverRidgePlan plan;                ///< what the DEM was built from (empty for plain DMMC)
   std::optional<double> sea_level_m;  ///< cells at or below it are sea
   /// Upstream area (m²) at which the generator starts its rivers: the D8 stream threshold of the
   /// consistency check. None: the median D8 area at the generated channel heads.
@@ -41,4 +41,4 @@ struct GeneratedTerrain {
   std::vector<std::pair<std::string, double>> figures;  ///< the method's own figures (e.g. the paper's Tab. 2), for the report
 };
 
-}  // namespace terrapolis::terrain
+}  // namespace terrapolis::generate

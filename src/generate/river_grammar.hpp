@@ -12,9 +12,9 @@
 #include "core/progress.hpp"
 #include "core/raster.hpp"
 #include "hydro/river_types.hpp"
-#include "terrain/plan_geometry.hpp"
+#include "generate/plan_geometry.hpp"
 
-namespace terrapolis::terrain {
+namespace terrapolis::generate {
 
 /// Parameters of the coast method. Lengths in metres; the paper gives the rules, not the figures:
 /// the defaults are ours, chosen so that the drainage density and primitive counts match its Tab. 2.
@@ -116,4 +116,4 @@ std::vector<RidgeSegment> voronoi_ridges(const std::vector<Point2>& points, cons
                                          const std::vector<std::pair<int, int>>& river_edges,
                                          const std::function<double(Point2)>& lambda_at);
 
-}  // namespace terrapolis::terrain
+}  // namespace terrapolis::generate

@@ -1,20 +1,20 @@
-// Skeleton trees, Strahler orders, Horton ratios and the D8 consistency check on hand-made cases.
+// River trees of a generator's plan, Strahler orders, Horton ratios and the D8 consistency check on hand-made cases.
 // SPDX-License-Identifier: MIT
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "terrain/skeleton.hpp"
-#include "terrain/skeleton_checks.hpp"
+#include "generate/river_ridge_plan.hpp"
+#include "generate/river_checks.hpp"
 
-namespace terrapolis::terrain {
+namespace terrapolis::generate {
 namespace {
 
 std::vector<GridPoint> row_line(double row, double from, double to) { return {{from, row}, {to, row}}; }
 
 // A complete binary tree: four order-1 reaches of 10 cells, two order-2 of 20, one order-3 of 40.
-Skeleton binary_tree() {
-  Skeleton s;
+RiverRidgePlan binary_tree() {
+  RiverRidgePlan s;
   for (int i = 0; i < 4; ++i) s.rivers.push_back({row_line(i, 0, 10), 4 + i / 2, 1, 0});
   for (int i = 0; i < 2; ++i) s.rivers.push_back({row_line(10 + i, 0, 20), 6, 1, 0});
   s.rivers.push_back({row_line(20, 0, 40), -1, 1, 0});
@@ -22,13 +22,13 @@ Skeleton binary_tree() {
   return s;
 }
 
-TEST(Skeleton, StrahlerOfABinaryTree) {
-  const Skeleton s = binary_tree();
+TEST(RiverRidgePlan, StrahlerOfABinaryTree) {
+  const RiverRidgePlan s = binary_tree();
   const int expected[] = {1, 1, 1, 1, 2, 2, 3};
   for (std::size_t i = 0; i < 7; ++i) EXPECT_EQ(s.rivers[i].strahler, expected[i]) << i;
 }
 
-TEST(Skeleton, HortonRatiosOfABinaryTree) {
+TEST(RiverRidgePlan, HortonRatiosOfABinaryTree) {
   // N = 4, 2, 1 and mean L = 100, 200, 400 m (10 m cells): log N and log L are exactly linear in
   // the order, so Rb = 2 and Rl = 2.
   const HortonRatios h = horton_ratios(binary_tree(), 10.0);
@@ -40,7 +40,7 @@ TEST(Skeleton, HortonRatiosOfABinaryTree) {
   EXPECT_NEAR(*h.length, 2.0, 1e-12);
 }
 
-TEST(Skeleton, PathsSplitAtConfluencesAndStreamsChainThroughThem) {
+TEST(RiverRidgePlan, PathsSplitAtConfluencesAndStreamsChainThroughThem) {
   // Main river 0 (x 0..20 on row 0, points every cell) takes river 1 at x=5 and river 2 at x=10;
   // river 3 joins river 1 at its point 3. Orders: river 1 becomes 2 below river 3, the main river
   // becomes 2 below river 1 and stays 2 past river 2: one order-2 stream, four order-1 streams.
@@ -61,7 +61,7 @@ TEST(Skeleton, PathsSplitAtConfluencesAndStreamsChainThroughThem) {
   EXPECT_EQ(reaches[4].strahler, 2);
   EXPECT_EQ(reaches[5].downstream, 2);  // river 2 joins the third
   EXPECT_EQ(reaches[6].downstream, 4);  // river 3 joins river 1's lower reach
-  Skeleton s;
+  RiverRidgePlan s;
   s.rivers = reaches;
   const HortonRatios h = horton_ratios(s, 1.0);
   EXPECT_EQ(h.streams, (std::vector<int>{4, 1}));
@@ -70,19 +70,19 @@ TEST(Skeleton, PathsSplitAtConfluencesAndStreamsChainThroughThem) {
   EXPECT_DOUBLE_EQ(h.mean_length_m[1], 20.0);
 }
 
-TEST(Skeleton, CycleIsRefused) {
-  Skeleton s;
+TEST(RiverRidgePlan, CycleIsRefused) {
+  RiverRidgePlan s;
   s.rivers.push_back({row_line(0, 0, 1), 1, 1, 0});
   s.rivers.push_back({row_line(1, 0, 1), 0, 1, 0});
   EXPECT_THROW(assign_strahler(s), std::logic_error);
 }
 
-TEST(SkeletonChecks, ConsistencyOnATinyRaster) {
+TEST(RiverChecks, ConsistencyOnATinyRaster) {
   // An order-2 D8 stream along row 5 of a 12x12 grid.
   Raster<std::uint8_t> order(12, 12, Georef{}, 0);
   for (int c = 0; c < 12; ++c) order(c, 5) = 2;
   Raster<float> dem(12, 12, Georef{}, 100.0f);
-  Skeleton s;
+  RiverRidgePlan s;
   s.rivers.push_back({row_line(7, 0, 11), -1, 1, 0});  // 2 cells away, order 1: matched, ends on the border
   s.rivers.push_back({row_line(8, 0, 6), -1, 1, 0});   // 3 cells away: not matched, ends inland
   s.rivers.push_back({row_line(5, 0, 5), -1, 4, 0});   // on it but order 4: not matched, ends inland
@@ -96,8 +96,8 @@ TEST(SkeletonChecks, ConsistencyOnATinyRaster) {
   EXPECT_EQ(d8_consistency(s, order, dem, 10.0, 2.0, 0.0).ending_in_pit, 1);
 }
 
-TEST(SkeletonChecks, DrainageDensityAndChannelHeadThreshold) {
-  Skeleton s;
+TEST(RiverChecks, DrainageDensityAndChannelHeadThreshold) {
+  RiverRidgePlan s;
   s.rivers.push_back({row_line(0, 0, 10), -1, 1, 0});  // 10 cells of 100 m: 1 km
   Raster<float> dem(10, 10, Georef{}, 1.0f);            // 1 km2
   dem(0, 0) = std::numeric_limits<float>::quiet_NaN();
@@ -109,7 +109,7 @@ TEST(SkeletonChecks, DrainageDensityAndChannelHeadThreshold) {
   EXPECT_EQ(channel_head_threshold_m2(binary_tree(), area), 20.0);
 }
 
-TEST(SkeletonChecks, StreamOrderRasterFromLines) {
+TEST(RiverChecks, StreamOrderRasterFromLines) {
   Georef g;
   g.transform = {1000, 10, 0, 2000, 0, -10};
   VectorLayer streams;
@@ -123,4 +123,4 @@ TEST(SkeletonChecks, StreamOrderRasterFromLines) {
 }
 
 }  // namespace
-}  // namespace terrapolis::terrain
+}  // namespace terrapolis::generate

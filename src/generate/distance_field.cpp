@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "terrain/distance_field.hpp"
+#include "generate/distance_field.hpp"
 
 #include <cmath>
 #include <functional>
@@ -8,7 +8,7 @@
 
 #include "core/neighbours.hpp"
 
-namespace terrapolis::terrain {
+namespace terrapolis::generate {
 
 void distance_to(const std::vector<char>& source, int cols, int rows, std::vector<double>& dist, std::vector<std::size_t>& nearest) {
   const std::size_t n = std::size_t(cols) * rows;
@@ -33,4 +33,4 @@ void distance_to(const std::vector<char>& source, int cols, int rows, std::vecto
   }
 }
 
-}  // namespace terrapolis::terrain
+}  // namespace terrapolis::generate

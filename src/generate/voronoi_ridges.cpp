@@ -9,9 +9,9 @@
 #include <set>
 #include <utility>
 
-#include "terrain/river_grammar.hpp"
+#include "generate/river_grammar.hpp"
 
-namespace terrapolis::terrain {
+namespace terrapolis::generate {
 
 std::vector<RidgeSegment> voronoi_ridges(const std::vector<Point2>& points, const std::vector<double>& z,
                                          const std::vector<std::pair<int, int>>& river_edges,
@@ -63,4 +63,4 @@ std::vector<RidgeSegment> voronoi_ridges(const std::vector<Point2>& points, cons
   return out;
 }
 
-}  // namespace terrapolis::terrain
+}  // namespace terrapolis::generate

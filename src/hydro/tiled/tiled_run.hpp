@@ -1,0 +1,263 @@
+// The state and passes of one run of the tile engine (run_tiled_hydro), private to src/hydro/tiled:
+// the per-tile records the passes hand on, and TiledRun, whose passes live one group a file.
+// SPDX-License-Identifier: MIT
+#pragma once
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cstdint>
+#include <exception>
+#include <filesystem>
+#include <limits>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+#include "core/geodesy.hpp"
+#include "hydro/depressions.hpp"
+#include "hydro/exact_accumulation.hpp"
+#include "hydro/grid.hpp"
+#include "hydro/spill_graph.hpp"
+#include "hydro/tiled/tile_bytes.hpp"
+#include "hydro/tiled/tiled_hydro.hpp"
+
+namespace terrapolis::hydro::tiled {
+
+inline constexpr std::uint32_t kVoid = 0xFFFFFFFFu, kOpen = 0xFFFFFFFEu;  // labels: nodata, not reached yet
+
+/// The cells of a tile within two of its edges (where neighbouring tiles look): filled values
+/// and global labels after the first pass.
+class Frame {
+ public:
+  Frame() = default;
+  /// The shape only, or with room for the values.
+  explicit Frame(const TileRect& r, bool with_values = true) : cols_(r.cols), rows_(r.rows) {
+    if (!with_values) return;
+    z.resize(size());
+    label.resize(size());
+  }
+  std::size_t size() const {
+    return whole() ? std::size_t(cols_) * std::size_t(rows_) : std::size_t(4) * (std::size_t(cols_) + std::size_t(rows_) - 4);
+  }
+  bool contains(int c, int r) const { return std::min({c, r, cols_ - 1 - c, rows_ - 1 - r}) < 2; }
+  std::size_t index(int c, int r) const {
+    if (whole()) return std::size_t(r) * std::size_t(cols_) + std::size_t(c);
+    if (r < 2) return std::size_t(r) * std::size_t(cols_) + std::size_t(c);
+    if (r >= rows_ - 2) return std::size_t(2 + r - (rows_ - 2)) * std::size_t(cols_) + std::size_t(c);
+    return std::size_t(4) * std::size_t(cols_) + std::size_t(r - 2) * 4 + std::size_t(c < 2 ? c : 2 + c - (cols_ - 2));
+  }
+  std::vector<float> z;
+  std::vector<std::uint32_t> label;  // global
+
+ private:
+  bool whole() const { return cols_ < 4 || rows_ < 4; }
+  int cols_ = 0, rows_ = 0;
+};
+
+/// One tile filled with its edges as outlets (Barnes 2016, first stage): every cell labelled
+/// with the seed that flooded it (0: a true outlet), and the lowest spill between labels.
+struct TileFill {
+  Dem z;                             // the tile's cells, filled
+  std::vector<std::uint32_t> label;  // local labels, kVoid on nodata
+  std::uint32_t labels = 1;          // local labels used (0 included)
+  std::vector<SpillEdge> edges;      // local labels
+};
+
+/// `window` is the tile with a halo of one cell (NaN outside the mosaic), so that a cell next to
+/// nodata in a neighbouring tile, or on the mosaic's border, is a true outlet as in the whole grid.
+TileFill fill_tile(const Dem& window, const std::optional<double>& sea_level);  // fill_pass.cpp
+
+/// A cell given to the global flat resolution: its filled value and first-pass D8 code, and
+/// whether it belongs to a flat that reaches beyond its tile.
+struct SharedCell {
+  float z;
+  std::uint8_t code;
+  bool member;
+};
+struct SharedEntry {
+  std::int64_t cell;  // mosaic index
+  SharedCell value;
+};
+
+/// A cell of the stream network, as a tile hands it on.
+struct StreamCell {
+  std::int64_t index;
+  double area_m2;
+  std::uint8_t code;
+};
+
+/// A flow path leaving a tile (Barnes 2017): the last cell in the tile, what it has gathered
+/// inside the tile, and the cell of the next tile it flows into.
+struct Link {
+  std::int64_t exit, target;
+  std::int64_t local;
+};
+
+/// The D8 codes of a tile kept on a scratch file between passes (tiled_run.cpp).
+void write_codes(const std::string& path, const Raster<std::uint8_t>& d8);
+void read_codes(const std::string& path, Raster<std::uint8_t>& d8);
+
+/// One run of the engine: the state its passes hand on to each other. Each pass works on the
+/// tiles this process owns, then exchange() gives every process what it learnt about every tile.
+class TiledRun {
+ public:
+  TiledRun(int cols, int rows, const Georef& georef, const ReadWindow& read, const TiledOptions& options, const TileSinks& sinks,
+           Progress& progress, TileDriver& driver);
+  ~TiledRun();
+  TiledRun(const TiledRun&) = delete;
+  TiledRun& operator=(const TiledRun&) = delete;
+
+  /// The passes in order (tiled_run.cpp).
+  TiledReport run();
+
+ private:
+  /// A pass over this process's tiles; its error, if any, for the driver to agree on.
+  template <class Body>
+  std::exception_ptr for_tiles(const char* what, Body&& body) {
+    try {
+      ProgressStep step(progress_, what);
+      std::atomic<int> done{0};
+      std::mutex m;
+      arena_.execute([&] {
+        tbb::parallel_for(0, int(own_.size()), 1, [&](int k) {
+          body(own_[std::size_t(k)], grid_.rect(own_[std::size_t(k)]));
+          const int d = ++done;
+          std::unique_lock lock(m, std::try_to_lock);
+          if (lock) step.update(double(d) / double(own_.size()));
+        });
+      });
+    } catch (...) {
+      return std::current_exception();
+    }
+    return nullptr;
+  }
+
+  /// After a pass: what it learnt about each tile, from the process that owns it, everywhere.
+  template <class PackFn, class UnpackFn>
+  void exchange(std::exception_ptr failure, PackFn&& pack, UnpackFn&& unpack) {
+    if (driver_.ranks() == 1) return driver_.check(failure);
+    std::vector<std::vector<char>> bytes(static_cast<std::size_t>(tiles_));
+    if (!failure)
+      for (int t : own_) pack(t, bytes[std::size_t(t)]);
+    driver_.share(bytes, failure);
+    for (int t = 0; t < tiles_; ++t)
+      if (!driver_.owns(t)) {
+        Unpack in(bytes[std::size_t(t)]);
+        unpack(t, in);
+        bytes[std::size_t(t)] = {};
+      }
+  }
+
+  Dem read_tile(const TileRect& r) const { return read_(r.col0 - 1, r.row0 - 1, r.cols + 2, r.rows + 2); }
+  std::string codes_path(int t) const { return (scratch_ / ("d8-" + std::to_string(t) + ".bin")).string(); }
+  bool off_mosaic(int gc, int gr) const { return gc < 0 || gr < 0 || gc >= cols_ || gr >= rows_; }
+  Raster<std::uint8_t> tile_codes(const TileRect& r) const {
+    return Raster<std::uint8_t>(r.cols, r.rows, shifted(georef_, r.col0, r.row0), kNoData);
+  }
+
+  /// Global labels: 0 for the true outlets, then each tile's edge seeds in tile order.
+  std::uint32_t global(int t, std::uint32_t l) const { return l == 0 || l == kVoid ? l : base_[std::size_t(t)] + l; }
+
+  /// Cells of a frame by mosaic coordinates.
+  void frame_cell(int gc, int gr, float& z, std::uint32_t& label) const {
+    const int u = grid_.tile_of(gc, gr);
+    const TileRect ru = grid_.rect(u);
+    const std::size_t j = frames_[std::size_t(u)].index(gc - ru.col0, gr - ru.row0);
+    z = frames_[std::size_t(u)].z[j];
+    label = frames_[std::size_t(u)].label[j];
+  }
+
+  float final_z(float z, std::uint32_t label) const {
+    return label == kVoid ? std::numeric_limits<float>::quiet_NaN() : label == 0 ? z : std::max(z, level_[label]);
+  }
+
+  // fill_pass.cpp: pass 1 and the spill graph (Barnes 2016).
+  void fill_tiles();
+  void solve_spill_graph();
+  void add_edges_across_tiles(std::vector<SpillEdge>& edges) const;
+
+  // direction_pass.cpp: pass 2, first-pass D8 and the flats inside each tile.
+  void direct_tiles();
+  void direct_tile(int t, const TileRect& r);
+  Dem with_halo(const TileRect& r, const Dem& filled) const;
+
+  // shared_flats.cpp: the flats that cross tile edges, drained whole.
+  /// The cells handed on by the tiles, by mosaic index, and the flats that cross tile edges among them.
+  struct SharedFlats {
+    std::unordered_map<std::int64_t, std::uint32_t> slot;
+    std::vector<std::int64_t> cell_of;
+    std::vector<SharedCell> cells;
+  };
+  std::int64_t neighbour(std::int64_t g, int k) const;
+  std::unordered_map<std::uint32_t, std::vector<std::uint32_t>> flat_groups(const SharedFlats& s) const;
+  void drain_shared_flats();
+  void drain_shared_flat(const SharedFlats& s, const std::vector<std::uint32_t>& members);
+
+  // accumulation_pass.cpp: pass 3, final directions, accumulation inside each tile, links (Barnes 2017).
+  std::vector<std::int64_t> own_units(const Raster<std::uint8_t>& d8, const TileRect& r) const;
+  std::int64_t crossing(int t, int gc, int gr, std::uint8_t k) const;
+  /// Where the D8 paths of tile t end, in row-major order: its outlets (a cell that keeps its water,
+  /// or flows off the mosaic or onto nodata: drainage_basins' outlets) and the cells that flow into
+  /// another tile (its links, with their targets).
+  struct PathEnds {
+    std::vector<std::uint32_t> outlets, exits;
+    std::vector<std::int64_t> targets;
+  };
+  PathEnds path_ends(int t, const TileRect& r, const Raster<std::uint8_t>& d8) const;
+  void accumulate_tiles();
+  void accumulate_tile(int t, const TileRect& r);
+
+  // link_graph.cpp: the links solved across tiles, the outlets numbered for the basins.
+  std::int32_t edge_exit_at(std::int64_t g, int& u) const;
+  std::uint32_t basin_of_outlet(int u, std::uint32_t j) const;
+  void solve_link_graph();
+  void number_outlets();
+  void label_links(const std::vector<Link>& all, const std::vector<std::int64_t>& next);
+
+  // final_accumulation.cpp: pass 4, the outputs; the stream cells gathered.
+  bool final_accumulation();
+  void finish_tile(int t, const TileRect& r);
+  void gather_streams();
+
+  const int cols_, rows_;
+  const Georef& georef_;
+  const ReadWindow& read_;
+  const TiledOptions& options_;
+  const TileSinks& sinks_;
+  Progress& progress_;
+  TileDriver& driver_;
+  TiledReport report_;
+  const TileGrid grid_;
+  const int tiles_;
+  const CellMetrics metrics_;
+  tbb::task_arena arena_;
+  const std::filesystem::path scratch_;
+  std::vector<int> own_;  // the tiles this process reads and writes
+  // Pass 1 and the spill graph.
+  std::vector<Frame> frames_;
+  std::vector<std::vector<SpillEdge>> tile_edges_;
+  std::vector<std::uint32_t> tile_labels_, base_;
+  std::vector<float> level_;
+  double frame_bytes_ = 0;
+  // Pass 2 and the shared flats: the cells handed on, then the codes of the flats solved whole.
+  std::vector<std::vector<SharedEntry>> shared_;
+  std::vector<std::vector<std::pair<std::uint32_t, std::uint8_t>>> patches_;
+  // Pass 3 and the link graph.
+  FixedPointUnits units_;
+  std::vector<std::vector<Link>> links_;
+  std::vector<std::vector<std::uint32_t>> outlet_rows_;  // outlets of each tile by row (the basins' numbering)
+  std::vector<std::vector<std::int32_t>> edge_exit_;     // for each edge cell of a tile (Frame order), the link its flow leaves by
+  std::vector<std::uint32_t> link_base_, link_basin_;
+  std::vector<std::uint64_t> before_row_;
+  std::vector<std::vector<std::uint32_t>> outlets_above_;
+  std::vector<std::vector<std::pair<std::uint32_t, std::int64_t>>> inflow_;
+  // Pass 4.
+  std::vector<std::vector<StreamCell>> stream_cells_;
+};
+
+}  // namespace terrapolis::hydro::tiled
