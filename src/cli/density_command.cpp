@@ -57,7 +57,8 @@ Raster<float> read_hydrometry(const std::string& path, const Georef& grid, int c
   return values;
 }
 
-Hydrometry obtain_hydrometry(const Dem& dem, const density::DensityOptions& options, const std::string& path, Progress& progress) {
+Hydrometry obtain_hydrometry(const Dem& dem, const pipeline::Scenario& scenario, const density::DensityOptions& options, const std::string& path,
+                             Progress& progress) {
   Hydrometry h;
   h.used = hydrometry_used(options);
   if (!path.empty()) {
@@ -68,8 +69,9 @@ Hydrometry obtain_hydrometry(const Dem& dem, const density::DensityOptions& opti
     h.values = dem.like<float>(0.0f);
     return h;
   }
-  // Belhadj's hydrometry (thesis Alg. 12) with the sea as outlet, as `terrapolis hydro --sea-level` does.
-  hydro::HydrometryOptions hydrometry;
+  // The hydro stage's hydrometry (the scenario's hydro section: Belhadj's Alg. 12 by default) with
+  // the sea as outlet, as a run and `terrapolis hydro --sea-level` compute it.
+  hydro::HydrometryOptions hydrometry = pipeline::hydro_options(scenario).hydrometry;
   hydrometry.sea_level = options.sea_level_m;
   h.values = hydro::compute_hydrometry(dem, hydrometry, progress);
   return h;
@@ -120,7 +122,7 @@ class DensityCommand final : public Command {
     const plugin::PluginSet plugins = plugins_.load(context.log);
     const Dem dem = dem_.read();
     pipeline::read_density_files(scenario, dem, scenario.path("/water/water_mask"), options);
-    const Hydrometry hydrometry = obtain_hydrometry(dem, options, hydrometry_path_, context.progress);
+    const Hydrometry hydrometry = obtain_hydrometry(dem, scenario, options, hydrometry_path_, context.progress);
     plugin::add_to_density(plugin::density_factors(plugins, dem, context.progress, context.log), options);
     const auto t1 = clock::now();
     const std::clock_t cpu1 = std::clock();  // processor time of all threads

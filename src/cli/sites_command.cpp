@@ -20,21 +20,12 @@
 #include "pipeline/density_folder.hpp"
 #include "pipeline/places.hpp"
 #include "pipeline/stage_options.hpp"
+#include "pipeline/stages.hpp"
 #include "sites/layers.hpp"
 #include "sites/sites.hpp"
 
 namespace terrapolis::cli {
 namespace {
-
-/// A DEM instead of a density folder: the density model with its defaults (hydrometry by
-/// Belhadj's method, the sea at 0 m as outlet and water), as `terrapolis density` writes it.
-pipeline::DensityFolder density_from_dem(const Dem& dem, Progress& progress) {
-  const density::DensityOptions options;
-  hydro::HydrometryOptions hydrometry;
-  hydrometry.sea_level = options.sea_level_m;
-  density::DensityResult model = density::compute_density(dem, hydro::compute_hydrometry(dem, hydrometry, progress), options, progress);
-  return {std::move(model.density), std::move(model.buildable)};
-}
 
 class SitesCommand final : public Command {
  public:
@@ -44,7 +35,7 @@ class SitesCommand final : public Command {
   void setup(CLI::App& app) override {
     file_kind(app.add_option("DENSITY_DIR_OR_DEM", dir_,
                    "Folder holding density.tif (float, [0,1]) and buildable.tif (1 = buildable) on the DEM grid, or a DEM "
-                   "(the density model is then computed with its defaults)")
+                   "(the density is then computed as a run's hydro and density stages do, with the scenario's defaults)")
         ->required(), FileKind::folder_in);
     dem_.add_read_options(app, "of a DEM");
     file_kind(app.add_option("OUTDIR", out_, "Output folder: cities.geojson, city_extents.geojson")->required(), FileKind::folder_out);
@@ -62,7 +53,7 @@ class SitesCommand final : public Command {
     const auto t0 = std::chrono::steady_clock::now();
     const bool dem = std::filesystem::is_regular_file(dir_);
     if (!dem && dem_.given()) throw bad_input("--band, --assume-crs: only for a DEM, and " + dir_ + " is a density folder");
-    const pipeline::DensityFolder in = dem ? density_from_dem(dem_.read(dir_), context.progress) : pipeline::read_density_folder(dir_);
+    const pipeline::DensityFolder in = dem ? run_density(scenario, dem_.read(dir_), options, context) : pipeline::read_density_folder(dir_);
     pipeline::ExistingPlaces existing;
     if (!existing_file.empty()) {
       existing = pipeline::read_existing_places(existing_file, in.buildable);
@@ -117,6 +108,20 @@ class SitesCommand final : public Command {
   }
 
  private:
+  /// A DEM instead of a density folder: the density the run's hydro and density stages compute,
+  /// with the scenario's settings, and the land it finds for the default population (as a run).
+  pipeline::DensityFolder run_density(const pipeline::Scenario& scenario, const Dem& dem, sites::SitesOptions& options, Context& context) const {
+    pipeline::StageSettings settings;
+    for (const char* stage : {"hydro", "density"})
+      schema_.settings([&] {
+        pipeline::stage(stage).prepare(scenario, dem, settings);
+        return 0;
+      });
+    density::DensityResult model = pipeline::run_density(scenario, settings, dem, context.progress, context.log);
+    options.land_area_km2 = pipeline::land_area_figure(model.stats);
+    return {std::move(model.density), std::move(model.buildable)};
+  }
+
   std::string dir_, out_;
   DemInput dem_;  // --band and --assume-crs when DENSITY_DIR_OR_DEM is a DEM
   SchemaOptions schema_;

@@ -10,6 +10,7 @@
 #include "core/error.hpp"
 #include "core/geodesy.hpp"
 #include "density/tiled_density.hpp"
+#include "io/mask_io.hpp"
 #include "io/raster_io.hpp"
 #include "network/layers.hpp"
 #include "pipeline/density_folder.hpp"
@@ -145,13 +146,20 @@ void hydro_summary(const json& figures, SummaryText& out) {
 
 // ---- density (Belhadj 2007 §4.2; docs/density.md) -----------------------------------------
 
-/// The density model's inputs in a run: the settings, the scenario's layers and exclusions, and
-/// the hydro stage's inland water (which holds water.water_mask).
-density::DensityOptions density_inputs(const RunState& s) {
-  density::DensityOptions options = s.settings.density;
-  read_density_files(s.scenario, s.dem, saved(s, kInlandWater), options);
-  if (s.rivers) options.rivers = *s.rivers;
+/// The density model's inputs: the settings, the scenario's layers and exclusions, the hydro
+/// stage's inland water (which holds water.water_mask) and its rivers.
+density::DensityOptions density_inputs(const Scenario& scenario, const Settings& settings, const Dem& dem, Raster<std::uint8_t> water,
+                                       const std::optional<Raster<std::uint8_t>>& rivers) {
+  density::DensityOptions options = settings.density;
+  read_density_files(scenario, dem, "", options);
+  options.water_mask = std::move(water);
+  if (rivers) options.rivers = *rivers;
   return options;
+}
+
+/// The same in a run, the inland water read back from the hydro stage's inland_water.tif.
+density::DensityOptions density_inputs(const RunState& s) {
+  return density_inputs(s.scenario, s.settings, s.dem, read_mask(saved(s, kInlandWater), s.dem.georef(), s.dem.cols(), s.dem.rows()), s.rivers);
 }
 
 void density_run(RunState& s, Progress& progress, const Log& log) {
@@ -168,7 +176,7 @@ void density_run(RunState& s, Progress& progress, const Log& log) {
   s.summary["density"] = {{"buildable_land_share", land ? round_to(double(st.buildable_cells) / double(land), 1e-4) : 0.0},
                           {"water_share", st.known_cells ? round_to(double(st.water_cells) / double(st.known_cells), 1e-4) : 0.0},
                           {"mean_density", round_to(st.mean_density, 1e-4)},
-                          {"land_area_km2", round_to(st.land_area_km2, 0.01)},
+                          {"land_area_km2", land_area_figure(st)},
                           {"preset", s.scenario.resolved["density"]["preset"]}};
   s.density = std::move(r.density);
   s.buildable = std::move(r.buildable);
@@ -661,6 +669,22 @@ void access_summary(const json& figures, SummaryText& out) {
 }
 
 }  // namespace
+
+double land_area_figure(const density::DensityStats& stats) { return round_to(stats.land_area_km2, 0.01); }
+
+density::DensityResult run_density(const Scenario& scenario, const StageSettings& settings, const Dem& dem, Progress& progress,
+                                   const Log& log) {
+  const hydro::HydroResult h = hydro::run_hydro(dem, settings.hydro, progress);
+  const density::DensityOptions options =
+      density_inputs(scenario, settings, dem, inland_water(dem, settings.water, progress, log).mask, river_cells(h.accumulation, scenario));
+  return density::compute_density(dem, h.hydrometry, options, progress);
+}
+
+const StageDef& stage(const std::string& name) {
+  for (const StageDef& s : stages())
+    if (name == s.name) return s;
+  throw std::out_of_range("no stage " + name);
+}
 
 const std::vector<StageDef>& stages() {
   static const std::vector<StageDef> list = {

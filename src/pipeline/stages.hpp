@@ -49,5 +49,15 @@ struct StageDef {
 
 /// The stages, in data-flow order: the one list the runner, --help and the docs read.
 const std::vector<StageDef>& stages();
+/// A stage by name (an unknown name is a programming error: std::out_of_range).
+const StageDef& stage(const std::string& name);
+
+/// The density the hydro and density stages of a run compute on `dem` (the same hydrometry,
+/// inland water, rivers and model), in memory: for a command given a DEM where a run has its
+/// density stage (`terrapolis sites DEM`). `settings` holds those two stages' prepared settings.
+density::DensityResult run_density(const Scenario& scenario, const StageSettings& settings, const Dem& dem, Progress& progress,
+                                   const Log& log);
+/// The land area of the density (km2) as the run's summary records it and the sites stage reads it.
+double land_area_figure(const density::DensityStats& stats);
 
 }  // namespace terrapolis::pipeline
