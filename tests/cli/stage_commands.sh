@@ -1,6 +1,7 @@
-# A command given a DEM where a run has earlier stages computes what those stages compute (one
-# stage object, docs/architecture.md): `terrapolis sites DEM` places the settlements of
-# `terrapolis run --until sites` on the same DEM and settings, byte for byte.
+# A command computes what the run's stage computes (one stage object, docs/architecture.md):
+# `terrapolis sites DEM` places the settlements of `terrapolis run --until sites` on the same DEM
+# and settings, byte for byte; `terrapolis roads` on a run's network and cities routes its roads,
+# byte for byte; `terrapolis access` on its cities and roads gives its travel times, cell for cell.
 source "$(dirname "$0")/lib.sh" "$@"
 cd "$WORK"
 
@@ -21,4 +22,19 @@ same_sites "$SAMPLES/gebco2022_15s_north_corsica_capcorse.asc"
 same_sites "$SAMPLES/terra_elev_luxembourg.tif"
 same_sites "$SAMPLES/gebco2022_15s_north_corsica_capcorse.asc" --seed 7 --population 150000 -- \
   --set seed=7 --set sites.population=150000
+
+dem=$SAMPLES/gebco2022_15s_north_corsica_capcorse.asc
+rm -rf run
+"$TP" --progress none --quiet run -o run --set "dem=\"$dem\"" 2> /dev/null
+"$TP" --progress none --quiet roads "$dem" run/network.geojson roads --cities run/cities.geojson
+for f in roads.geojson sections.geojson road_sections.geojson junctions.geojson; do
+  cmp -s run/$f roads/$f || fail "roads: the command and the run differ in $f"
+done
+"$TP" --progress none --quiet access "$dem" access --to run/cities.geojson --roads run/roads.geojson 2> /dev/null
+for f in access_minutes.tif access_nearest.tif; do  # the pixels (the metadata record each its own provenance)
+  /usr/bin/python3 -c "
+import sys; from osgeo import gdal; import numpy as np
+a, b = (gdal.Open(p).ReadAsArray() for p in sys.argv[1:])
+sys.exit(0 if a.shape == b.shape and np.array_equal(a, b, equal_nan=True) else 1)" run/$f access/$f || fail "access: the command and the run differ in $f"
+done
 echo "stage_commands: ok"
