@@ -20,7 +20,8 @@
 #include "core/text.hpp"
 #include "density/density.hpp"
 #include "density/tiled_density.hpp"
-#include "hydro/hydrometry.hpp"
+#include "hydro/hydro.hpp"
+#include "pipeline/inland_water.hpp"
 #include "io/output_set.hpp"
 #include "io/mask_io.hpp"
 #include "io/raster_io.hpp"
@@ -36,7 +37,7 @@ namespace fs = std::filesystem;
 /// The hydrometry the density model uses, on the DEM's grid, and whether it is worth writing.
 /// This is the ONE place that decides where hydrometry comes from: a file given with --hydrometry
 /// (resampled bilinearly to the DEM's grid), nothing when neither its weight nor a river-bed cap
-/// needs it (all zeros, not written), otherwise Belhadj's hydrometry computed from the DEM.
+/// needs it (all zeros, not written), otherwise the hydro stage's, computed from the DEM.
 struct Hydrometry {
   Raster<float> values;
   bool used = false;
@@ -57,23 +58,30 @@ Raster<float> read_hydrometry(const std::string& path, const Georef& grid, int c
   return values;
 }
 
-Hydrometry obtain_hydrometry(const Dem& dem, const pipeline::Scenario& scenario, const density::DensityOptions& options, const std::string& path,
-                             Progress& progress) {
+bool rivers_used(const density::DensityOptions& options) {
+  return options.terrain_weights[std::size_t(density::TerrainTerm::river_near)] != 0 || options.model;
+}
+
+/// What the run's hydro stage gives its density stage, computed here from the DEM: the inland
+/// water (the lakes the DEM flattens, water.water_mask, the reservoirs) as the water mask, the
+/// rivers when river_near is used, and the hydrometry (unless --hydrometry gives it or nothing
+/// uses it), with the scenario's hydro section, as `terrapolis run` does.
+Hydrometry hydro_inputs(const Dem& dem, const pipeline::Scenario& scenario, density::DensityOptions& options, const std::string& path,
+                        Progress& progress, const Log& log) {
+  options.water_mask = pipeline::inland_water(dem, pipeline::inland_water_settings(scenario), progress, log).mask;
   Hydrometry h;
   h.used = hydrometry_used(options);
-  if (!path.empty()) {
-    h.values = read_hydrometry(path, dem.georef(), dem.cols(), dem.rows());
-    return h;
+  const bool compute = h.used && path.empty();
+  if (compute || rivers_used(options)) {
+    hydro::HydroOptions hydro = pipeline::hydro_options(scenario);
+    hydro.with_streams = false;
+    hydro.with_hydrometry = compute;
+    hydro::HydroResult r = hydro::run_hydro(dem, hydro, progress);
+    if (rivers_used(options)) options.rivers = pipeline::river_cells(r.accumulation, scenario);
+    if (compute) h.values = std::move(r.hydrometry);
   }
-  if (!h.used) {
-    h.values = dem.like<float>(0.0f);
-    return h;
-  }
-  // The hydro stage's hydrometry (the scenario's hydro section: Belhadj's Alg. 12 by default) with
-  // the sea as outlet, as a run and `terrapolis hydro --sea-level` compute it.
-  hydro::HydrometryOptions hydrometry = pipeline::hydro_options(scenario).hydrometry;
-  hydrometry.sea_level = options.sea_level_m;
-  h.values = hydro::compute_hydrometry(dem, hydrometry, progress);
+  if (!path.empty()) h.values = read_hydrometry(path, dem.georef(), dem.cols(), dem.rows());
+  else if (!compute) h.values = dem.like<float>(0.0f);
   return h;
 }
 
@@ -121,8 +129,8 @@ class DensityCommand final : public Command {
     const auto t0 = clock::now();
     const plugin::PluginSet plugins = plugins_.load(context.log);
     const Dem dem = dem_.read();
-    pipeline::read_density_files(scenario, dem, scenario.path("/water/water_mask"), options);
-    const Hydrometry hydrometry = obtain_hydrometry(dem, scenario, options, hydrometry_path_, context.progress);
+    pipeline::read_density_files(scenario, dem, "", options);
+    const Hydrometry hydrometry = hydro_inputs(dem, scenario, options, hydrometry_path_, context.progress, context.log);
     plugin::add_to_density(plugin::density_factors(plugins, dem, context.progress, context.log), options);
     const auto t1 = clock::now();
     const std::clock_t cpu1 = std::clock();  // processor time of all threads

@@ -1,7 +1,9 @@
 # A command computes what the run's stage computes (one stage object, docs/architecture.md):
 # `terrapolis sites DEM` places the settlements of `terrapolis run --until sites` on the same DEM
 # and settings, byte for byte; `terrapolis roads` on a run's network and cities routes its roads,
-# byte for byte; `terrapolis access` on its cities and roads gives its travel times, cell for cell.
+# byte for byte; `terrapolis access` on its cities and roads gives its travel times, cell for cell;
+# `terrapolis density DEM` (the thesis's weights by default) gives the density stage's rasters of a
+# run with those weights, cell for cell (inland water and hydrometry from the same functions).
 source "$(dirname "$0")/lib.sh" "$@"
 cd "$WORK"
 
@@ -31,10 +33,21 @@ for f in roads.geojson sections.geojson road_sections.geojson junctions.geojson;
   cmp -s run/$f roads/$f || fail "roads: the command and the run differ in $f"
 done
 "$TP" --progress none --quiet access "$dem" access --to run/cities.geojson --roads run/roads.geojson 2> /dev/null
-for f in access_minutes.tif access_nearest.tif; do  # the pixels (the metadata record each its own provenance)
+same_pixels() {  # A B: the same values (the metadata record each its own provenance)
   /usr/bin/python3 -c "
 import sys; from osgeo import gdal; import numpy as np
 a, b = (gdal.Open(p).ReadAsArray() for p in sys.argv[1:])
-sys.exit(0 if a.shape == b.shape and np.array_equal(a, b, equal_nan=True) else 1)" run/$f access/$f || fail "access: the command and the run differ in $f"
+sys.exit(0 if a.shape == b.shape and np.array_equal(a, b, equal_nan=True) else 1)" "$1" "$2"
+}
+for f in access_minutes.tif access_nearest.tif; do
+  same_pixels run/$f access/$f || fail "access: the command and the run differ in $f"
+done
+for dem in "$SAMPLES/gebco2022_15s_north_corsica_capcorse.asc" "$SAMPLES/terra_elev_luxembourg.tif"; do
+  rm -rf run density
+  "$TP" --progress none --quiet run -o run --until density --set "dem=\"$dem\"" --set 'density.preset="belhadj2007"' 2> /dev/null
+  "$TP" --progress none --quiet density "$dem" density
+  for f in density buildable coast plateau plain hydrometry; do
+    same_pixels run/$f.tif density/$f.tif || fail "density $(basename "$dem"): the command and the run differ in $f.tif"
+  done
 done
 echo "stage_commands: ok"
