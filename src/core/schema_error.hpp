@@ -2,7 +2,10 @@
 // failing field and every object enclosing it; the deepest report is the specific one.
 // SPDX-License-Identifier: MIT
 #pragma once
+#include <nlohmann/json.hpp>
 #include <valijson/validation_results.hpp>
+
+#include <algorithm>
 
 #include <string>
 #include <string_view>
@@ -12,9 +15,59 @@
 
 namespace terrapolis {
 
+/// valijson's description of a problem in a user's words: "Expected number less than or equal to
+/// 100.000000" is "must be <= 100"; a type or choice the schema refuses says so.
+inline std::string plain_problem(const std::string& description) {
+  static const std::pair<std::string_view, std::string_view> bounds[] = {{"Expected number less than or equal to ", "must be <= "},
+                                                                         {"Expected number greater than or equal to ", "must be >= "},
+                                                                         {"Expected number less than ", "must be < "},
+                                                                         {"Expected number greater than ", "must be > "}};
+  for (const auto& [said, meant] : bounds)
+    if (description.starts_with(said)) {
+      std::string number = description.substr(said.size());
+      if (number.find('.') != std::string::npos) {  // std::to_string's six decimals, trailing zeros dropped
+        number.erase(number.find_last_not_of('0') + 1);
+        if (number.back() == '.') number.pop_back();
+      }
+      return std::string(meant) + number;
+    }
+  if (description == "Value type not permitted by 'type' constraint.") return "wrong type (see the schema)";
+  if (description == "Failed to match against any enum values.") return "not one of the allowed values (see --help or the schema)";
+  return description;
+}
+
+/// The choices (`enum`) the schema gives the value at `pointer` ("" when it gives none): the schema
+/// walked along the pointer's keys (properties, array items, local "#/definitions/..." references).
+inline std::string schema_choices(const nlohmann::json& schema, const std::string& pointer) {
+  const nlohmann::json* node = &schema;
+  auto resolve = [&] {
+    while (node->is_object() && node->contains("$ref") && (*node)["$ref"].is_string()) {
+      const std::string ref = (*node)["$ref"].get<std::string>();
+      if (!ref.starts_with("#/")) return;
+      node = &schema.at(nlohmann::json::json_pointer(ref.substr(1)));
+    }
+  };
+  std::size_t at = 1;
+  while (at <= pointer.size() && pointer != "/") {
+    const std::size_t next = std::min(pointer.find('/', at), pointer.size());
+    const std::string key = pointer.substr(at, next - at);
+    resolve();
+    if (node->contains("properties") && (*node)["properties"].contains(key)) node = &(*node)["properties"][key];
+    else if (node->contains("items") && (*node)["items"].is_object()) node = &(*node)["items"];
+    else return "";
+    at = next + 1;
+  }
+  resolve();
+  if (!node->is_object() || !node->contains("enum")) return "";
+  std::string choices;
+  for (const auto& c : (*node)["enum"]) choices += (choices.empty() ? "" : ", ") + (c.is_string() ? c.get<std::string>() : c.dump());
+  return choices;
+}
+
 /// The JSON pointer ("/density/r_max_m", "/" for the root) and the problem of the most specific
-/// error. A key the schema does not declare is named by its own pointer: "/road/slope", "unknown key".
-inline std::pair<std::string, std::string> schema_error(const valijson::ValidationResults& results) {
+/// error. A key the schema does not declare is named by its own pointer: "/road/slope", "unknown key";
+/// a value outside the schema's choices lists them when `schema` is given.
+inline std::pair<std::string, std::string> schema_error(const valijson::ValidationResults& results, const nlohmann::json* schema = nullptr) {
   valijson::ValidationResults::Error best;
   for (const auto& e : results)
     if (e.context.size() > best.context.size()) best = e;
@@ -24,7 +77,9 @@ inline std::pair<std::string, std::string> schema_error(const valijson::Validati
     const std::string key = best.description.substr(kUndeclared.size(), best.description.size() - kUndeclared.size() - 2);
     return {(pointer == "/" ? "" : pointer) + "/" + key, "unknown key"};
   }
-  return {pointer, best.description};
+  if (const std::string choices = schema ? schema_choices(*schema, pointer) : ""; !choices.empty())
+    return {pointer, "must be one of " + choices};
+  return {pointer, plain_problem(best.description)};
 }
 
 }  // namespace terrapolis

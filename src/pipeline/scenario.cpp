@@ -111,7 +111,7 @@ std::string validate_scenario(const json& scenario) {
   valijson::ValidationResults results;
   valijson::adapters::NlohmannJsonAdapter target(doc);
   if (validator.validate(schema, target, &results)) return "";
-  const auto [pointer, problem] = schema_error(results);
+  const auto [pointer, problem] = schema_error(results, &schema_doc);
   return pointer + ": " + problem;
 }
 

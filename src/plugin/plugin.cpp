@@ -275,7 +275,7 @@ void validate_params(const LoadedPlugin& plugin, const json& params) {
   valijson::ValidationResults results;
   valijson::adapters::NlohmannJsonAdapter target(params);
   if (validator.validate(schema, target, &results)) return;
-  const auto [pointer, problem] = schema_error(results);
+  const auto [pointer, problem] = schema_error(results, &plugin.module->schema);
   throw bad_input(where(plugin) + ": params" + (pointer == "/" ? "" : pointer) + ": " + problem);
 }
 

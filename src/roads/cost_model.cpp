@@ -122,7 +122,7 @@ void validate(const json& doc, const std::string& origin, bool transfer_only) {
   valijson::ValidationResults results;
   valijson::adapters::NlohmannJsonAdapter target(doc);
   if (validator.validate((transfer_only ? transfer : whole).schema, target, &results)) return;
-  const auto [pointer, problem] = schema_error(results);
+  const auto [pointer, problem] = schema_error(results, transfer_only ? nullptr : &whole.document);
   throw bad_input(origin + ": " + pointer + ": " + problem);
 }
 

@@ -67,7 +67,7 @@ EOF
 # Refusals: exit 2, nothing written.
 expect_refused "$work/none" "needs the streams output" "$bin" -q hydro "$samples/spDataLarge_srtm_zion.tif" "$work/none" \
   --classify --outputs filled
-expect_refused "$work/none" "--braided-discharge: Expected number greater than 0" "$bin" -q hydro "$samples/spDataLarge_srtm_zion.tif" "$work/none" \
+expect_refused "$work/none" "--braided-discharge: must be > 0" "$bin" -q hydro "$samples/spDataLarge_srtm_zion.tif" "$work/none" \
   --classify --braided-discharge 0
 # An existing streams.qml is refused like the other outputs.
 expect_fail 2 "exists" "$bin" -q hydro "$samples/gebco2022_15s_north_corsica_capcorse.asc" "$work/corsica" --sea-level 0 \

@@ -4,7 +4,9 @@ cd "$WORK"
 DEM=$SAMPLES/gebco2022_15s_north_corsica_capcorse.asc
 # cities.geojson of the thesis's quotas and weights on the bundled DEM, seed 1, as of commit f437b48.
 PINNED=43f74baa6e097951aaec6a21b7551f6e79e01ce9e7a5837748c3cbc26136780a
-"$TP" --quiet sites "$DEM" thesis --quotas belhadj2007 > /dev/null
+# The commands: `density` (the thesis's weights by default), then `sites` on its folder.
+"$TP" --quiet density "$DEM" thesis_density
+"$TP" --quiet sites thesis_density thesis --quotas belhadj2007 > /dev/null
 [[ $(sha256sum < thesis/cities.geojson | cut -d' ' -f1) == "$PINNED" ]] || fail "sites: the thesis's cities changed"
 echo "settlements: ok"
 
