@@ -34,6 +34,17 @@ double round_to(double v, double step) { return std::round(v / step) * step; }
 
 std::string saved(const RunState& s, const std::string& name) { return (s.folder / name).string(); }
 
+/// Runs a check of the file a setting names, its errors prefixed by the setting's pointer (they
+/// name the file, which may itself start with '/').
+template <class Check>
+void named(const std::string& pointer, Check&& check) {
+  try {
+    check();
+  } catch (const Error& e) {
+    throw Error(e.kind(), pointer + ": " + e.what());
+  }
+}
+
 // ---- terrain -------------------------------------------------------------------------------
 
 void terrain_run(RunState& s, Progress&, const Log&) {
@@ -342,11 +353,7 @@ void sites_prepare(const Scenario& scenario, const Dem& dem, Settings& s) {
   if (const std::string existing = scenario.path("/sites/existing"); !existing.empty()) {
     check_file("/sites/existing", existing);
     // Its format and figures now (whether each place finds land needs the density).
-    try {
-      check_existing_places(existing, dem.georef().crs);
-    } catch (const Error& e) {
-      throw Error(e.kind(), "/sites/existing: " + std::string(e.what()));
-    }
+    named("/sites/existing", [&] { check_existing_places(existing, dem.georef().crs); });
   }
 }
 
@@ -559,11 +566,7 @@ void roads_prepare(const Scenario& scenario, const Dem& dem, Settings& s) {
   if (const std::string& lines = s.roads.existing; !lines.empty()) {
     check_file("/roads/existing", lines);
     // Its CRS and geometry now (which roads lie on the DEM needs its grid).
-    try {
-      roads::check_existing_roads(lines, dem.georef().crs);
-    } catch (const Error& e) {
-      throw Error(e.kind(), "/roads/existing: " + std::string(e.what()));
-    }
+    named("/roads/existing", [&] { roads::check_existing_roads(lines, dem.georef().crs); });
   }
 }
 
