@@ -30,6 +30,7 @@ std::vector<std::unique_ptr<Command>> all_commands() {
   commands.push_back(make_reconstruct_command());
   commands.push_back(make_skeleton_command());
   commands.push_back(make_generate_command());
+  commands.push_back(make_erode_command());
   commands.push_back(make_run_command());
   commands.push_back(make_compare_command());
   return commands;

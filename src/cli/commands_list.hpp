@@ -21,6 +21,7 @@ std::unique_ptr<Command> make_network_command();
 std::unique_ptr<Command> make_path_command();
 std::unique_ptr<Command> make_roads_command();
 std::unique_ptr<Command> make_fill_command();
+std::unique_ptr<Command> make_erode_command();
 std::unique_ptr<Command> make_reconstruct_command();
 std::unique_ptr<Command> make_generate_command();
 std::unique_ptr<Command> make_calibrate_command();

@@ -200,6 +200,24 @@ Raster<std::uint8_t> river_cells(const Raster<double>& accumulation_m2, const Sc
   return rivers;
 }
 
+erode::ErodeOptions erode_options(const Scenario& scenario) {
+  const json& e = scenario.resolved["erode"];
+  erode::ErodeOptions o;
+  const std::string process = e["process"].get<std::string>();
+  o.process = process == "hydraulic" ? erode::Process::hydraulic : process == "thermal" ? erode::Process::thermal : erode::Process::both;
+  o.iterations = e["iterations"].get<int>();
+  o.hydraulic.rain_m = e["rain_m"].get<double>();
+  o.hydraulic.capacity_s = e["capacity_s"].get<double>();
+  o.hydraulic.dissolve = e["dissolve"].get<double>();
+  o.hydraulic.deposit = e["deposit"].get<double>();
+  o.hydraulic.evaporation = e["evaporation"].get<double>();
+  o.hydraulic.dt_s = e["dt_s"].get<double>();
+  const double angle = e["angle_deg"].get<double>();
+  o.thermal.angle_deg = angle > 0 ? angle : erode::material_angle_deg(e["material"].get<std::string>());
+  erode::check_settings(o);
+  return o;
+}
+
 skeleton::SkeletonOptions skeleton_options(const Scenario& scenario) {
   const json& k = scenario.resolved["skeleton"];
   skeleton::SkeletonOptions o;

@@ -8,6 +8,7 @@
 #include "access/access.hpp"
 #include "core/error.hpp"
 #include "density/density.hpp"
+#include "erode/erosion.hpp"
 #include "hydro/hydro.hpp"
 #include "hydro/river_types.hpp"
 #include "lake/lake.hpp"
@@ -43,6 +44,9 @@ std::optional<hydro::RiverTypeOptions> river_type_options(const Scenario& scenar
 std::vector<lake::LakeSpec> reservoir_specs(const Scenario& scenario);
 /// The skeleton section (terrapolis skeleton, docs/skeleton.md).
 skeleton::SkeletonOptions skeleton_options(const Scenario& scenario);
+/// The erode section (terrapolis erode, docs/erode.md): the angle of repose from erode.angle_deg, or
+/// else erode.material; the files it names (erode.mask, erode.angles) are read by the caller.
+erode::ErodeOptions erode_options(const Scenario& scenario);
 /// Code convention of flowdir.tif.
 hydro::D8Codes d8_codes(const Scenario& scenario);
 /// The density section, with the water section (its files are read by read_density_files).

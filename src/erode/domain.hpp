@@ -1,0 +1,85 @@
+// The state both erosions share: heights in double, which cells may change, cell sizes (internal).
+// SPDX-License-Identifier: MIT
+#pragma once
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <array>
+#include <cstdint>
+#include <numeric>
+#include <vector>
+
+#include "core/geodesy.hpp"
+#include "core/neighbours.hpp"
+#include "erode/erosion.hpp"
+
+namespace terrapolis::erode {
+
+/// Heights (m) and the domain: cells with data inside the mask. Cells outside the domain never
+/// change; the processes treat them as outside the grid.
+struct Domain {
+  int cols = 0, rows = 0;
+  std::vector<double> height;      ///< m, NaN outside the data
+  std::vector<std::uint8_t> in;    ///< 1: may change
+  const CellMetrics* metrics = nullptr;
+
+  std::size_t index(int c, int r) const { return std::size_t(r) * std::size_t(cols) + std::size_t(c); }
+  /// Neighbour k of (c, r) when it is inside the domain.
+  bool inside(int c, int r, int k) const {
+    const int cc = c + dcol[k], rr = r + drow[k];
+    return cc >= 0 && rr >= 0 && cc < cols && rr < rows && in[index(cc, rr)];
+  }
+};
+
+/// Runs body(r) for every row in parallel; the row's figures go to per_row[r] and are summed in
+/// row order, so the total does not depend on the threads.
+template <class Body>
+double rows_sum(int rows, Body&& body) {
+  std::vector<double> per_row(std::size_t(rows), 0.0);
+  tbb::parallel_for(tbb::blocked_range<int>(0, rows), [&](const tbb::blocked_range<int>& range) {
+    for (int r = range.begin(); r < range.end(); ++r) per_row[std::size_t(r)] = body(r);
+  });
+  return std::accumulate(per_row.begin(), per_row.end(), 0.0);
+}
+
+/// Virtual-pipe hydraulic erosion (Mei, Decaudin & Hu 2007) on a Domain, one iteration per step().
+class Hydraulic {
+ public:
+  Hydraulic(Domain& domain, const HydraulicOptions& options);
+  /// One iteration: rain, pipe fluxes, water, velocity, transport, dissolution/deposition, evaporation.
+  void step();
+  /// Deposits the sediment still in suspension where it is (the end of the run).
+  void settle();
+  double sediment_out_m3 = 0;  ///< sediment that left the domain with the water, m³
+  double water_out_m3 = 0;     ///< water that left the domain, m³
+
+ private:
+  double fluxes(int r);     // pass 1 of a row: rain, outflow per pipe scaled to the water, slope
+  double transport(int r);  // pass 2 of a row: water, velocity, sediment, erosion, evaporation
+  double sediment_in(int c, int r) const;  // m³ arriving from the neighbours' pipes
+
+  Domain& d_;
+  HydraulicOptions o_;
+  std::vector<double> water_, rained_, sediment_, sediment_next_, sin_slope_;
+  std::vector<std::array<double, 4>> flux_;  ///< outflow per pipe (east, south, west, north), m³/s
+  std::vector<double> water_out_row_;
+};
+
+/// Thermal erosion to the angle of repose (Musgrave, Kolb & Mace 1989; Peytavie 2010 §2.3.4).
+class Thermal {
+ public:
+  Thermal(Domain& domain, const ThermalOptions& options);
+  /// One iteration; returns the volume moved, m³ (0: stable).
+  double step();
+
+ private:
+  double outflows(int r);  // pass 1 of a row: the volume each cell sends to each lower neighbour
+  void gather(int r);      // pass 2 of a row: heights from what left and what arrived
+
+  Domain& d_;
+  double rate_;
+  std::vector<double> tan_, next_;
+  std::vector<std::array<double, 8>> out_;  ///< m³ sent to neighbour k (neighbours.hpp order)
+};
+
+}  // namespace terrapolis::erode

@@ -1,0 +1,105 @@
+// The erosion run: the domain, the iterations of each process, and what they moved.
+// SPDX-License-Identifier: MIT
+#include "erode/erosion.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <optional>
+
+#include "core/error.hpp"
+#include "erode/domain.hpp"
+
+namespace terrapolis::erode {
+
+double material_angle_deg(const std::string& material) {
+  // Peytavie 2010, Tab. 2.3 (dry, homogeneous materials): the middle of each range.
+  if (material == "sand") return 32.5;    // 30-35
+  if (material == "stones") return 42.5;  // 40-45
+  if (material == "earth") return 32.5;   // 25-40
+  if (material == "snow") return 60.0;    // 40-80
+  throw bad_input("/erode/material: unknown material '" + material + "' (sand, stones, earth, snow)");
+}
+
+void check_settings(const ErodeOptions& o) {
+  if (o.iterations < 0) throw bad_input("/erode/iterations: must be >= 0");
+  const HydraulicOptions& h = o.hydraulic;
+  if (!(h.rain_m > 0) || !(h.dt_s > 0) || !(h.capacity_s >= 0)) throw bad_input("/erode: rain, dt and capacity must be > 0");
+  if (!(h.dissolve >= 0 && h.dissolve <= 1) || !(h.deposit >= 0 && h.deposit <= 1) || !(h.evaporation >= 0 && h.evaporation < 1))
+    throw bad_input("/erode: dissolve and deposit must lie in [0, 1], evaporation in [0, 1)");
+  if (!(o.thermal.angle_deg > 0 && o.thermal.angle_deg < 90)) throw bad_input("/erode/angle_deg: must lie in (0, 90) degrees");
+  if (!(o.thermal.rate > 0 && o.thermal.rate <= 1)) throw bad_input("/erode: the thermal rate must lie in (0, 1]");
+}
+
+namespace {
+
+Domain make_domain(const Dem& dem, const CellMetrics& metrics, const Raster<std::uint8_t>* mask) {
+  if (mask && (mask->cols() != dem.cols() || mask->rows() != dem.rows())) throw bad_input("/erode/mask: not on the DEM's grid");
+  Domain d;
+  d.cols = dem.cols();
+  d.rows = dem.rows();
+  d.metrics = &metrics;
+  d.height.assign(dem.values().begin(), dem.values().end());
+  d.in.resize(dem.size());
+  for (std::size_t i = 0; i < dem.size(); ++i) d.in[i] = !std::isnan(dem[i]) && (!mask || (*mask)[i] != 0);
+  return d;
+}
+
+/// The report's volumes from the float output against the float input, row by row in order.
+void measure(const Dem& before, const Dem& after, const CellMetrics& metrics, ErodeReport& report) {
+  std::vector<double> eroded(std::size_t(before.rows()), 0.0), deposited(eroded), lowering(eroded), raising(eroded);
+  rows_sum(before.rows(), [&](int r) {
+    const double area = metrics.area_m2[std::size_t(r)];
+    for (int c = 0; c < before.cols(); ++c) {
+      const double change = double(after(c, r)) - double(before(c, r));
+      if (std::isnan(change)) continue;  // nodata
+      if (change < 0) eroded[std::size_t(r)] -= change * area, lowering[std::size_t(r)] = std::max(lowering[std::size_t(r)], -change);
+      if (change > 0) deposited[std::size_t(r)] += change * area, raising[std::size_t(r)] = std::max(raising[std::size_t(r)], change);
+    }
+    return 0.0;
+  });
+  report.eroded_m3 = std::accumulate(eroded.begin(), eroded.end(), 0.0);
+  report.deposited_m3 = std::accumulate(deposited.begin(), deposited.end(), 0.0);
+  report.max_lowering_m = *std::max_element(lowering.begin(), lowering.end());
+  report.max_raising_m = *std::max_element(raising.begin(), raising.end());
+}
+
+}  // namespace
+
+Dem erode(const Dem& dem, const CellMetrics& metrics, const ErodeOptions& options, const Raster<std::uint8_t>* mask,
+          Progress& progress, ErodeReport* report) {
+  check_settings(options);
+  const auto start = std::chrono::steady_clock::now();
+  Domain domain = make_domain(dem, metrics, mask);
+  const bool hydraulic = options.process != Process::thermal, thermal = options.process != Process::hydraulic;
+  std::optional<Hydraulic> water;
+  std::optional<Thermal> slide;
+  if (hydraulic) water.emplace(domain, options.hydraulic);
+  if (thermal) slide.emplace(domain, options.thermal);
+  int done = 0;
+  {
+    ProgressStep step(progress, "erode");
+    while (done < options.iterations) {
+      if (water) water->step();
+      const double moved = slide ? slide->step() : 0.0;
+      ++done;
+      step.update(double(done) / options.iterations);
+      if (!hydraulic && moved == 0) break;  // stable: further iterations would change nothing
+    }
+  }
+  if (water) water->settle();
+  Dem out = dem;
+  for (std::size_t i = 0; i < out.size(); ++i)
+    if (domain.in[i]) out[i] = float(domain.height[i]);
+  if (report) {
+    report->iterations = done;
+    measure(dem, out, metrics, *report);
+    report->carried_out_m3 = water ? water->sediment_out_m3 : 0.0;
+    report->water_out_m3 = water ? water->water_out_m3 : 0.0;
+    report->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    report->seconds_per_iteration = done > 0 ? report->seconds / done : 0.0;
+  }
+  return out;
+}
+
+}  // namespace terrapolis::erode
