@@ -28,9 +28,9 @@ class RunCommand final : public Command {
               FileKind::file_in);
     app.add_option("--jobs", jobs_, "Batch: runs at once (each a process of its own, sharing --threads)")->check(CLI::PositiveNumber);
     app.add_option("--set", sets_, "Override a field: stage.field=value (repeatable), e.g. --set density.weights=[1,1,0,0]");
-    // The schema's range (a JSON-safe integer): a negative or larger seed is refused, never replaced.
-    app.add_option("--seed", seed_, "Seed of the run, 0 .. 2^53-1 (overrides the scenario's)")
-        ->check(CLI::Range(std::uint64_t(0), std::uint64_t(9007199254740991)));
+    // --seed: the schema's seed, over the scenario's when given (its range: a negative seed is refused).
+    // The run's messages keep naming the scenario's settings by pointer (/seed from a file or --set).
+    schema_.setup(app, name(), false);
     file_kind(app.add_option("-o,--output", output_, "Run folder (overrides the scenario's); batch: the folder holding a run folder per scenario, named by its file"),
               FileKind::folder_out);
     add_overwrite_flag(app, overwrite_);
@@ -44,6 +44,7 @@ class RunCommand final : public Command {
     app.add_flag("--print-scenario", print_, "Print the resolved scenario (defaults filled) and exit");
   }
   void run(Context& context) override {
+    if (schema_.given("/seed")) seed_ = schema_.scenario().resolved["seed"].get<std::uint64_t>();  // checked by the schema, named --seed
     if (is_batch(files_)) {
       if (print_) throw bad_input("--print-scenario: takes one scenario, not a batch");
       run_batch({files_, sets_, seed_, output_, overwrite_, from_, until_, only_, jobs_, context.threads}, context.log);
@@ -78,6 +79,7 @@ class RunCommand final : public Command {
   std::optional<std::string> output_;
   std::vector<std::string> sets_, only_;
   std::optional<std::uint64_t> seed_;
+  SchemaOptions schema_;
   bool overwrite_ = false, print_ = false;
 };
 

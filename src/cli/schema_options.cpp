@@ -129,9 +129,9 @@ std::vector<std::pair<std::string, json>> schema_fields_of(const std::string& co
   return out;
 }
 
-void SchemaOptions::setup(CLI::App& app, const std::string& command) {
+void SchemaOptions::setup(CLI::App& app, const std::string& command, bool names_messages) {
   command_ = command;
-  by_command()[command] = this;
+  if (names_messages) by_command()[command] = this;
   for (auto& [pointer, field] : schema_fields_of(command)) {
     const CliEntry cli = cli_entry(field, command);
     Entry& e = entries_.emplace_back();

@@ -42,8 +42,10 @@ const OptionSource* option_source(const CLI::Option& option);
 /// adds the option to the command; the command's stage settings function reads it from the scenario.
 class SchemaOptions {
  public:
-  /// Declares each field as an option of `app`: help = description and unit, default, range and choices.
-  void setup(CLI::App& app, const std::string& command);
+  /// Declares each field as an option of `app`: help = description and unit, default, range and
+  /// choices. `names_messages`: the command's error messages name these fields by their flags
+  /// (with_flag_names); off for `run`, whose messages name the scenario's settings by pointer.
+  void setup(CLI::App& app, const std::string& command, bool names_messages = true);
   /// True when the option of the field at `pointer` ("/water/sea_level_m") was given.
   bool given(const std::string& pointer) const;
   /// The command's settings as a scenario: `base` ("section.field=value", the command's own

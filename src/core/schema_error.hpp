@@ -36,9 +36,9 @@ inline std::string plain_problem(const std::string& description) {
   return description;
 }
 
-/// The choices (`enum`) the schema gives the value at `pointer` ("" when it gives none): the schema
-/// walked along the pointer's keys (properties, array items, local "#/definitions/..." references).
-inline std::string schema_choices(const nlohmann::json& schema, const std::string& pointer) {
+/// The schema's field of the value at `pointer` (nullptr when the walk finds none): the schema walked
+/// along the pointer's keys (properties, array items, local "#/definitions/..." references).
+inline const nlohmann::json* schema_field(const nlohmann::json& schema, const std::string& pointer) {
   const nlohmann::json* node = &schema;
   auto resolve = [&] {
     while (node->is_object() && node->contains("$ref") && (*node)["$ref"].is_string()) {
@@ -54,14 +54,30 @@ inline std::string schema_choices(const nlohmann::json& schema, const std::strin
     resolve();
     if (node->contains("properties") && (*node)["properties"].contains(key)) node = &(*node)["properties"][key];
     else if (node->contains("items") && (*node)["items"].is_object()) node = &(*node)["items"];
-    else return "";
+    else return nullptr;
     at = next + 1;
   }
   resolve();
-  if (!node->is_object() || !node->contains("enum")) return "";
-  std::string choices;
-  for (const auto& c : (*node)["enum"]) choices += (choices.empty() ? "" : ", ") + (c.is_string() ? c.get<std::string>() : c.dump());
-  return choices;
+  return node->is_object() ? node : nullptr;
+}
+
+/// What the field wants, said from its schema: "must be one of a, b, c" (its choices) or "must be
+/// an integer" (its type); "" when the field says neither.
+inline std::string field_wants(const nlohmann::json& field, const std::string& problem) {
+  if (field.contains("enum")) {
+    std::string choices;
+    for (const auto& c : field["enum"]) choices += (choices.empty() ? "" : ", ") + (c.is_string() ? c.get<std::string>() : c.dump());
+    return "must be one of " + choices;
+  }
+  if (problem != "Value type not permitted by 'type' constraint." || !field.contains("type")) return "";
+  static const std::pair<std::string_view, std::string_view> names[] = {
+      {"integer", "an integer"}, {"number", "a number"}, {"string", "a string"}, {"boolean", "true or false"},
+      {"array", "a list [...]"}, {"object", "an object {...}"}, {"null", "null"}};
+  std::string wanted;
+  for (const auto& t : field["type"].is_array() ? field["type"] : nlohmann::json::array({field["type"]}))
+    for (const auto& [type, said] : names)
+      if (t.is_string() && t.get<std::string>() == type) wanted += (wanted.empty() ? "" : " or ") + std::string(said);
+  return wanted.empty() ? "" : "must be " + wanted;
 }
 
 /// The JSON pointer ("/density/r_max_m", "/" for the root) and the problem of the most specific
@@ -77,8 +93,8 @@ inline std::pair<std::string, std::string> schema_error(const valijson::Validati
     const std::string key = best.description.substr(kUndeclared.size(), best.description.size() - kUndeclared.size() - 2);
     return {(pointer == "/" ? "" : pointer) + "/" + key, "unknown key"};
   }
-  if (const std::string choices = schema ? schema_choices(*schema, pointer) : ""; !choices.empty())
-    return {pointer, "must be one of " + choices};
+  if (const nlohmann::json* field = schema ? schema_field(*schema, pointer) : nullptr)
+    if (std::string wants = field_wants(*field, best.description); !wants.empty()) return {pointer, wants};
   return {pointer, plain_problem(best.description)};
 }
 

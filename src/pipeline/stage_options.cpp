@@ -241,7 +241,11 @@ RoadsSettings roads_settings(const Scenario& scenario) {
   const json& r = scenario.resolved["roads"];
   RoadsSettings s;
   const std::string costs = scenario.path("/roads/costs");
-  s.model = costs.empty() ? roads::default_cost_model() : roads::load_cost_model(costs);
+  try {
+    s.model = costs.empty() ? roads::default_cost_model() : roads::load_cost_model(costs);
+  } catch (const Error& e) {  // the file's errors name it and the key; the scenario's reader needs the setting
+    throw Error(e.kind(), "/roads/costs: " + std::string(e.what()));
+  }
   if (!r["bridges"].get<bool>()) s.model.bridge.enabled = false;
   if (!r["tunnels"].get<bool>()) s.model.tunnel.enabled = false;
   const std::uint64_t seed = scenario.resolved["seed"].get<std::uint64_t>();

@@ -6,7 +6,6 @@
 #include <vector>
 
 #include "access/access.hpp"
-#include "core/error.hpp"
 #include "density/density.hpp"
 #include "erode/erosion.hpp"
 #include "hydro/hydro.hpp"
@@ -125,15 +124,5 @@ struct StageSettings {
 /// A file the scenario names must exist before the run starts (GDAL's /vsi paths are GDAL's to
 /// check): throws bad_input "POINTER: PATH: no such file".
 void check_file(const std::string& pointer, const std::string& path);
-/// Runs `make`, naming `pointer` in its errors unless they name a setting already.
-template <class Make>
-auto at_pointer(const std::string& pointer, Make&& make) -> decltype(make()) {
-  try {
-    return make();
-  } catch (const Error& e) {
-    const std::string message = e.what();
-    throw Error(e.kind(), message.starts_with('/') ? message : pointer + ": " + message);
-  }
-}
 
 }  // namespace terrapolis::pipeline

@@ -559,7 +559,7 @@ void roads_run(RunState& s, Progress& progress, const Log& log) {
 void roads_load(RunState&) {}  // the access stage reads the saved layers
 
 void roads_prepare(const Scenario& scenario, const Dem& dem, Settings& s) {
-  s.roads = at_pointer("/roads/costs", [&] { return roads_settings(scenario); });
+  s.roads = roads_settings(scenario);
   s.corridor = corridor_settings(scenario);
   check_file("/roads/corridor/side_angles", s.corridor.side_angles);
   check_file("/roads/vegetation", s.roads.vegetation);
