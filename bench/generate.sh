@@ -5,7 +5,8 @@
 # in 0.35-0.5 s, its DMMC in 0.1-0.15 s on 2007 hardware; Horton's ranges of real basins; Génévaux
 # et al. Tab. 2: 0.42-0.46 km of river per km²).
 # Usage: bench/generate.sh [SIZE]   (default 513: the thesis's grid)
-# Env: TERRAPOLIS_BIN (default build/src/cli/terrapolis), REPEAT (default 5), METHODS (default "dmmc flow tectonic coast planar"), TABLE1 (1: also the coast method at the sizes of Génévaux et al. Tab. 1), SEED (default 1)
+# Env: TERRAPOLIS_BIN (default build/src/cli/terrapolis), REPEAT (default 5), METHODS (default "dmmc flow tectonic coast planar"), TABLE1 (1: also the coast method at the sizes of Génévaux et al. Tab. 1), SEED (default 1),
+#      ARGS (more options of generate for the method table, e.g. "--subdivision triangle-edge --bottom-up mean")
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BIN=$(realpath "${TERRAPOLIS_BIN:-build/src/cli/terrapolis}")
@@ -14,6 +15,7 @@ REPEAT=${REPEAT:-5}
 METHODS=${METHODS:-dmmc flow tectonic coast planar}
 TABLE1=${TABLE1:-1}
 SEED=${SEED:-1}
+read -r -a ARGS <<<"${ARGS:-}"
 WORK=$(mktemp -d)
 trap 'rm -rf "$WORK"' EXIT
 median() { sort -g | awk '{a[NR]=$1} END {print (NR % 2) ? a[(NR+1)/2] : (a[NR/2] + a[NR/2+1]) / 2}'; }
@@ -23,7 +25,7 @@ for m in $METHODS; do
   for i in $(seq "$REPEAT"); do
     rm -f "$WORK/$m".*
     /usr/bin/time -f %e -o "$WORK/t" "$BIN" --verbose generate "$WORK/$m.tif" --method "$m" --size "${SIZE}x${SIZE}" --cell 30 \
-      --seed "$SEED" 2>"$WORK/log"
+      --seed "$SEED" "${ARGS[@]}" 2>"$WORK/log"
     cat "$WORK/t" >>"$WORK/wall"
     sed -n 's/.*generate: \(skeleton\|tectonic\) in \([0-9.]*\) s.*/\2/p' "$WORK/log" >>"$WORK/skel"
     sed -n 's/.*generate: dmmc in \([0-9.]*\) s.*/\1/p' "$WORK/log" >>"$WORK/dmmc"

@@ -21,6 +21,7 @@ namespace terrapolis::cli {
 struct TerrainOptions {
   std::string method = "thin-plate";
   std::string subdivision = "diamond-square";
+  std::string bottom_up = "weighted";
   std::uint64_t seed = 1;
   double roughness_m = 0.0;
   double hurst = 0.5;
@@ -42,6 +43,9 @@ struct TerrainOptions {
         ->capture_default_str()->check(CLI::Range(0.01, 1.0));
     app.add_option("--shape", shape, "I of Belhadj eq. 3.4: shapes the interpolation with distance (0: plain mean)")->capture_default_str();
     app.add_option("--shape-up", shape_up, "I_-1 of Belhadj eq. 3.5: shapes the bottom-up extrapolation (0: plain)")->capture_default_str();
+    app.add_option("--bottom-up", bottom_up, "dmmc: bottom-up extrapolation: weighted (Belhadj Alg. 11, children weighted by distance) | "
+                                             "mean (Alg. 10 as printed: plain mean of the children, noise s = roughness/65536 m per cell of distance)")
+        ->capture_default_str()->check(CLI::IsMember({"weighted", "mean"}));
     app.add_option("--tension", tension, "thin-plate: tension in 1/cell^2 (0: pure thin plate; large: membrane)")
         ->capture_default_str()->check(CLI::NonNegativeNumber);
     app.add_flag("--no-low-pass", no_low_pass, "dmmc: skip the 3x3 low-pass of Belhadj §5.2.1");
@@ -59,6 +63,12 @@ struct TerrainOptions {
     m.hurst = hurst;
     m.shape = shape;
     p.dmmc.bottom_up.shape = shape_up;
+    if (bottom_up == "mean") {
+      // Alg. 10 has no extrapolation shaping: I_-1 comes with Alg. 11 (§3.2.2).
+      if (shape_up != 0.0) throw bad_input("--shape-up: needs --bottom-up weighted (Belhadj Alg. 10 has no extrapolation shaping)");
+      p.dmmc.bottom_up.rule = terrain::BottomUpRule::mean;
+      p.dmmc.bottom_up.noise_m_per_cell = terrain::thesis_noise_per_cell_m(roughness_m);
+    }
     p.dmmc.low_pass = !no_low_pass;
     p.spline.tension = tension;
     return p;
@@ -73,6 +83,8 @@ struct TerrainOptions {
       md.emplace_back("TERRAPOLIS_SEED", std::to_string(seed));
       md.emplace_back("TERRAPOLIS_ROUGHNESS_M", std::to_string(roughness_m));
       md.emplace_back("TERRAPOLIS_HURST", std::to_string(hurst));
+      // Only when not the default, so outputs made with the default keep their bytes.
+      if (bottom_up != "weighted") md.emplace_back("TERRAPOLIS_BOTTOM_UP", bottom_up);
     }
     if (method == "thin-plate") md.emplace_back("TERRAPOLIS_TENSION", std::to_string(tension));
     return md;

@@ -224,7 +224,39 @@ void midpoint_displacement(SubdivisionGrid& grid, const MidpointParams& params, 
   }
 }
 
-std::size_t bottom_up(SubdivisionGrid& grid, Subdivision scheme, const BottomUpParams& params) {
+namespace {
+
+/// The altitude of unknown parent p from its children links[g, h) (all known at the start of the round).
+double extrapolate(const SubdivisionGrid& grid, const std::vector<std::pair<std::uint32_t, std::uint32_t>>& links,
+                   std::size_t g, std::size_t h, double d_max, const BottomUpParams& params, std::uint64_t seed) {
+  const std::uint32_t cols = std::uint32_t(grid.cols), p = links[g].first;
+  const double px = double(p % cols), py = double(p / cols);
+  double a = 0, weight_sum = 0, distance_sum = 0;
+  for (std::size_t k = g; k < h; ++k) {
+    const std::uint32_t e = links[k].second;
+    const double d = std::hypot(px - double(e % cols), py - double(e / cols));
+    if (params.rule == BottomUpRule::mean) {
+      a += grid.z[e];
+      distance_sum += d;
+      continue;
+    }
+    const double weight = params.weight_by_distance ? d : 1.0 / d;
+    a += weight * shape_curve(grid.z[e], d, d_max, params.shape);
+    weight_sum += weight;
+  }
+  if (params.rule == BottomUpRule::weighted) return a / weight_sum;
+  // Belhadj Alg. 10 (§3.1.1.3, applied in §3.1.2): T.a <- Ex.a / Ex.n + (Ex.d x s / Ex.n) x X, with Ex.a the sum
+  // of the children's altitudes, Ex.n their count, Ex.d the sum of their Euclidean distances to the
+  // parent (cells), s the scale factor of eq. 1.1 and X uniform in [-1,1]. X is the position's hash,
+  // so the result does not depend on the order of work.
+  const double n = double(h - g);
+  if (params.noise_m_per_cell == 0.0) return a / n;
+  return a / n + distance_sum * params.noise_m_per_cell / n * position_noise(seed, int(px), int(py));
+}
+
+}  // namespace
+
+std::size_t bottom_up(SubdivisionGrid& grid, Subdivision scheme, const BottomUpParams& params, std::uint64_t seed) {
   const int cols = grid.cols;
   const SubdivisionTree tree(cols, grid.rows);
   const double d_max = std::hypot(double(cols), double(grid.rows));
@@ -246,21 +278,14 @@ std::size_t bottom_up(SubdivisionGrid& grid, Subdivision scheme, const BottomUpP
       }
     }
     // Sorting makes the groups (and so the floating-point sums) independent of the order of work.
+    // Each parent is set, and queued for the next round, once (Alg. 10 queues it once per child).
     std::sort(links.begin(), links.end());
     active.clear();
     for (std::size_t g = 0; g < links.size();) {
       const std::uint32_t p = links[g].first;
-      const double px = double(p % std::uint32_t(cols)), py = double(p / std::uint32_t(cols));
-      double a = 0, weight_sum = 0;
       std::size_t h = g;
-      for (; h < links.size() && links[h].first == p; ++h) {
-        const std::uint32_t e = links[h].second;
-        const double d = std::hypot(px - double(e % std::uint32_t(cols)), py - double(e / std::uint32_t(cols)));
-        const double weight = params.weight_by_distance ? d : 1.0 / d;
-        a += weight * shape_curve(grid.z[e], d, d_max, params.shape);
-        weight_sum += weight;
-      }
-      grid.z[p] = float(a / weight_sum);
+      while (h < links.size() && links[h].first == p) ++h;
+      grid.z[p] = float(extrapolate(grid, links, g, h, d_max, params, seed));
       grid.state[p] = CellState::known;
       active.push_back(p);
       ++set;
@@ -293,7 +318,7 @@ void low_pass(SubdivisionGrid& grid) {
 namespace {
 
 void run_dmmc(SubdivisionGrid& grid, const DmmcParams& params, Progress* progress) {
-  bottom_up(grid, params.top_down.subdivision, params.bottom_up);
+  bottom_up(grid, params.top_down.subdivision, params.bottom_up, params.top_down.seed);
   midpoint_displacement(grid, params.top_down, progress);
 }
 

@@ -35,13 +35,34 @@ struct MidpointParams {
   std::uint64_t seed = 1;   ///< seed of the position hash
 };
 
-/// Parameters of the bottom-up pass (Belhadj Alg. 11, eq. 3.5).
-struct BottomUpParams {
-  double shape = 0.0;  ///< I_-1 of eq. 3.5: shapes each child's contribution with distance; 0 keeps it
-  /// Alg. 11 weights each child by its distance d to the parent (a += d f(a_e, d); D += d). true keeps
-  /// that; false weights by 1/d (a variant we measured, see docs/terrain.md).
-  bool weight_by_distance = true;
+/// How the bottom-up pass extrapolates an unknown parent from its known children.
+enum class BottomUpRule {
+  /// Belhadj Alg. 11 (DMMC, §3.2.3): a = Σ w f_-1(a_e, d) / Σ w, w = d (or 1/d), no noise. The default.
+  weighted,
+  /// Belhadj Alg. 10 (§3.1.1.3) as printed: the plain mean of the known children plus a noise that
+  /// grows with their mean distance, a = Σ a_e / n + (Σ d / n) s X. No shaping (f_-1 is Alg. 11's).
+  mean,
 };
+
+/// Parameters of the bottom-up pass (Belhadj Alg. 10 or 11, eq. 3.5).
+struct BottomUpParams {
+  BottomUpRule rule = BottomUpRule::weighted;
+  double shape = 0.0;  ///< weighted: I_-1 of eq. 3.5, shapes each child's contribution with distance; 0 keeps it
+  /// weighted: Alg. 11 weights each child by its distance d to the parent (a += d f(a_e, d); D += d).
+  /// true keeps that; false weights by 1/d (a variant we measured, see docs/terrain.md).
+  bool weight_by_distance = true;
+  /// mean: s of Alg. 10's noise term, in metres per cell of mean child-to-parent distance (>= 0;
+  /// 0: the plain mean). The thesis's s is eq. 1.1's unitless factor of S = dim(T.a) s, so with S
+  /// in metres it is S / kThesisAltitudeRange (see thesis_noise_per_cell_m).
+  double noise_m_per_cell = 0.0;
+};
+
+/// dim(T.a) of eq. 1.1: the range of the thesis's 16-bit signed altitudes (§1.1.1, note 1).
+inline constexpr double kThesisAltitudeRange = 65536.0;
+
+/// Alg. 10's s for a top-down scale S (`scale_m`, metres): s = S / dim(T.a), one altitude unit
+/// taken as one metre as for S; one cell of mean distance adds at most S / 65536 metres of noise.
+inline double thesis_noise_per_cell_m(double scale_m) { return scale_m / kThesisAltitudeRange; }
 
 /// A grid being subdivided: altitudes (metres) and states, row-major, row 0 north.
 struct SubdivisionGrid {
@@ -83,11 +104,11 @@ class SubdivisionTree {
 /// none) plus their level-0 displacement. Deterministic and independent of the thread count.
 void midpoint_displacement(SubdivisionGrid& grid, const MidpointParams& params, Progress* progress = nullptr);
 
-/// Bottom-up pass of Belhadj's Alg. 11 (DMMC): rounds in which every non-unknown cell extrapolates
-/// its unknown parents (distance-weighted mean of the children shaped by f_-1, eq. 3.5), until no
-/// parent is left to set. Afterwards every cell whose subtree holds a constraint is known.
-/// Returns the number of cells it set.
-std::size_t bottom_up(SubdivisionGrid& grid, Subdivision scheme, const BottomUpParams& params);
+/// Bottom-up pass of Belhadj's Alg. 10 / 11: rounds in which every non-unknown cell extrapolates
+/// its unknown parents (by `params.rule`), until no parent is left to set. Afterwards every cell
+/// whose subtree holds a constraint is known. `seed` draws Alg. 10's X per position (the hash of
+/// the top-down pass; a cell is set by one pass only). Returns the number of cells it set.
+std::size_t bottom_up(SubdivisionGrid& grid, Subdivision scheme, const BottomUpParams& params, std::uint64_t seed = 1);
 
 /// DMMC parameters: both passes and the optional low-pass of §5.2.1.
 struct DmmcParams {
@@ -98,8 +119,9 @@ struct DmmcParams {
   int max_low_pass = 200;        ///< cap on the number of passes
 };
 
-/// Belhadj's DMMC (Alg. 11 then the top-down pass; §5.2.1 low-pass when asked). Cells of `raster`
-/// that are finite are kept exactly; NaN cells are computed. Returns the number of low-pass passes.
+/// Belhadj's DMMC (the bottom-up pass, Alg. 11 or 10, seeded by top_down.seed, then the top-down
+/// pass; §5.2.1 low-pass when asked). Cells of `raster` that are finite are kept exactly; NaN cells
+/// are computed. Returns the number of low-pass passes.
 int dmmc(Raster<float>& raster, const DmmcParams& params, Progress* progress = nullptr);
 
 /// One 3x3 mean pass over the cells whose state is not constrained (double-buffered, deterministic).

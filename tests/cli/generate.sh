@@ -25,7 +25,20 @@ PY
 from osgeo import gdal; import numpy as np, sys
 ds = gdal.Open('$T/s.tif'); a = ds.GetRasterBand(1).ReadAsArray()
 sys.exit(0 if np.all(a[48, 10:120] == 800) and np.isfinite(a).all() else 1)"
+# Alg. 10's bottom-up rule: the sketch still kept exactly, same bytes at 1 thread, the rule in the metadata.
+"$BIN" --quiet generate "$T/m.tif" --size 129x97 --cell 30 --crs EPSG:32632 --origin 500000,5000000 --constraints "$T/sketch.tif" --roughness 100 --bottom-up mean
+"$BIN" --quiet --threads 1 generate "$T/m1.tif" --size 129x97 --cell 30 --crs EPSG:32632 --origin 500000,5000000 --constraints "$T/sketch.tif" --roughness 100 --bottom-up mean
+cmp "$T/m.tif" "$T/m1.tif"
+! cmp -s "$T/m.tif" "$T/s.tif"
+/usr/bin/python3 -c "
+from osgeo import gdal; import numpy as np, sys
+ds = gdal.Open('$T/m.tif'); a = ds.GetRasterBand(1).ReadAsArray()
+sys.exit(0 if np.all(a[48, 10:120] == 800) and np.isfinite(a).all() and ds.GetMetadataItem('TERRAPOLIS_BOTTOM_UP') == 'mean' else 1)"
 set +e
+"$BIN" generate "$T/bad.tif" --size 65x65 --cell 30 --bottom-up mean --shape-up 1 2>"$T/err"; rc=$?
+[ $rc -eq 2 ] && grep -q -- "--shape-up: needs --bottom-up weighted" "$T/err" && [ ! -e "$T/bad.tif" ] || { echo "mean with shape-up: rc=$rc"; cat "$T/err"; exit 1; }
+"$BIN" generate "$T/bad.tif" --size 65x65 --cell 30 --bottom-up thesis 2>"$T/err"; rc=$?
+[ $rc -eq 2 ] && grep -q -- "--bottom-up" "$T/err" && [ ! -e "$T/bad.tif" ] || { echo "unknown rule: rc=$rc"; cat "$T/err"; exit 1; }
 "$BIN" generate "$T/bad.tif" --size 12 --cell 30 2>"$T/err"; rc=$?
 [ $rc -eq 2 ] && grep -q -- "--size" "$T/err" && [ ! -e "$T/bad.tif" ] || { echo "bad size: rc=$rc"; cat "$T/err"; exit 1; }
 "$BIN" generate "$T/bad.tif" --size 10x10 --cell 30 --crs EPSG:4326 2>"$T/err"; rc=$?

@@ -196,16 +196,109 @@ TEST(Dmmc, BottomUpDownDoesNotTearAlongTheShiftedDiagonal) {
     midpoint_displacement(plain, p);
     Raster<float> plain_r = skeleton;
     plain_r.values() = plain.z;
-    Raster<float> bud = skeleton;
-    DmmcParams dp;
-    dp.top_down = p;
-    dmmc(bud, dp);
     const double jump_plain = largest_jump_at_constraints(skeleton, plain_r);
-    const double jump_bud = largest_jump_at_constraints(skeleton, bud);
-    // The smooth slope from ridge to border is ridge / (n/2) per cell; a tear is many times that.
-    std::printf("scheme %d: largest jump plain %.1f m, bottom-up-down %.1f m\n", int(scheme), jump_plain, jump_bud);
     EXPECT_GT(jump_plain, 0.4 * ridge) << int(scheme);
-    EXPECT_LT(jump_bud, 0.2 * ridge) << int(scheme);
+    for (const auto rule : {BottomUpRule::weighted, BottomUpRule::mean}) {
+      Raster<float> bud = skeleton;
+      DmmcParams dp;
+      dp.top_down = p;
+      dp.bottom_up.rule = rule;
+      dmmc(bud, dp);
+      const double jump_bud = largest_jump_at_constraints(skeleton, bud);
+      // The smooth slope from ridge to border is ridge / (n/2) per cell; a tear is many times that.
+      std::printf("scheme %d, rule %d: largest jump plain %.1f m, bottom-up-down %.1f m\n", int(scheme), int(rule), jump_plain, jump_bud);
+      EXPECT_LT(jump_bud, 0.2 * ridge) << int(scheme) << " " << int(rule);
+    }
+  }
+}
+
+namespace {
+
+/// 5x5 Triangle-Edge grid with (1,0) = 10 and (1,1) = 20 fixed, after Alg. 10's bottom-up pass.
+/// Round 1: (1,0) feeds its edge ends (0,0), (2,0) at d = 1; (1,1) feeds the 4 corners of its
+/// square, (0,0), (2,0), (0,2), (2,2), at d = sqrt 2. Round 2: (2,0) feeds (4,0) at d = 2; (0,2)
+/// feeds (0,4) at d = 2; (2,2) feeds (4,0), (0,4), (4,4) at d = 2 sqrt 2.
+SubdivisionGrid alg10_grid(double noise_m_per_cell, std::uint64_t seed, std::size_t* set = nullptr) {
+  Raster<float> r(5, 5, unit_georef(), nan_f);
+  r(1, 0) = 10;
+  r(1, 1) = 20;
+  SubdivisionGrid g = SubdivisionGrid::from_raster(r);
+  BottomUpParams p;
+  p.rule = BottomUpRule::mean;
+  p.noise_m_per_cell = noise_m_per_cell;
+  const std::size_t n = bottom_up(g, Subdivision::triangle_edge, p, seed);
+  if (set) *set = n;
+  return g;
+}
+
+double z_at(const SubdivisionGrid& g, int x, int y) { return g.z[std::size_t(y * g.cols + x)]; }
+
+}  // namespace
+
+TEST(BottomUpMean, ZeroNoiseGivesThePlainMeanOfTheKnownChildren) {
+  std::size_t set = 0;
+  const SubdivisionGrid g = alg10_grid(0.0, 1, &set);
+  EXPECT_EQ(set, 7u);
+  EXPECT_EQ(z_at(g, 0, 0), 15.0f);  // (10 + 20) / 2, not Alg. 11's (1 x 10 + sqrt2 x 20) / (1 + sqrt2)
+  EXPECT_EQ(z_at(g, 2, 0), 15.0f);
+  EXPECT_EQ(z_at(g, 0, 2), 20.0f);
+  EXPECT_EQ(z_at(g, 2, 2), 20.0f);
+  EXPECT_EQ(z_at(g, 4, 0), 17.5f);  // round 2: (15 + 20) / 2
+  EXPECT_EQ(z_at(g, 0, 4), 20.0f);
+  EXPECT_EQ(z_at(g, 4, 4), 20.0f);
+  EXPECT_EQ(g.state[std::size_t(2 * 5 + 4)], CellState::unknown);  // (4,2): no constraint below it
+  // The default rule weights by distance, so the two differ wherever the distances do.
+  Raster<float> r(5, 5, unit_georef(), nan_f);
+  r(1, 0) = 10;
+  r(1, 1) = 20;
+  SubdivisionGrid w = SubdivisionGrid::from_raster(r);
+  bottom_up(w, Subdivision::triangle_edge, BottomUpParams{});
+  EXPECT_FLOAT_EQ(z_at(w, 0, 0), float((10 + 20 * std::sqrt(2.0)) / (1 + std::sqrt(2.0))));
+}
+
+TEST(BottomUpMean, NoiseIsTheMeanChildDistanceTimesSTimesX) {
+  const double s = 3.0, r2 = std::sqrt(2.0);
+  const std::uint64_t seed = 9;
+  const SubdivisionGrid g = alg10_grid(s, seed);
+  auto x = [&](int col, int row) { return position_noise(seed, col, row); };
+  EXPECT_NEAR(z_at(g, 0, 0), 15 + (1 + r2) / 2 * s * x(0, 0), 1e-4);  // Ex.d / Ex.n = (1 + sqrt2) / 2
+  EXPECT_NEAR(z_at(g, 2, 0), 15 + (1 + r2) / 2 * s * x(2, 0), 1e-4);
+  EXPECT_NEAR(z_at(g, 0, 2), 20 + r2 * s * x(0, 2), 1e-4);            // one child at sqrt 2
+  EXPECT_NEAR(z_at(g, 4, 4), z_at(g, 2, 2) + 2 * r2 * s * x(4, 4), 1e-4);  // one child at 2 sqrt 2
+  EXPECT_NEAR(z_at(g, 4, 0), (z_at(g, 2, 0) + z_at(g, 2, 2)) / 2 + (2 + 2 * r2) / 2 * s * x(4, 0), 1e-4);
+  // Linear in s: twice s, twice the departure from the mean.
+  const SubdivisionGrid g2 = alg10_grid(2 * s, seed);
+  EXPECT_NEAR(z_at(g2, 0, 0) - 15, 2 * (z_at(g, 0, 0) - 15), 1e-4);
+  EXPECT_NE(z_at(g, 0, 0), 15.0f);
+  // Fixed cells are never touched.
+  EXPECT_EQ(z_at(g, 1, 0), 10.0f);
+  EXPECT_EQ(z_at(g, 1, 1), 20.0f);
+}
+
+TEST(BottomUpMean, DmmcKeepsConstraintsAndIsThreadIndependent) {
+  const Raster<float> input = sample(smooth_surface(200, 130), 0.03, 3);
+  auto run = [&](int threads, std::uint64_t seed, Subdivision scheme) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
+    Raster<float> d = input;
+    DmmcParams dp;
+    dp.top_down.subdivision = scheme;
+    dp.top_down.scale_m = 500;
+    dp.top_down.seed = seed;
+    dp.bottom_up.rule = BottomUpRule::mean;
+    dp.bottom_up.noise_m_per_cell = 0.5;
+    dmmc(d, dp);
+    return d;
+  };
+  for (const auto scheme : {Subdivision::triangle_edge, Subdivision::diamond_square}) {
+    const Raster<float> one = run(1, 5, scheme), two = run(2, 5, scheme), other = run(2, 6, scheme);
+    EXPECT_EQ(std::memcmp(one.values().data(), two.values().data(), one.size() * sizeof(float)), 0);
+    EXPECT_NE(std::memcmp(one.values().data(), other.values().data(), one.size() * sizeof(float)), 0);
+    for (std::size_t i = 0; i < input.size(); ++i) {
+      EXPECT_TRUE(std::isfinite(one[i]));
+      if (std::isfinite(input[i])) {
+        EXPECT_EQ(one[i], input[i]);
+      }
+    }
   }
 }
 
