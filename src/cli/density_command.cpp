@@ -97,7 +97,7 @@ class DensityCommand final : public Command {
     file_kind(app.add_option("OUTDIR", out_dir_, "Folder for coast.tif, plateau.tif, plain.tif, hydrometry.tif, buildable.tif, density.tif")
                   ->required(),
               FileKind::folder_out);
-    app.add_option("--weights", weights_, "Weights of coast,hydrometry,plateau,plain; negative repulsive, 0 neutral (default 1,1,1.5,0)");
+    app.add_option("--weights", weights_, "Weights of coast,hydrometry,plateau,plain; negative repulsive, 0 neutral (default: the --preset's; belhadj2007 1,1,1.5,0)");
     file_kind(app.add_option("--layer", layers_, "User raster and its weight, FILE:WEIGHT (repeatable); values in [0,1] or rescaled from their range"),
               FileKind::raster_in);
     file_kind(app.add_option("--exclude", exclusions_, "Exclusion raster: non-zero cells are uninhabitable (repeatable)"), FileKind::raster_in);
@@ -237,9 +237,9 @@ class DensityCommand final : public Command {
     return buf;
   }
 
-  /// The command's own options as scenario fields: the thesis's weights unless --weights, --layer, --exclude.
+  /// The command's own options as scenario fields: --weights (over the --preset's), --layer, --exclude.
   std::vector<std::string> table_options() const {
-    std::vector<std::string> sets = {"density.preset=\"belhadj2007\""};
+    std::vector<std::string> sets;
     if (!weights_.empty()) {
       std::stringstream ss(weights_);
       std::string part;

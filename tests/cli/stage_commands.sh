@@ -50,4 +50,11 @@ for dem in "$SAMPLES/gebco2022_15s_north_corsica_capcorse.asc" "$SAMPLES/terra_e
     same_pixels run/$f.tif density/$f.tif || fail "density $(basename "$dem"): the command and the run differ in $f.tif"
   done
 done
+# --preset fitted: the run's default density.
+rm -rf run density
+"$TP" --progress none --quiet run -o run --until density --set "dem=\"$dem\"" 2> /dev/null
+"$TP" --progress none --quiet density "$dem" density --preset fitted
+for f in density buildable; do
+  same_pixels run/$f.tif density/$f.tif || fail "density --preset fitted: the command and the run's default differ in $f.tif"
+done
 echo "stage_commands: ok"
