@@ -20,8 +20,7 @@
 #include "core/text.hpp"
 #include "density/density.hpp"
 #include "density/tiled_density.hpp"
-#include "hydro/hydro.hpp"
-#include "pipeline/inland_water.hpp"
+#include "pipeline/stages.hpp"
 #include "io/output_set.hpp"
 #include "io/mask_io.hpp"
 #include "io/raster_io.hpp"
@@ -62,26 +61,19 @@ bool rivers_used(const density::DensityOptions& options) {
   return options.terrain_weights[std::size_t(density::TerrainTerm::river_near)] != 0 || options.model;
 }
 
-/// What the run's hydro stage gives its density stage, computed here from the DEM: the inland
-/// water (the lakes the DEM flattens, water.water_mask, the reservoirs) as the water mask, the
-/// rivers when river_near is used, and the hydrometry (unless --hydrometry gives it or nothing
-/// uses it), with the scenario's hydro section, as `terrapolis run` does.
+/// What the run's hydro stage gives its density stage (pipeline::hydro_for_density, with the
+/// scenario's water and hydro sections): the inland water as the water mask, the rivers when
+/// river_near is read, and the hydrometry unless --hydrometry gives it or nothing uses it.
 Hydrometry hydro_inputs(const Dem& dem, const pipeline::Scenario& scenario, density::DensityOptions& options, const std::string& path,
                         Progress& progress, const Log& log) {
-  options.water_mask = pipeline::inland_water(dem, pipeline::inland_water_settings(scenario), progress, log).mask;
   Hydrometry h;
   h.used = hydrometry_used(options);
   const bool compute = h.used && path.empty();
-  if (compute || rivers_used(options)) {
-    hydro::HydroOptions hydro = pipeline::hydro_options(scenario);
-    hydro.with_streams = false;
-    hydro.with_hydrometry = compute;
-    hydro::HydroResult r = hydro::run_hydro(dem, hydro, progress);
-    if (rivers_used(options)) options.rivers = pipeline::river_cells(r.accumulation, scenario);
-    if (compute) h.values = std::move(r.hydrometry);
-  }
-  if (!path.empty()) h.values = read_hydrometry(path, dem.georef(), dem.cols(), dem.rows());
-  else if (!compute) h.values = dem.like<float>(0.0f);
+  pipeline::HydroForDensity hydro = pipeline::hydro_for_density(scenario, dem, pipeline::inland_water_settings(scenario), pipeline::hydro_options(scenario),
+                                                                compute, rivers_used(options), progress, log);
+  options.water_mask = std::move(hydro.water);
+  if (hydro.rivers) options.rivers = std::move(*hydro.rivers);
+  h.values = compute ? std::move(hydro.hydrometry) : path.empty() ? dem.like<float>(0.0f) : read_hydrometry(path, dem.georef(), dem.cols(), dem.rows());
   return h;
 }
 
@@ -189,6 +181,7 @@ class DensityCommand final : public Command {
     if (hydrometry && hydrometry_path_.empty())
       throw bad_input("density on tiles: the hydrometry is not computed on tiles yet; give --hydrometry FILE (a raster or VRT in [0,1]), "
                       "or a hydrometry weight of 0 (--weights C,0,P,L) and no --river-bed-cap");
+    context.log.detail("density tiles: the lakes the DEM flattens need the whole grid; on tiles only --water-mask is inland water (docs/scale.md)");
     const DemWindowReader reader(dem_.path, dem_.options());
     const RasterHeader& h = reader.header();
     const std::string water_mask = scenario.path("/water/water_mask");

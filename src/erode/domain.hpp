@@ -31,14 +31,20 @@ struct Domain {
   }
 };
 
+/// Runs body(r) for every row in parallel (each row writes only its own cells).
+template <class Body>
+void for_rows(int rows, Body&& body) {
+  tbb::parallel_for(tbb::blocked_range<int>(0, rows), [&](const tbb::blocked_range<int>& range) {
+    for (int r = range.begin(); r < range.end(); ++r) body(r);
+  });
+}
+
 /// Runs body(r) for every row in parallel; the row's figures go to per_row[r] and are summed in
 /// row order, so the total does not depend on the threads.
 template <class Body>
 double rows_sum(int rows, Body&& body) {
   std::vector<double> per_row(std::size_t(rows), 0.0);
-  tbb::parallel_for(tbb::blocked_range<int>(0, rows), [&](const tbb::blocked_range<int>& range) {
-    for (int r = range.begin(); r < range.end(); ++r) per_row[std::size_t(r)] = body(r);
-  });
+  for_rows(rows, [&](int r) { per_row[std::size_t(r)] = body(r); });
   return std::accumulate(per_row.begin(), per_row.end(), 0.0);
 }
 
@@ -55,7 +61,7 @@ class Hydraulic {
 
  private:
   double fluxes(int r);     // pass 1 of a row: rain, outflow per pipe scaled to the water, slope
-  double transport(int r);  // pass 2 of a row: water, velocity, sediment, erosion, evaporation
+  void transport(int r);    // pass 2 of a row: water, velocity, sediment, erosion, evaporation
   double sediment_in(int c, int r) const;  // m³ arriving from the neighbours' pipes
 
   Domain& d_;

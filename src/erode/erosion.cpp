@@ -45,23 +45,17 @@ Domain make_domain(const Dem& dem, const CellMetrics& metrics, const Raster<std:
   return d;
 }
 
-/// The report's volumes from the float output against the float input, row by row in order.
+/// The report's volumes from the float output against the float input (one pass, in cell order).
 void measure(const Dem& before, const Dem& after, const CellMetrics& metrics, ErodeReport& report) {
-  std::vector<double> eroded(std::size_t(before.rows()), 0.0), deposited(eroded), lowering(eroded), raising(eroded);
-  rows_sum(before.rows(), [&](int r) {
+  for (int r = 0; r < before.rows(); ++r) {
     const double area = metrics.area_m2[std::size_t(r)];
     for (int c = 0; c < before.cols(); ++c) {
       const double change = double(after(c, r)) - double(before(c, r));
       if (std::isnan(change)) continue;  // nodata
-      if (change < 0) eroded[std::size_t(r)] -= change * area, lowering[std::size_t(r)] = std::max(lowering[std::size_t(r)], -change);
-      if (change > 0) deposited[std::size_t(r)] += change * area, raising[std::size_t(r)] = std::max(raising[std::size_t(r)], change);
+      if (change < 0) report.eroded_m3 -= change * area, report.max_lowering_m = std::max(report.max_lowering_m, -change);
+      if (change > 0) report.deposited_m3 += change * area, report.max_raising_m = std::max(report.max_raising_m, change);
     }
-    return 0.0;
-  });
-  report.eroded_m3 = std::accumulate(eroded.begin(), eroded.end(), 0.0);
-  report.deposited_m3 = std::accumulate(deposited.begin(), deposited.end(), 0.0);
-  report.max_lowering_m = *std::max_element(lowering.begin(), lowering.end());
-  report.max_raising_m = *std::max_element(raising.begin(), raising.end());
+  }
 }
 
 }  // namespace

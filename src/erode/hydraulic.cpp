@@ -86,7 +86,7 @@ double Hydraulic::sediment_in(int c, int r) const {
   return in;
 }
 
-double Hydraulic::transport(int r) {
+void Hydraulic::transport(int r) {
   const CellMetrics& m = *d_.metrics;
   const double area = m.area_m2[std::size_t(r)], ns = ns_size(m, r), dt = o_.dt_s;
   for (int c = 0; c < d_.cols; ++c) {
@@ -113,13 +113,12 @@ double Hydraulic::transport(int r) {
     sediment_next_[i] = s;
     water_[i] = d2 * (1 - o_.evaporation);  // eq. 14
   }
-  return 0;
 }
 
 void Hydraulic::step() {
   sediment_out_m3 += rows_sum(d_.rows, [&](int r) { return fluxes(r); });
   water_out_m3 += std::accumulate(water_out_row_.begin(), water_out_row_.end(), 0.0);
-  rows_sum(d_.rows, [&](int r) { return transport(r); });
+  for_rows(d_.rows, [&](int r) { transport(r); });
   sediment_.swap(sediment_next_);
 }
 

@@ -77,10 +77,7 @@ void Thermal::gather(int r) {
 double Thermal::step() {
   const double moved = rows_sum(d_.rows, [&](int r) { return outflows(r); });
   if (moved == 0) return 0;
-  rows_sum(d_.rows, [&](int r) {
-    gather(r);
-    return 0.0;
-  });
+  for_rows(d_.rows, [&](int r) { gather(r); });
   d_.height.swap(next_);
   return moved;
 }

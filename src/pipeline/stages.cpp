@@ -675,11 +675,22 @@ void access_summary(const json& figures, SummaryText& out) {
 
 double land_area_figure(const density::DensityStats& stats) { return round_to(stats.land_area_km2, 0.01); }
 
+HydroForDensity hydro_for_density(const Scenario& scenario, const Dem& dem, const InlandWaterSettings& water, hydro::HydroOptions hydro,
+                                  bool hydrometry, bool rivers, Progress& progress, const Log& log) {
+  HydroForDensity out{inland_water(dem, water, progress, log).mask, {}, std::nullopt};
+  if (!hydrometry && !rivers) return out;
+  hydro.with_streams = false;  // neither the hydrometry nor the upstream areas depend on them
+  hydro.with_hydrometry = hydrometry;
+  hydro::HydroResult h = hydro::run_hydro(dem, hydro, progress);
+  if (rivers) out.rivers = river_cells(h.accumulation, scenario);
+  out.hydrometry = std::move(h.hydrometry);
+  return out;
+}
+
 density::DensityResult run_density(const Scenario& scenario, const StageSettings& settings, const Dem& dem, Progress& progress,
                                    const Log& log) {
-  const hydro::HydroResult h = hydro::run_hydro(dem, settings.hydro, progress);
-  const density::DensityOptions options =
-      density_inputs(scenario, settings, dem, inland_water(dem, settings.water, progress, log).mask, river_cells(h.accumulation, scenario));
+  HydroForDensity h = hydro_for_density(scenario, dem, settings.water, settings.hydro, true, true, progress, log);
+  const density::DensityOptions options = density_inputs(scenario, settings, dem, std::move(h.water), h.rivers);
   return density::compute_density(dem, h.hydrometry, options, progress);
 }
 

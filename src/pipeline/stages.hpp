@@ -3,6 +3,7 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 #include <cstdio>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -51,6 +52,17 @@ struct StageDef {
 const std::vector<StageDef>& stages();
 /// A stage by name (an unknown name is a programming error: std::out_of_range).
 const StageDef& stage(const std::string& name);
+
+/// What a run's hydro stage hands its density stage, computed in memory on `dem` with these water
+/// and hydro settings: the inland water (the lakes the DEM flattens, the mask, the reservoirs) and,
+/// when asked, the hydrometry and the river cells (for river_near).
+struct HydroForDensity {
+  Raster<std::uint8_t> water;
+  Raster<float> hydrometry;                    ///< empty unless asked
+  std::optional<Raster<std::uint8_t>> rivers;  ///< none unless asked
+};
+HydroForDensity hydro_for_density(const Scenario& scenario, const Dem& dem, const InlandWaterSettings& water, hydro::HydroOptions hydro,
+                                  bool hydrometry, bool rivers, Progress& progress, const Log& log);
 
 /// The density the hydro and density stages of a run compute on `dem` (the same hydrometry,
 /// inland water, rivers and model), in memory: for a command given a DEM where a run has its
