@@ -6,11 +6,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
-#include <algorithm>
-#include <cctype>
-#include <map>
-#include <regex>
-#include <sstream>
 
 #include "cli/command.hpp"
 #include "cli/commands_list.hpp"
@@ -18,6 +13,7 @@
 #include "cli/schema_options.hpp"
 #include "core/error.hpp"
 #include "lake/lake.hpp"
+#include "pipeline/stage_options.hpp"
 #include "io/output_set.hpp"
 #include "io/raster_io.hpp"
 #include "io/text_io.hpp"
@@ -28,42 +24,6 @@ namespace terrapolis::cli {
 namespace {
 
 namespace fs = std::filesystem;
-
-/// "LINESTRING (lon lat, lon lat, ...)" (WKT, WGS 84 degrees) into points.
-std::vector<std::array<double, 2>> parse_linestring(const std::string& text) {
-  std::string s = text;
-  const auto open = s.find('('), close = s.rfind(')');
-  std::string head = s.substr(0, open == std::string::npos ? 0 : open);
-  head.erase(std::remove_if(head.begin(), head.end(), ::isspace), head.end());
-  for (auto& ch : head) ch = char(std::toupper(static_cast<unsigned char>(ch)));
-  if (open == std::string::npos || close == std::string::npos || close < open || head != "LINESTRING")
-    throw bad_input("--dam: '" + text + "' is not a WKT LINESTRING (lon lat, lon lat, ...)");
-  std::vector<std::array<double, 2>> points;
-  std::stringstream body(s.substr(open + 1, close - open - 1));
-  for (std::string pair; std::getline(body, pair, ',');) {
-    std::istringstream in(pair);
-    std::array<double, 2> p{};
-    std::string rest;
-    if (!(in >> p[0] >> p[1]) || (in >> rest)) throw bad_input("--dam: '" + pair + "' is not a 'lon lat' pair");
-    points.push_back(p);
-  }
-  if (points.size() < 2) throw bad_input("--dam: a line needs at least two points");
-  return points;
-}
-
-/// `message` with the lake module's field pointers ("/level_m: ...") named by this command's flags.
-std::string with_lake_flags(const std::string& message) {
-  static const std::regex field(R"((^|[\s(])/(at|level_m|depth_m|dam|crest_m)(?=[:,\s)]|$))");
-  static const std::map<std::string, std::string> flag = {
-      {"at", "--at"}, {"level_m", "--level"}, {"depth_m", "--depth"}, {"dam", "--dam"}, {"crest_m", "--crest"}};
-  std::string out;
-  auto last = message.cbegin();
-  for (std::sregex_iterator m(message.begin(), message.end(), field), end; m != end; ++m) {
-    out.append(last, (*m)[0].first).append((*m)[1].str()).append(flag.at((*m)[2].str()));
-    last = (*m)[0].second;
-  }
-  return out.append(last, message.cend());
-}
 
 std::string fixed(double v, int digits) {
   char buf[64];
@@ -79,34 +39,29 @@ class LakeCommand final : public Command {
   void setup(CLI::App& app) override {
     dem_.add_to(app);
     file_kind(app.add_option("OUTDIR", out_dir_, "Output folder: depth.tif, shoreline.geojson, lake.json (its parent must exist)")->required(), FileKind::folder_out);
-    app.add_option("--at", at_, "Seed LON,LAT (WGS 84) on the lake's floor")->required();
-    app.add_option("--level", level_, "Water surface elevation (m)");
-    app.add_option("--depth", depth_, "Water depth above the seed's ground (m)");
-    app.add_option("--dam", dam_, "Dam line, WKT in lon/lat: 'LINESTRING (lon lat, lon lat)'; its cells rise to --crest");
-    app.add_option("--crest", crest_, "Dam crest elevation (m); the level defaults to it");
+    // --at, --level, --depth, --dam, --crest: the fields of a run's water.reservoirs item.
+    options_.setup(app, "lake");
+    app.get_option("--at")->required();
     file_kind(app.add_option("--run", run_dir_, "Run folder: report the flooded road length (roads.geojson) and the cities touched (cities.geojson)"), FileKind::folder_in);
     app.add_flag("--cog", cog_, "Write a Cloud Optimized GeoTIFF");
     add_overwrite_flag(app, overwrite_);
+    app_ = &app;
   }
 
   void run(Context& context) override {
     try {
       flood_and_write(context);
     } catch (const Error& e) {
-      throw Error(e.kind(), with_lake_flags(e.what()));
+      throw Error(e.kind(), options_.with_flags(e.what()));
     }
   }
 
  private:
   void flood_and_write(Context& context) {
-    lake::LakeSpec spec;
-    const auto at = parse_pair("--at", at_);
-    spec.lon = at[0];
-    spec.lat = at[1];
-    if (!std::isnan(level_)) spec.level_m = level_;
-    if (!std::isnan(depth_)) spec.depth_m = depth_;
-    if (!std::isnan(crest_)) spec.crest_m = crest_;
-    if (!dam_.empty()) spec.dam_lonlat = parse_linestring(dam_);
+    // The flags as the scenario's one reservoir, read as a run reads it.
+    const pipeline::Scenario scenario = options_.scenario();
+    const lake::LakeSpec spec = pipeline::reservoir_spec(scenario.resolved["water"]["reservoirs"][0]);
+    const std::string at_text = app_->get_option("--at")->results().front();
     const std::string roads_path = (fs::path(run_dir_) / "roads.geojson").string(), cities_path = (fs::path(run_dir_) / "cities.geojson").string();
     if (!run_dir_.empty() && !fs::is_directory(run_dir_)) throw bad_input(run_dir_ + ": --run: not a folder");
     OutputSet outputs("lake", {dem_.path, run_dir_}, overwrite_);  // refused before any work
@@ -142,7 +97,7 @@ class LakeCommand final : public Command {
       w.cog = cog_;
       w.description = "Water depth (m) of a lake at " + fixed(lake.level_m, 2) + " m";
       w.metadata = {{"TERRAPOLIS_VERSION", version}, {"TERRAPOLIS_COMMAND", "lake"}, {"SOURCE_DEM", fs::path(dem_.path).filename().string()},
-                    {"AT", at_}, {"LEVEL_M", fixed(lake.level_m, 3)}, {"UNIT", "m"}};
+                    {"AT", at_text}, {"LEVEL_M", fixed(lake.level_m, 3)}, {"UNIT", "m"}};
       write_raster((dir / "depth.tif").string(), lake.depth, w);
     }
     write_vector((dir / "shoreline.geojson").string(), shoreline);
@@ -155,8 +110,9 @@ class LakeCommand final : public Command {
 
 
   DemInput dem_;
-  std::string out_dir_, at_, dam_, run_dir_;
-  double level_ = NAN, depth_ = NAN, crest_ = NAN;
+  SchemaOptions options_;
+  CLI::App* app_ = nullptr;
+  std::string out_dir_, run_dir_;
   bool cog_ = false, overwrite_ = false;
 };
 

@@ -7,6 +7,9 @@
 
 #include <algorithm>
 #include <map>
+#include <optional>
+#include <regex>
+#include <sstream>
 
 #include "core/text.hpp"
 
@@ -30,6 +33,8 @@ void collect(const json& schema, const std::string& pointer, const std::string& 
     const std::string at = pointer + "/" + key;
     if (field.contains("x-cli") && field["x-cli"].contains(command)) out.emplace_back(at, field);
     collect(field, at, command, out);
+    // A list of objects (water.reservoirs): a command's flags fill one item, its first.
+    if (field.contains("items") && field["items"].is_object()) collect(field["items"], at + "/0", command, out);
   }
 }
 
@@ -65,7 +70,26 @@ std::string type_name_of(const json& field) {
     return "{" + names + "}";
   }
   const std::string type = field.value("type", "string");
+  if (type == "array") return field["items"].value("type", "") == "array" ? "LINESTRING" : "X,Y";
   return type == "integer" ? "INT" : type == "number" ? "FLOAT" : "TEXT";
+}
+
+/// "LINESTRING (x y, x y, ...)" (WKT) as [[x, y], ...]; nullopt when the text is not one.
+std::optional<json> wkt_linestring(const std::string& text) {
+  static const std::regex shape(R"(^\s*LINESTRING\s*\(([^()]*)\)\s*$)", std::regex::icase);
+  std::smatch m;
+  if (!std::regex_match(text, m, shape)) return std::nullopt;
+  json points = json::array();
+  std::stringstream body(m[1].str());
+  for (std::string pair; std::getline(body, pair, ',');) {
+    std::istringstream in(pair);
+    std::string x, y, rest;
+    if (!(in >> x >> y) || (in >> rest)) return std::nullopt;
+    const auto px = parse_number(x), py = parse_number(y);
+    if (!px || !py) return std::nullopt;
+    points.push_back({*px, *py});
+  }
+  return points;
 }
 
 std::string default_text(const json& value) {
@@ -88,6 +112,17 @@ json typed_value(const json& field, const std::string& text) {
   if (type == "number") {
     if (const auto v = parse_number(text)) return *v;
     return text;
+  }
+  if (type == "array") {  // a pair as X,Y; a line as WKT; either as JSON
+    if (const json parsed = json::parse(text, nullptr, false); parsed.is_array()) return parsed;
+    if (field["items"].value("type", "") == "array") {
+      if (auto line = wkt_linestring(text)) return *line;
+      throw bad_input("'" + text + "' is not a WKT LINESTRING (lon lat, lon lat, ...)");
+    }
+    const auto comma = text.find(',');
+    const auto x = parse_number(text.substr(0, comma)), y = comma == std::string::npos ? std::nullopt : parse_number(text.substr(comma + 1));
+    if (!x || !y) throw bad_input("'" + text + "' is not an X,Y pair of numbers");
+    return json::array({*x, *y});
   }
   return text;
 }
@@ -160,11 +195,23 @@ bool SchemaOptions::given(const std::string& pointer) const {
 
 pipeline::Scenario SchemaOptions::scenario(const std::vector<std::string>& base) const {
   std::vector<std::string> sets = base;
+  std::map<std::string, json> items;  // a list's pointer -> its first item, from the fields under ".../0/"
   for (const Entry& e : entries_) {
     const bool flag = e.field.value("type", "") == "boolean";
-    if (e.option->count() > 0) sets.push_back(dotted(e.pointer) + "=" + (flag ? json(e.on) : typed_value(e.field, e.text)).dump());
-    else if (e.own_default && !e.field["default"].is_null()) sets.push_back(dotted(e.pointer) + "=" + e.field["default"].dump());
+    json value;
+    try {
+      if (e.option->count() > 0) value = flag ? json(e.on) : typed_value(e.field, e.text);
+      else if (e.own_default) value = e.field["default"];
+    } catch (const Error& error) {
+      throw Error(error.kind(), e.flag.substr(0, e.flag.find(',')) + ": " + error.what());
+    }
+    if (value.is_null()) continue;
+    if (const auto item = e.pointer.find("/0/"); item != std::string::npos)
+      items[e.pointer.substr(0, item)][e.pointer.substr(item + 3)] = value;
+    else
+      sets.push_back(dotted(e.pointer) + "=" + value.dump());
   }
+  for (const auto& [list, item] : items) sets.push_back(dotted(list) + "=" + json::array({item}).dump());
   const std::string source = "command line";
   try {
     return pipeline::scenario_from_text("{}", source, sets);
@@ -184,6 +231,13 @@ std::string SchemaOptions::with_flags(std::string message) const {
       if (name.find_first_of("/.") == std::string::npos) continue;  // "seed": a word, not a name
       for (std::size_t at = message.find(name); at != std::string::npos; at = message.find(name, at + flag.size()))
         message.replace(at, name.size(), flag);
+    }
+  // A list item's module names its fields from the item ("/level_m, /depth_m: give one"): the
+  // command's flags fill one item, so those names are its flags too.
+  for (const Entry& e : entries_)
+    if (const auto item = e.pointer.find("/0/"); item != std::string::npos) {
+      const std::regex name(R"((^|[\s(,])/)" + e.pointer.substr(item + 3) + R"((?![\w/]))");
+      message = std::regex_replace(message, name, "$1" + e.flag.substr(0, e.flag.find(',')));
     }
   return message;
 }

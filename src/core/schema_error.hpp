@@ -31,6 +31,11 @@ inline std::string plain_problem(const std::string& description) {
       }
       return std::string(meant) + number;
     }
+  static const std::pair<std::string_view, std::string_view> counts[] = {{"Array should contain no more than ", "at most "},
+                                                                         {"Array should contain no fewer than ", "at least "}};
+  for (const auto& [said, meant] : counts)
+    if (description.starts_with(said) && description.ends_with(" elements."))
+      return "must have " + std::string(meant) + description.substr(said.size(), description.size() - said.size() - 10) + " items";
   if (description == "Value type not permitted by 'type' constraint.") return "wrong type (see the schema)";
   if (description == "Failed to match against any enum values.") return "not one of the allowed values (see --help or the schema)";
   return description;

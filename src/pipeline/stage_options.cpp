@@ -55,17 +55,22 @@ std::optional<hydro::RiverTypeOptions> river_type_options(const Scenario& scenar
   return o;
 }
 
+lake::LakeSpec reservoir_spec(const json& r) {
+  lake::LakeSpec spec;
+  spec.lon = r["at"][0].get<double>();
+  spec.lat = r["at"][1].get<double>();
+  if (r.contains("level_m")) spec.level_m = r["level_m"].get<double>();
+  if (r.contains("depth_m")) spec.depth_m = r["depth_m"].get<double>();
+  if (r.contains("crest_m")) spec.crest_m = r["crest_m"].get<double>();
+  if (r.contains("dam"))
+    for (const json& p : r["dam"]) spec.dam_lonlat.push_back({p[0].get<double>(), p[1].get<double>()});
+  return spec;
+}
+
 std::vector<lake::LakeSpec> reservoir_specs(const Scenario& scenario) {
   std::vector<lake::LakeSpec> out;
   for (const json& r : scenario.resolved["water"]["reservoirs"]) {
-    lake::LakeSpec spec;
-    spec.lon = r["at"][0].get<double>();
-    spec.lat = r["at"][1].get<double>();
-    if (r.contains("level_m")) spec.level_m = r["level_m"].get<double>();
-    if (r.contains("depth_m")) spec.depth_m = r["depth_m"].get<double>();
-    if (r.contains("crest_m")) spec.crest_m = r["crest_m"].get<double>();
-    if (r.contains("dam"))
-      for (const json& p : r["dam"]) spec.dam_lonlat.push_back({p[0].get<double>(), p[1].get<double>()});
+    const lake::LakeSpec spec = reservoir_spec(r);
     try {
       lake::check_spec(spec);
     } catch (const Error& e) {

@@ -39,8 +39,11 @@ TileSettings tile_settings(const Scenario& scenario);
 hydro::HydroOptions hydro_options(const Scenario& scenario);
 /// hydro.classify's thresholds, or none when the reaches are not classified.
 std::optional<hydro::RiverTypeOptions> river_type_options(const Scenario& scenario);
-/// The water section's reservoirs (docs/lakes.md), in the scenario's order.
+/// The water section's reservoirs (docs/lakes.md), in the scenario's order, each checked
+/// (lake::check_spec; errors name /water/reservoirs/K).
 std::vector<lake::LakeSpec> reservoir_specs(const Scenario& scenario);
+/// One item of water.reservoirs as a lake, unchecked (what `terrapolis lake` floods from its flags).
+lake::LakeSpec reservoir_spec(const nlohmann::ordered_json& item);
 /// The skeleton section (terrapolis skeleton, docs/skeleton.md).
 skeleton::SkeletonOptions skeleton_options(const Scenario& scenario);
 /// The erode section (terrapolis erode, docs/erode.md): the angle of repose from erode.angle_deg, or

@@ -108,6 +108,10 @@ expect_refused "$work/no" "level or --depth" "$bin" -q lake "$zion" "$work/no" -
 expect_refused "$work/no" "one, not both" "$bin" -q lake "$zion" "$work/no" --at=$at --level 2490 --depth 3
 expect_refused "$work/no" "not a WKT LINESTRING" "$bin" -q lake "$zion" "$work/no" --at=$at --dam "(1 2, 3 4)" --crest 2490
 expect_refused "$work/no" "needs --crest" "$bin" -q lake "$zion" "$work/no" --at=$at --dam "$dam"
+# The flags are a run's water.reservoirs item: the schema's ranges and shapes, named by flag.
+expect_refused "$work/no" "error: --level: must be <= 9000" "$bin" -q lake "$zion" "$work/no" --at=$at --level 99999
+expect_refused "$work/no" "error: --at: '10' is not an X,Y pair" "$bin" -q lake "$zion" "$work/no" --at=10 --level 1
+expect_refused "$work/no" "error: --crest: only with --dam" "$bin" -q lake "$zion" "$work/no" --at=$at --crest 1200
 expect_refused "$work/no" "not a folder" "$bin" -q lake "$zion" "$work/no" --at=$at --level 2490 --run "$work/nothing"
 no_leftovers "$work"
 echo ok

@@ -17,6 +17,8 @@ def fields(node, pointer=""):
     for key, field in node.get("properties", {}).items():
         yield pointer + "/" + key, field
         yield from fields(field, pointer + "/" + key)
+        if isinstance(field.get("items"), dict):  # a list's flags fill its first item
+            yield from fields(field["items"], pointer + "/" + key + "/0")
 
 checked = 0
 for pointer, field in fields(schema):

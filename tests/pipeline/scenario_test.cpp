@@ -63,6 +63,10 @@ TEST(Scenario, EveryFieldHasDescriptionUnitDefaultAndRange) {
   nlohmann::json typo = schema_defaults();
   typo["density"]["weigths"] = 1;
   EXPECT_EQ(validate_scenario(typo), "/density/weigths: unknown key");
+  // A list of the wrong length is said in a user's words.
+  nlohmann::json triple = schema_defaults();
+  triple["water"]["reservoirs"] = nlohmann::json::parse(R"([{"at": [1, 2, 3], "level_m": 5}])");
+  EXPECT_EQ(validate_scenario(triple), "/water/reservoirs/0/at: must have at most 2 items");
 }
 
 TEST(Scenario, DefaultScenarioIsTheSchemaDefaults) {
