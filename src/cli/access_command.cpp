@@ -21,6 +21,7 @@
 #include "io/text_io.hpp"
 #include "io/vector_io.hpp"
 #include "pipeline/inland_water.hpp"
+#include "pipeline/descriptions.hpp"
 #include "pipeline/stage_options.hpp"
 #include "terrapolis/version.hpp"
 
@@ -126,12 +127,13 @@ class AccessCommand final : public Command {
                            context.progress, [&](const access::LevelFigures& f) {
       const bool all = f.level == 0;
       WriteOptions w;
-      w.description = all ? "Travel time to the nearest settlement, minutes" : "Travel time to a settlement of " + f.key + " people or more, minutes";
+      const std::string minutes_file = all ? "access_minutes.tif" : "access_minutes_" + f.key + ".tif";
+      w.description = pipeline::describe_output(minutes_file);
       w.metadata = {{"TERRAPOLIS_VERSION", version}, {"TERRAPOLIS_COMMAND", "access"}, {"UNIT", "min"},
                     {"TERRAPOLIS_ACCESS", scenario.resolved["access"].dump()}};
-      write_raster((dir / (all ? "access_minutes.tif" : "access_minutes_" + f.key + ".tif")).string(), f.times.minutes, w);
+      write_raster((dir / minutes_file).string(), f.times.minutes, w);
       if (all) {
-        w.description = "Id of the settlement nearest in time, -1 where none is reached";
+        w.description = pipeline::describe_output("access_nearest.tif");
         w.metadata[2] = {"UNIT", "id"};
         write_raster((dir / "access_nearest.tif").string(), f.times.nearest, w);
         write_vector((dir / "access_catchments.geojson").string(), access::catchments_layer(f.times, weight, unit, places.all));

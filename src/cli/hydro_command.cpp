@@ -23,6 +23,7 @@
 #include "io/raster_io.hpp"
 #include "io/text_io.hpp"
 #include "io/vector_io.hpp"
+#include "pipeline/descriptions.hpp"
 #include "pipeline/stage_options.hpp"
 #include "terrapolis/version.hpp"
 
@@ -92,12 +93,14 @@ class HydroCommand final : public Command {
       return w;
     };
     const ReadOptions read = dem_.options();
-    const std::string flowdir_description = "D8 flow direction, " + describe(codes);
+    pipeline::DescriptionTerms terms = pipeline::description_terms(scenario);
+    terms.accumulation_unit = units_;
+    terms.weighted = !weights_.empty();
+    const std::string flowdir_description = pipeline::describe_output("flowdir.tif", terms);
     const std::vector<std::pair<std::string, std::string>> flowdir_metadata = {{"D8_CODES", h["d8_codes"].get<std::string>()}, {"D8_CODES_DESCRIPTION", describe(codes)}};
-    const std::string basins_description = "Drainage basin: 1 + rank of its outlet cell in row-major order (0: nodata)";
+    const std::string basins_description = pipeline::describe_output("basins.tif", terms);
     const std::string acc_unit = units_ == "cells" ? "cells" : units_;
-    const std::string acc_description = "Upstream " + std::string(units_ == "cells" ? "cell count" : "area (" + acc_unit + ")") + ", " +
-                                        flow + " routing" + (weights_.empty() ? "" : ", weighted");
+    const std::string acc_description = pipeline::describe_output("accumulation.tif", terms);
     const pipeline::TileSettings tiles = schema_.settings([&] { return pipeline::tile_settings(scenario); });
     if (tiles.tiled(dem_.path)) {
       // The tile engine: fill, D8 and accumulation, tile by tile (docs/scale.md).
@@ -119,7 +122,7 @@ class HydroCommand final : public Command {
       q.basins = wanted[5];
       q.streams = wanted[4] && o.unit != AccumulationUnit::cells;
       q.streams_threshold_km2 = o.streams.threshold_km2;
-      q.filled_file = opts("Conditioned elevation (m), " + fill + " depression handling");
+      q.filled_file = opts(pipeline::describe_output("filled.tif", terms));
       q.flowdir_file = opts(flowdir_description, flowdir_metadata);
       q.accumulation_file = opts(acc_description, {{"UNIT", acc_unit}});
       q.basins_file = opts(basins_description);
@@ -152,13 +155,13 @@ class HydroCommand final : public Command {
     std::vector<std::function<void()>> writes;
     if (wanted[0])
       writes.push_back([&, p = path(0)] {
-        write_raster(p, result.filled, opts("Conditioned elevation (m), " + fill + " depression handling"));
+        write_raster(p, result.filled, opts(pipeline::describe_output("filled.tif", terms)));
       });
     if (wanted[1])
       writes.push_back([&, p = path(1)] { write_raster(p, encode_d8(result.d8, codes), opts(flowdir_description, flowdir_metadata)); });
     if (wanted[2]) writes.push_back([&, p = path(2)] { write_raster(p, acc, opts(acc_description, {{"UNIT", acc_unit}})); });
     if (wanted[3])
-      writes.push_back([&, p = path(3)] { write_raster(p, result.hydrometry, opts("Hydrometry in [0,1] (" + hydrometry + ")")); });
+      writes.push_back([&, p = path(3)] { write_raster(p, result.hydrometry, opts(pipeline::describe_output("hydrometry.tif", terms))); });
     if (wanted[4]) writes.push_back([&, p = path(4)] { write_vector(p, result.streams); });
     if (wanted[5]) writes.push_back([&, p = path(5)] { write_raster(p, drainage_basins(result.d8), opts(basins_description)); });
     if (classify) writes.push_back([&] { write_text_file((dir / "streams.qml").string(), river_types_qml(), false); });

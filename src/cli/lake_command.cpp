@@ -13,6 +13,7 @@
 #include "cli/schema_options.hpp"
 #include "core/error.hpp"
 #include "lake/lake.hpp"
+#include "pipeline/descriptions.hpp"
 #include "pipeline/stage_options.hpp"
 #include "io/output_set.hpp"
 #include "io/raster_io.hpp"
@@ -95,7 +96,9 @@ class LakeCommand final : public Command {
     {
       WriteOptions w;
       w.cog = cog_;
-      w.description = "Water depth (m) of a lake at " + fixed(lake.level_m, 2) + " m";
+      pipeline::DescriptionTerms terms;
+      terms.lake_level_m = lake.level_m;
+      w.description = pipeline::describe_output("depth.tif", terms);
       w.metadata = {{"TERRAPOLIS_VERSION", version}, {"TERRAPOLIS_COMMAND", "lake"}, {"SOURCE_DEM", fs::path(dem_.path).filename().string()},
                     {"AT", at_text}, {"LEVEL_M", fixed(lake.level_m, 3)}, {"UNIT", "m"}};
       write_raster((dir / "depth.tif").string(), lake.depth, w);

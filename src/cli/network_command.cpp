@@ -4,9 +4,11 @@
 
 #include <chrono>
 #include <cstdio>
+#include <optional>
 
 #include "cli/command.hpp"
 #include "cli/commands_list.hpp"
+#include "cli/dem_input.hpp"
 #include "cli/schema_options.hpp"
 #include "core/error.hpp"
 #include "io/crs.hpp"
@@ -30,19 +32,27 @@ class NetworkCommand final : public Command {
                   ->required(),
               FileKind::vector_in);
     file_kind(app.add_option("OUTDIR", out_, "Output folder: network.geojson")->required(), FileKind::folder_out);
+    file_kind(app.add_option("--dem", dem_.path,
+                             "The DEM the cities were placed on (a run's): their centres are put back on its cell centres and the "
+                             "network is built in its CRS, as a run builds it (a GeoJSON keeps 7 decimals of lon/lat)"),
+              FileKind::raster_in);
+    dem_.add_read_options(app, "--dem");
     schema_.setup(app, name());
     add_overwrite_flag(app, overwrite_);
   }
 
   void run(Context& context) override {
     const network::NetworkOptions options = pipeline::network_options(schema_.scenario());
-    OutputSet outputs("network", {cities_}, overwrite_);
+    OutputSet outputs("network", {cities_, dem_.path}, overwrite_);
     const std::string network_path = (outputs.folder(out_) / "network.geojson").string();
-    // Lengths are geodesic whatever the file's CRS: work in WGS 84 longitude/latitude.
-    const Crs crs = wgs84();
+    // Lengths are geodesic whatever the CRS: without a DEM, work in WGS 84 longitude/latitude.
+    std::optional<RasterHeader> grid;
+    if (!dem_.path.empty()) grid = dem_.header(dem_.path);
+    const Crs crs = grid ? grid->georef.crs : wgs84();
     const auto t0 = std::chrono::steady_clock::now();
     const VectorLayer layer = read_vector(cities_, crs);
-    const std::vector<sites::Site> sites = sites::sites_from_layer(layer, cities_);
+    std::vector<sites::Site> sites = sites::sites_from_layer(layer, cities_);
+    if (grid) sites::snap_to_cells(sites, grid->georef, grid->cols, grid->rows);
     const auto t1 = std::chrono::steady_clock::now();
     const network::SiteGraph graph = network::build_network(sites, crs, options, context.progress);
     const auto t2 = std::chrono::steady_clock::now();
@@ -66,6 +76,7 @@ class NetworkCommand final : public Command {
 
  private:
   std::string cities_, out_;
+  DemInput dem_;
   SchemaOptions schema_;
   bool overwrite_ = false;
 };

@@ -11,6 +11,7 @@
 #include "cli/schema_options.hpp"
 #include "io/raster_io.hpp"
 #include "pipeline/inland_water.hpp"
+#include "pipeline/descriptions.hpp"
 #include "pipeline/stage_options.hpp"
 #include "roads/corridor.hpp"
 #include "roads/road_network.hpp"
@@ -63,7 +64,7 @@ struct RoadOptions {
     if (earthworks.empty()) return;
     Raster<float> slopes;
     WriteOptions w;
-    w.description = "terrain after cut-and-fill along the roads (m)";
+    w.description = pipeline::describe_output("earthworks.tif");
     write_raster(path, roads::earthworks(dem, terrain, geometries(roads), roads::earthwork_options(corridor, slopes)), w);
   }
   static std::vector<const roads::RoadGeometry*> geometries(const std::vector<roads::Road>& roads) {

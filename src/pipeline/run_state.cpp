@@ -4,6 +4,7 @@
 
 #include <cstdint>
 
+#include "pipeline/descriptions.hpp"
 #include "terrapolis/version.hpp"
 
 namespace terrapolis::pipeline {
@@ -33,7 +34,8 @@ Style style_from_name(const std::string& name) {
 
 template <class T>
 void RunState::write(const std::string& stage, const std::string& name, const Raster<T>& raster,
-                     const std::string& description, Style style, const std::vector<std::pair<std::string, std::string>>& metadata) {
+                     Style style, const std::vector<std::pair<std::string, std::string>>& metadata) {
+  const std::string description = describe_output(name, description_terms(scenario));
   // The output folder is where, not what: it stays out of the provenance so runs compare byte for byte.
   nlohmann::ordered_json parameters = scenario.resolved;
   parameters.erase("output");
@@ -55,17 +57,17 @@ void RunState::write(const std::string& stage, const std::string& name, const Ra
   outputs.push_back({name, stage, description, style, true, 0});
 }
 
-template void RunState::write(const std::string&, const std::string&, const Raster<float>&, const std::string&, Style,
+template void RunState::write(const std::string&, const std::string&, const Raster<float>&, Style,
                               const std::vector<std::pair<std::string, std::string>>&);
-template void RunState::write(const std::string&, const std::string&, const Raster<std::uint8_t>&, const std::string&, Style,
+template void RunState::write(const std::string&, const std::string&, const Raster<std::uint8_t>&, Style,
                               const std::vector<std::pair<std::string, std::string>>&);
-template void RunState::write(const std::string&, const std::string&, const Raster<std::int32_t>&, const std::string&, Style,
+template void RunState::write(const std::string&, const std::string&, const Raster<std::int32_t>&, Style,
                               const std::vector<std::pair<std::string, std::string>>&);
-template void RunState::write(const std::string&, const std::string&, const Raster<std::uint32_t>&, const std::string&, Style,
+template void RunState::write(const std::string&, const std::string&, const Raster<std::uint32_t>&, Style,
                               const std::vector<std::pair<std::string, std::string>>&);
 
-void RunState::write(const std::string& stage, const std::string& name, const VectorLayer& layer,
-                     const std::string& description, Style style) {
+void RunState::write(const std::string& stage, const std::string& name, const VectorLayer& layer, Style style) {
+  const std::string description = describe_output(name, description_terms(scenario));
   write_vector((folder / name).string(), layer, true);
   outputs.push_back({name, stage, description, style, false, layer.features.size()});
   vectors.emplace_back(style, layer);

@@ -59,12 +59,13 @@ struct RunState {
   std::vector<std::pair<Style, VectorLayer>> vectors;  ///< vector layers written, kept for the preview
   nlohmann::ordered_json summary = nlohmann::ordered_json::object();  ///< per-stage figures for the summary and compare
 
-  /// Writes a raster of the run with provenance metadata, and records it.
+  /// Writes a raster of the run with provenance metadata and its description (describe_output of
+  /// the scenario's terms, the one a command writing the same file gives), and records it.
   template <class T>
-  void write(const std::string& stage, const std::string& name, const Raster<T>& raster, const std::string& description, Style style,
+  void write(const std::string& stage, const std::string& name, const Raster<T>& raster, Style style,
              const std::vector<std::pair<std::string, std::string>>& metadata = {});
-  /// Writes a vector layer of the run and records it.
-  void write(const std::string& stage, const std::string& name, const VectorLayer& layer, const std::string& description, Style style);
+  /// Writes a vector layer of the run and records it with its description.
+  void write(const std::string& stage, const std::string& name, const VectorLayer& layer, Style style);
 };
 
 }  // namespace terrapolis::pipeline

@@ -48,8 +48,8 @@ void named(const std::string& pointer, Check&& check) {
 // ---- terrain -------------------------------------------------------------------------------
 
 void terrain_run(RunState& s, Progress&, const Log&) {
-  s.write("terrain", "elevation.tif", s.dem, "elevation in metres (as read from the input DEM)", Style::elevation);
-  s.write("terrain", "hillshade.tif", hillshade(s.dem), "hillshade (Horn 1981), light from 315 deg at 45 deg", Style::hillshade);
+  s.write("terrain", "elevation.tif", s.dem, Style::elevation);
+  s.write("terrain", "hillshade.tif", hillshade(s.dem), Style::hillshade);
   double lo = 1e300, hi = -1e300;
   std::size_t valid = 0;
   for (float v : s.dem.values()) {
@@ -85,7 +85,7 @@ constexpr const char* kInlandWater = "inland_water.tif";
 /// the access stages read back.
 void write_inland_water(RunState& s, Progress& progress, const Log& log) {
   InlandWater water = inland_water(s.dem, s.settings.water, progress, log);
-  s.write("hydro", kInlandWater, water.mask, "inland water (1): lakes the DEM flattens, water.water_mask and water.reservoirs", Style::water);
+  s.write("hydro", kInlandWater, water.mask, Style::water);
   s.summary["hydro"]["flat_lakes"] = water.flat_lakes;
   s.summary["hydro"]["flat_lake_km2"] = round_to(water.flat_lake_km2, 0.01);
   if (!water.reservoirs.empty()) s.summary["hydro"]["reservoirs"] = std::move(water.reservoirs);
@@ -99,9 +99,8 @@ void hydro_run(RunState& s, Progress& progress, const Log& log) {
   if (const auto& types = s.settings.river_types) hydro::classify_streams(r.streams, r.filled, options.sea_level, *types);
   const json& h = s.scenario.resolved["hydro"];
   const hydro::D8Codes codes = s.settings.d8_codes;
-  s.write("hydro", "filled.tif", r.filled, "conditioned elevation (m), " + h["fill"].get<std::string>() + " depression handling",
-          Style::elevation);
-  s.write("hydro", "flowdir.tif", hydro::encode_d8(r.d8, codes), "D8 flow direction, " + hydro::describe(codes), Style::flow_direction,
+  s.write("hydro", "filled.tif", r.filled, Style::elevation);
+  s.write("hydro", "flowdir.tif", hydro::encode_d8(r.d8, codes), Style::flow_direction,
           {{"D8_CODES", h["d8_codes"].get<std::string>()}, {"D8_CODES_DESCRIPTION", hydro::describe(codes)}});
   Raster<float> area = r.filled.like<float>(NAN);
   double largest_km2 = 0;
@@ -109,12 +108,9 @@ void hydro_run(RunState& s, Progress& progress, const Log& log) {
     area[i] = float(r.accumulation[i] * 1e-6);
     if (!std::isnan(area[i])) largest_km2 = std::max(largest_km2, double(area[i]));
   }
-  s.write("hydro", "accumulation.tif", area, "upstream area (km2), " + h["flow"].get<std::string>() + " routing", Style::accumulation,
-          {{"UNIT", "km2"}});
-  s.write("hydro", "hydrometry.tif", r.hydrometry, "hydrometry in [0,1] (" + h["hydrometry"].get<std::string>() + ")",
-          Style::unit_ramp);
-  s.write("hydro", "streams.geojson", r.streams, "stream reaches with Strahler order, upstream area (km2), length (m)",
-          Style::streams);
+  s.write("hydro", "accumulation.tif", area, Style::accumulation, {{"UNIT", "km2"}});
+  s.write("hydro", "hydrometry.tif", r.hydrometry, Style::unit_ramp);
+  s.write("hydro", "streams.geojson", r.streams, Style::streams);
   const int f_order = r.streams.field_index("strahler"), f_length = r.streams.field_index("length_m");
   std::int64_t max_order = 0;
   double length_m = 0;
@@ -179,9 +175,9 @@ void density_run(RunState& s, Progress& progress, const Log& log) {
   density::DensityResult r = density::compute_density(s.dem, *s.hydrometry, options, progress);
   const std::pair<const char*, const Raster<float>*> characteristics[] = {{"coast", &r.coast}, {"plateau", &r.plateau}, {"plain", &r.plain}};
   for (const auto& [name, raster] : characteristics)
-    s.write("density", std::string(name) + ".tif", *raster, density::describe_output(name), Style::unit_ramp);
-  s.write("density", "buildable.tif", r.buildable, density::describe_output("buildable"), Style::mask);
-  s.write("density", "density.tif", r.density, density::describe_output("density"), Style::density);
+    s.write("density", std::string(name) + ".tif", *raster, Style::unit_ramp);
+  s.write("density", "buildable.tif", r.buildable, Style::mask);
+  s.write("density", "density.tif", r.density, Style::density);
   const auto& st = r.stats;
   const std::size_t land = st.known_cells - st.water_cells;
   s.summary["density"] = {{"buildable_land_share", land ? round_to(double(st.buildable_cells) / double(land), 1e-4) : 0.0},
@@ -271,8 +267,8 @@ void sites_run(RunState& s, Progress& progress, const Log& log) {
   const sites::SitesResult r = sites::place_sites(*s.density, *s.buildable, options, progress);
   const Crs& crs = s.dem.georef().crs;
   s.cities = sites::cities_layer(r, crs);
-  s.write("sites", "cities.geojson", *s.cities, "city centres with radius, class, population, parent and depth", Style::cities);
-  s.write("sites", "city_extents.geojson", sites::city_extents_layer(r, crs), "city discs (geodesic circles)", Style::city_extents);
+  s.write("sites", "cities.geojson", *s.cities, Style::cities);
+  s.write("sites", "city_extents.geojson", sites::city_extents_layer(r, crs), Style::city_extents);
   std::map<int, int> per_class;
   std::int64_t population = 0;
   int roots = 0;
@@ -334,17 +330,7 @@ void sites_run(RunState& s, Progress& progress, const Log& log) {
 void sites_load(RunState& s) {
   s.cities = read_vector(saved(s, "cities.geojson"), s.dem.georef().crs);
   s.sites = sites::sites_from_layer(*s.cities, saved(s, "cities.geojson"));
-  // Centres lie on cell centres; GeoJSON keeps 7 decimals of lon/lat. Snap them back so the
-  // network (Delaunay on grid-aligned, often co-circular points) is the one a full run builds.
-  const GeoTransform& t = s.dem.georef().transform;
-  if (t[2] != 0 || t[4] != 0) return;  // rotated grids: keep the positions as read
-  for (auto& site : s.sites) {
-    site.col = std::clamp(int(std::floor((site.x - t[0]) / t[1])), 0, s.dem.cols() - 1);
-    site.row = std::clamp(int(std::floor((site.y - t[3]) / t[5])), 0, s.dem.rows() - 1);
-    const auto xy = s.dem.georef().cell_centre(site.col, site.row);
-    site.x = xy[0];
-    site.y = xy[1];
-  }
+  sites::snap_to_cells(s.sites, s.dem.georef(), s.dem.cols(), s.dem.rows());  // the network a full run builds
 }
 
 void sites_prepare(const Scenario& scenario, const Dem& dem, Settings& s) {
@@ -417,8 +403,7 @@ void network_run(RunState& s, Progress& progress, const Log&) {
   const Crs& crs = s.dem.georef().crs;
   const network::SiteGraph graph = network::build_network(s.sites, crs, s.settings.network, progress);
   s.network = network::network_layer(graph, s.sites, crs);
-  s.write("network", "network.geojson", *s.network, "candidate links between cities (kept = in the simplified network)",
-          Style::network);
+  s.write("network", "network.geojson", *s.network, Style::network);
   std::size_t kept = 0;
   double length_m = 0;
   for (const auto& e : graph.edges)
@@ -447,10 +432,7 @@ json corridor_hook(RunState& s, const roads::TerrainField& terrain, const std::v
   if (!c.side_angles.empty())
     c.options.side_angles_deg = read_resampled(c.side_angles, s.dem.georef(), s.dem.cols(), s.dem.rows(), Resampling::nearest);
   const roads::Corridors corridors = roads::road_corridors(terrain, built, c.options, existing);  // the new stretches only
-  s.write("roads", "corridors.geojson", roads::corridors_layer(terrain, corridors),
-          existing.empty() ? "per section the carriageway and earthworks zone (cut, fill), and the land take united"
-                           : "per section of the new roads off the existing ones the carriageway and earthworks zone (cut, fill), and the land take united",
-          Style::corridors);
+  s.write("roads", "corridors.geojson", roads::corridors_layer(terrain, corridors), Style::corridors);
   json out = {{"land_take_ha", round_to(corridors.run.land_take_ha, 0.01)}, {"cut_m3", round_to(corridors.run.cut_m3, 1)},
               {"fill_m3", round_to(corridors.run.fill_m3, 1)}};
   if (corridors.vegetation) out["cleared_ha"] = round_to(corridors.run.cleared_ha, 0.01);
@@ -478,8 +460,7 @@ std::optional<roads::ExistingRoads> existing_roads(RunState& s, const roads::Ter
   if (e.outside > 0) log.warn(std::string("roads.existing: ").append(std::to_string(e.outside)).append(" lines outside the DEM left out"));
   if (e.ferries > 0)
     log.warn(std::string("roads.existing: ").append(std::to_string(e.ferries)).append(" ferry lines left out (no road on the ground)"));
-  s.write("roads", "existing_roads.geojson", roads::existing_roads_layer(terrain, e),
-          "the given roads (roads.existing) as the run read them: through the cells they cross, with their class", Style::existing_roads);
+  s.write("roads", "existing_roads.geojson", roads::existing_roads_layer(terrain, e), Style::existing_roads);
   return e;
 }
 
@@ -523,16 +504,12 @@ void roads_run(RunState& s, Progress& progress, const Log& log) {
     for (const auto& f : r.redundant) list += (list.empty() ? "" : ", ") + f;
     log.detail(std::to_string(r.redundant.size()) + " redundant links dropped (roads.redundant_share): " + list);
   }
-  s.write("roads", "roads.geojson", roads::roads_layer(terrain, r.roads, &r.layout),
-          "one road per link with class, router, length, cost, grades, structures and its sections", Style::roads);
-  s.write("roads", "sections.geojson", roads::network_sections_layer(terrain, r.layout),
-          "the network drawn once: each section with the roads using it and their highest class", Style::sections);
+  s.write("roads", "roads.geojson", roads::roads_layer(terrain, r.roads, &r.layout), Style::roads);
+  s.write("roads", "sections.geojson", roads::network_sections_layer(terrain, r.layout), Style::sections);
   // An empty point layer has no geometry type QGIS can style: no junctions, no file.
   if (!r.layout.junctions.empty())
-    s.write("roads", "junctions.geojson", roads::junctions_layer(terrain, r.layout), "where three or more sections meet, with their classes",
-            Style::junctions);
-  s.write("roads", "road_sections.geojson", roads::sections_layer(terrain, r.roads), "road, bridge, tunnel and ferry sections",
-          Style::road_sections);
+    s.write("roads", "junctions.geojson", roads::junctions_layer(terrain, r.layout), Style::junctions);
+  s.write("roads", "road_sections.geojson", roads::sections_layer(terrain, r.roads), Style::road_sections);
   const json corridor = corridor_hook(s, terrain, r.roads, r.existing);
   std::map<std::string, double> km;
   double bridge_m = 0, tunnel_m = 0, over_limit_m = 0, water_m = 0, network_km = 0;
@@ -630,15 +607,10 @@ void access_run(RunState& s, Progress& progress, const Log& log) {
   access::for_each_level(s.dem, land, road_cells, settlements, a.levels_population, a.thresholds_minutes, people, a.options, progress,
                          [&](const access::LevelFigures& f) {
     const bool all = f.level == 0;
-    const std::string whom = all ? "the nearest settlement" : "a settlement of " + f.key + " people or more";
-    s.write("access", all ? "access_minutes.tif" : "access_minutes_" + f.key + ".tif", f.times.minutes,
-            "travel time to " + whom + ", minutes (on foot off the roads, by road on them)", Style::access_minutes, {{"UNIT", "min"}});
+    s.write("access", all ? "access_minutes.tif" : "access_minutes_" + f.key + ".tif", f.times.minutes, Style::access_minutes, {{"UNIT", "min"}});
     if (all) {
-      s.write("access", "access_nearest.tif", f.times.nearest, "id of the settlement nearest in time (cities.geojson), -1 where none is reached",
-              Style::unit_ramp);
-      s.write("access", "access_catchments.geojson", access::catchments_layer(f.times, people, "people", settlements),
-              "catchment of each settlement (the land nearest to it in time): its people, area (km2) and mean time (minutes)",
-              Style::access_catchments);
+      s.write("access", "access_nearest.tif", f.times.nearest, Style::unit_ramp);
+      s.write("access", "access_catchments.geojson", access::catchments_layer(f.times, people, "people", settlements), Style::access_catchments);
     }
     const access::Coverage& c = f.coverage;
     json within = json::object();

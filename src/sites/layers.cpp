@@ -86,6 +86,18 @@ VectorLayer city_extents_layer(const SitesResult& result, const Crs& crs, int ve
   return layer;
 }
 
+void snap_to_cells(std::vector<Site>& sites, const Georef& georef, int cols, int rows) {
+  const GeoTransform& t = georef.transform;
+  if (t[2] != 0 || t[4] != 0) return;
+  for (auto& site : sites) {
+    site.col = std::clamp(int(std::floor((site.x - t[0]) / t[1])), 0, cols - 1);
+    site.row = std::clamp(int(std::floor((site.y - t[3]) / t[5])), 0, rows - 1);
+    const auto xy = georef.cell_centre(site.col, site.row);
+    site.x = xy[0];
+    site.y = xy[1];
+  }
+}
+
 std::vector<Site> sites_from_layer(const VectorLayer& layer, const std::string& path) {
   if (!layer.features.empty() && layer.geometry != GeometryType::point) throw bad_input(path + ": cities must be points");
   const int radius = layer.field_index("radius_m"), id = layer.field_index("id"), parent = layer.field_index("parent"),

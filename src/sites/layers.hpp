@@ -23,4 +23,10 @@ VectorLayer city_extents_layer(const SitesResult& result, const Crs& crs, int ve
 /// Throws bad_input naming `path` for a missing field, a bad value or an unknown parent.
 std::vector<Site> sites_from_layer(const VectorLayer& layer, const std::string& path);
 
+/// Puts sites read back from a layer on the cell centres of the grid they were placed on (`georef`,
+/// `cols` x `rows`): GeoJSON keeps 7 decimals of lon/lat, and the network's Delaunay triangulation of
+/// grid-aligned, often co-circular points must see the positions the sites stage computed. Rotated
+/// grids keep the positions as read.
+void snap_to_cells(std::vector<Site>& sites, const Georef& georef, int cols, int rows);
+
 }  // namespace terrapolis::sites
