@@ -20,6 +20,7 @@
 #include "core/text.hpp"
 #include "density/density.hpp"
 #include "density/tiled_density.hpp"
+#include "pipeline/descriptions.hpp"
 #include "pipeline/stages.hpp"
 #include "io/output_set.hpp"
 #include "io/mask_io.hpp"
@@ -148,7 +149,7 @@ class DensityCommand final : public Command {
       writes.emplace_back([&, n] {
         WriteOptions w;
         w.cog = cog_;
-        w.description = density::describe_output(n);
+        w.description = pipeline::describe_output(n == "hydrometry" ? "density_hydrometry.tif" : n + ".tif");
         w.metadata = metadata;
         write_raster(path(n), raster, w);
       });

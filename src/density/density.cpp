@@ -218,16 +218,6 @@ double combine(const double* weights, const double* values, std::size_t n) {
   return std::clamp((sum - negative) / total, 0.0, 1.0);
 }
 
-std::string describe_output(const std::string& name) {
-  if (name == "coast") return "Coast: share of water between r_min and r_max around the cell, over its maximum on land (0..1; 0 on water)";
-  if (name == "plateau") return "Plateau: share of rough ground between plateau_min and plateau_max altitudes in the ring r_min..r_max, over its maximum on land (0..1)";
-  if (name == "plain") return "Plain: 1 - standard deviation of altitude within r_min / maximum variation, clamped (0..1; 0 on water)";
-  if (name == "hydrometry") return "Hydrometry used by the density model (0..1)";
-  if (name == "buildable") return "Buildable: 1 habitable, 0 uninhabitable (water, too high, too steep, river bed, excluded), 255 no data";
-  if (name == "density") return "Human population density model (MNDPH, Belhadj 2007 4.2): weighted characteristics, 0..1, 0 where uninhabitable";
-  return name;
-}
-
 namespace {
 
 /// The grid as the model sees it: what each cell is, each row's span of land (only land needs

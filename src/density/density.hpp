@@ -160,7 +160,4 @@ void to_unit_range(Raster<float>& layer);
 /// 2012) with columns measured at the feature row's width, rows by the northings of the grid.
 std::vector<float> distance_to_m(const std::vector<std::uint8_t>& feature, const CellMetrics& metrics, int cols, int rows);
 
-/// Describes each output for its metadata ("coast.tif" -> one line).
-std::string describe_output(const std::string& name);
-
 }  // namespace terrapolis::density

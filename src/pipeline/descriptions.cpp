@@ -4,7 +4,6 @@
 #include <cstdio>
 #include <stdexcept>
 
-#include "density/density.hpp"
 #include "hydro/flow_directions.hpp"
 #include "pipeline/stage_options.hpp"
 
@@ -34,9 +33,14 @@ std::string describe_output(const std::string& file, const DescriptionTerms& t) 
   if (file == "basins.tif") return "Drainage basin: 1 + rank of its outlet cell in row-major order (0: nodata)";
   if (file == "streams.geojson") return "Stream reaches with Strahler order, upstream area (km2), length (m)";
   if (file == "inland_water.tif") return "Inland water (1): lakes the DEM flattens, water.water_mask and water.reservoirs";
-  // density (the model's own wording, density::describe_output)
-  for (const char* name : {"coast", "plateau", "plain", "buildable", "density"})
-    if (file == std::string(name) + ".tif") return density::describe_output(name);
+  // density (Belhadj 2007 §4.2)
+  if (file == "coast.tif") return "Coast: share of water between r_min and r_max around the cell, over its maximum on land (0..1; 0 on water)";
+  if (file == "plateau.tif")
+    return "Plateau: share of rough ground between plateau_min and plateau_max altitudes in the ring r_min..r_max, over its maximum on land (0..1)";
+  if (file == "plain.tif") return "Plain: 1 - standard deviation of altitude within r_min / maximum variation, clamped (0..1; 0 on water)";
+  if (file == "buildable.tif") return "Buildable: 1 habitable, 0 uninhabitable (water, too high, too steep, river bed, excluded), 255 no data";
+  if (file == "density.tif") return "Human population density model (MNDPH, Belhadj 2007 4.2): weighted characteristics, 0..1, 0 where uninhabitable";
+  if (file == "density_hydrometry.tif") return "Hydrometry used by the density model (0..1)";  // the density command's hydrometry.tif
   // sites, network
   if (file == "cities.geojson") return "City centres with radius, class, population, parent and depth";
   if (file == "city_extents.geojson") return "City discs (geodesic circles)";
