@@ -21,4 +21,8 @@ GeneratedTerrain generate_coast(const GenerateRequest& request);
 /// ridge altitudes by linear programming, fractalised facets.
 GeneratedTerrain generate_planar(const GenerateRequest& request);
 
+/// Belhadj 2007 §2.1, Alg. 1 (growing_window.cpp): the sketch in request.grid (finite cells, kept
+/// exactly) dilated scale by scale by small midpoint displacements (request.dmmc.top_down).
+GeneratedTerrain generate_window(const GenerateRequest& request);
+
 }  // namespace terrapolis::generate
