@@ -45,6 +45,7 @@ constexpr Method kMethods[] = {
     {"coast", generate::generate_coast},
     {"planar", generate::generate_planar},
     {"window", generate::generate_window},
+    {"river", generate::generate_river},
 };
 
 std::string method_names() {
@@ -78,7 +79,7 @@ class GenerateCommand final : public Command {
     grid_.add(app, true, "dmmc, window: an unreferenced grid with its corner at 0,0; the other methods: ETRS89-LAEA Europe, "
                          "EPSG:3035, the grid centred on 52N 10E");
     app.add_option("--method", method_, "Generator: " + method_names() + " (see docs/terrain.md)")->capture_default_str();
-    app.add_option("--relief", relief_m_, "flow, tectonic: height (m) of the highest crest above the outlets")
+    app.add_option("--relief", relief_m_, "flow, tectonic, river: height (m) of the highest crest above the outlets (river: the north-west corner)")
         ->capture_default_str()->check(CLI::PositiveNumber);
     file_kind(app.add_option("--ridges", lines_path_, "flow: ridge lines (any OGR vector file of lines; default: random ridges from --seed)"), FileKind::vector_in);
     file_kind(app.add_option("--mountains", points_path_, "tectonic: mountain points, one plate each (any OGR vector file of points; default: random)"), FileKind::vector_in);
@@ -103,6 +104,10 @@ class GenerateCommand final : public Command {
     if (skeleton_method && grid_.crs.empty()) default_local_grid();
     // Between a skeleton's cells the noise must stay below the relief it carves, or it makes pits.
     if (skeleton_method && app_->get_option("--roughness")->count() == 0) options_.roughness_m = 0.05 * relief_m_;
+    if (method_ == "river") {  // Belhadj §1.2.3.2: H = 0.4565 and s = 1, S = dim(T.a) s the whole altitude range
+      if (app_->get_option("--hurst")->count() == 0) options_.hurst = 0.4565;
+      if (app_->get_option("--roughness")->count() == 0) options_.roughness_m = relief_m_;
+    }
     terrain::FillParams params = options_.params();
     Raster<float> grid = grid_.make();
     OutputSet outputs("generate", {sketch_, lines_path_, points_path_, skeleton_options_.coast_path}, overwrite_);

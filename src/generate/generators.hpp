@@ -25,4 +25,8 @@ GeneratedTerrain generate_planar(const GenerateRequest& request);
 /// exactly) dilated scale by scale by small midpoint displacements (request.dmmc.top_down).
 GeneratedTerrain generate_window(const GenerateRequest& request);
 
+/// Belhadj 2007 §1.2.3 (river_fractal.cpp): a Mandelbrot necklace from two sides of the grid, its
+/// edge labels in a binary search tree, and the midpoint displacement converging to its bed.
+GeneratedTerrain generate_river(const GenerateRequest& request);
+
 }  // namespace terrapolis::generate
