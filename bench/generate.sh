@@ -5,16 +5,18 @@
 # in 0.35-0.5 s, its DMMC in 0.1-0.15 s on 2007 hardware; Horton's ranges of real basins; Génévaux
 # et al. Tab. 2: 0.42-0.46 km of river per km²). window (Belhadj §2.1, Alg. 1) runs on fig. 2.3's
 # sketch (crossed diagonals at 1000 m, the counter-diagonal shifted one cell, borders at 0; the
-# thesis: 110 ms on 513² for fig. 2.2's), its phase in the dmmc_s column.
+# thesis: 110 ms on 513² for fig. 2.2's), its phase in the dmmc_s column. river (§1.2.3): the necklace
+# in the skeleton_s column, the terrain in dmmc_s (the thesis: 1,447 ms for both on 513²), and its
+# own D8 shares below the table.
 # Usage: bench/generate.sh [SIZE]   (default 513: the thesis's grid)
-# Env: TERRAPOLIS_BIN (default build/src/cli/terrapolis), REPEAT (default 5), METHODS (default "dmmc flow tectonic coast planar window"), TABLE1 (1: also the coast method at the sizes of Génévaux et al. Tab. 1), SEED (default 1),
+# Env: TERRAPOLIS_BIN (default build/src/cli/terrapolis), REPEAT (default 5), METHODS (default "dmmc flow tectonic coast planar window river"), TABLE1 (1: also the coast method at the sizes of Génévaux et al. Tab. 1), SEED (default 1),
 #      ARGS (more options of generate for the method table, e.g. "--subdivision triangle-edge --bottom-up mean")
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BIN=$(realpath "${TERRAPOLIS_BIN:-build/src/cli/terrapolis}")
 SIZE=${1:-513}
 REPEAT=${REPEAT:-5}
-METHODS=${METHODS:-dmmc flow tectonic coast planar window}
+METHODS=${METHODS:-dmmc flow tectonic coast planar window river}
 TABLE1=${TABLE1:-1}
 SEED=${SEED:-1}
 read -r -a ARGS <<<"${ARGS:-}"
@@ -46,8 +48,8 @@ for m in $METHODS; do
     /usr/bin/time -f %e -o "$WORK/t" "$BIN" --verbose generate "$WORK/$m.tif" --method "$m" --size "${SIZE}x${SIZE}" --cell 30 \
       --seed "$SEED" "${extra[@]}" "${ARGS[@]}" 2>"$WORK/log"
     cat "$WORK/t" >>"$WORK/wall"
-    sed -n 's/.*generate: \(skeleton\|tectonic\) in \([0-9.]*\) s.*/\2/p' "$WORK/log" >>"$WORK/skel"
-    sed -n 's/.*generate: \(dmmc\|growing window\) in \([0-9.]*\) s.*/\2/p' "$WORK/log" >>"$WORK/dmmc"
+    sed -n 's/.*generate: \(skeleton\|tectonic\|necklace\) in \([0-9.]*\) s.*/\2/p' "$WORK/log" >>"$WORK/skel"
+    sed -n 's/.*generate: \(dmmc\|growing window\|river terrain\) in \([0-9.]*\) s.*/\2/p' "$WORK/log" >>"$WORK/dmmc"
   done
   skel=$( [ -s "$WORK/skel" ] && median <"$WORK/skel" || echo -)
   dmmc=$( [ -s "$WORK/dmmc" ] && median <"$WORK/dmmc" || echo -)
@@ -59,10 +61,15 @@ print(c['share_within_2_cells'], c['mouths_ending_in_pit'], h['bifurcation_ratio
     share=- pits=- rb=- rl=- dd=-
   fi
   printf "%-9s %9s %10s %9s %9s %7s %6s %6s %9s\n" "$m" "$(median <"$WORK/wall")" "$skel" "$dmmc" "$share" "$pits" "$rb" "$rl" "$dd"
+  [ "$m" = river ] && river_note=$(/usr/bin/python3 -c "
+import json; f = json.load(open('$WORK/river.report.json'))['figures']
+print('river: %d river cells, %.3f of them drain into the river, %.3f of the line within 1 cell of a D8 stream (>= 0.1 km2)' % (
+    f['river_cells'], f['river_cells_draining_into_river_share'], f['river_line_within_1_cell_of_d8_stream_share']))")
 done
+[ -n "${river_note:-}" ] && echo "$river_note"
 echo "documents: flow skeleton 513² 0.35-0.5 s, DMMC 0.1-0.15 s (Belhadj 2007, 2007 hardware); Rb 3-5, Rl 1.5-3.5 (Horton 1945,"
 echo "Strahler 1957); drainage density 0.42-0.46 km/km² (Génévaux et al., Tab. 2). dmmc alone has no skeleton."
-echo "growing window (dmmc_s column): 110 ms on 513² (Belhadj 2007 §2.1.1, fig. 2.2)."
+echo "growing window (dmmc_s column): 110 ms on 513² (Belhadj 2007 §2.1.1, fig. 2.2); river (skeleton_s + dmmc_s): 1,447 ms (§1.2.3.2)."
 # Génévaux et al. Tab. 1-2: the coast method on islands of the paper's land areas (the seeded island
 # covers about 41 % of its grid), 100 m cells; the three phases the command logs with --verbose.
 if [ "$TABLE1" = 1 ]; then
