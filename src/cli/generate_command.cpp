@@ -78,7 +78,8 @@ class GenerateCommand final : public Command {
     file_kind(app.add_option("OUT", output_, "Output GeoTIFF (float32 heights in metres)")->required(), FileKind::raster_out);
     grid_.add(app, true, "dmmc, window: an unreferenced grid with its corner at 0,0; the other methods: ETRS89-LAEA Europe, "
                          "EPSG:3035, the grid centred on 52N 10E");
-    app.add_option("--method", method_, "Generator: " + method_names() + " (see docs/terrain.md)")->capture_default_str();
+    app.add_option("--method", method_, "Generator: " + method_names() + " (see docs/terrain.md; river defaults to the thesis's "
+                                         "--hurst 0.4565 and --roughness equal to --relief)")->capture_default_str();
     app.add_option("--relief", relief_m_, "flow, tectonic, river: height (m) of the highest crest above the outlets (river: the north-west corner)")
         ->capture_default_str()->check(CLI::PositiveNumber);
     file_kind(app.add_option("--ridges", lines_path_, "flow: ridge lines (any OGR vector file of lines; default: random ridges from --seed)"), FileKind::vector_in);
@@ -153,6 +154,11 @@ class GenerateCommand final : public Command {
     write.metadata = options_.metadata(false);
     write.metadata.emplace_back("TERRAPOLIS_GENERATOR", method_);
     if (skeleton_method) write.metadata.emplace_back("TERRAPOLIS_RELIEF_M", std::to_string(relief_m_));
+    if (method_ == "river") {
+      write.metadata.emplace_back("TERRAPOLIS_RIVER_CONVERGENCE", std::to_string(request.river.convergence));
+      write.metadata.emplace_back("TERRAPOLIS_RIVER_POWER", std::to_string(request.river.power));
+      write.metadata.emplace_back("TERRAPOLIS_RIVER_DROP_M", std::to_string(request.river.bed_drop_m));
+    }
     write_raster(out, terrain.dem, write);
     if (skeleton_method) {
       write_vector(skeleton_out, generate::river_ridge_layer(terrain.plan, terrain.dem.georef(), grid_.cell_m));
