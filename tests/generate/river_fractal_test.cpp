@@ -15,6 +15,7 @@
 #include "core/neighbours.hpp"
 #include "core/progress.hpp"
 #include "generate/generators.hpp"
+#include "generate/distance_field.hpp"
 #include "generate/river_fractal.hpp"
 #include "hydro/hydro.hpp"
 
@@ -150,4 +151,55 @@ TEST(RiverFractal, SameSeedSameBytesWhateverTheThreads) {
   ASSERT_EQ(one.size(), two.size());
   EXPECT_EQ(std::memcmp(one.data(), two.data(), one.size() * sizeof(float)), 0);
   EXPECT_NE(std::memcmp(one.data(), other.data(), one.size() * sizeof(float)), 0);
+}
+
+TEST(RiverFractal, WithoutNoiseEveryCellIsItsEquation) {
+  // S = 0: no displacement, so each computed cell is exactly eq. 1.3 (river vertices) or its
+  // parents' mean (the others), raised to the river cells it touches; checked against the
+  // formulas, the parents read from the result (each cell is set once).
+  const int cols = 129, rows = 97;
+  const Necklace n = mandelbrot_necklace(cols, rows, 7);
+  Raster<float> dem(cols, rows, Georef{}, std::numeric_limits<float>::quiet_NaN());
+  RiverFractalParams p;
+  p.top_down.subdivision = terrain::Subdivision::diamond_square;
+  p.top_down.scale_m = 0;
+  p.relief_m = 1000;
+  p.bed_drop_m = 50;
+  p.convergence = 4;
+  river_fractal(dem, n, p);
+  std::vector<char> river(dem.size(), 0);
+  for (std::size_t k = 0; k < n.cells.size(); ++k) {
+    river[n.cells[k]] = 1;
+    EXPECT_FLOAT_EQ(dem[n.cells[k]], float(50.0 * (1.0 - double(n.edge_of_cell[k]) / double(n.line.size() - 1))));
+  }
+  std::vector<double> dist;
+  std::vector<std::size_t> nearest;
+  distance_to(river, cols, rows, dist, nearest);
+  const terrain::SubdivisionTree tree(cols, rows);
+  const double r_max = 8;  // ceil(log2 129)
+  int vertices = 0;
+  for (int y = 0; y < rows; ++y)
+    for (int x = 0; x < cols; ++x) {
+      const std::size_t i = dem.index(x, y);
+      const bool corner = (x == 0 || x == cols - 1) && (y == 0 || y == rows - 1);
+      if (river[i] || corner) continue;
+      int pc[4], pr[4];
+      double w[4];
+      const int k = tree.parents(terrain::Subdivision::diamond_square, x, y, pc, pr, w);
+      double m = 0;
+      for (int q = 0; q < k; ++q) m += w[q] * dem(pc[q], pr[q]);
+      const int r = tree.level(x, y);
+      double z = m;
+      if (n.river_vertex_level[i] == r) {
+        const double b = dem[nearest[i]];
+        z = std::max(b, b + std::pow(1.0 - r / r_max, 4.0) * (m - b));
+        ++vertices;
+      }
+      float bank = -std::numeric_limits<float>::infinity();
+      for (int d = 0; d < 8; ++d)
+        if (dem.inside(x + dcol[std::size_t(d)], y + drow[std::size_t(d)]) && river[dem.index(x + dcol[std::size_t(d)], y + drow[std::size_t(d)])])
+          bank = std::max(bank, dem(x + dcol[std::size_t(d)], y + drow[std::size_t(d)]));
+      ASSERT_FLOAT_EQ(dem[i], std::max(float(z), bank)) << x << "," << y;
+    }
+  EXPECT_GT(vertices, 10);
 }
