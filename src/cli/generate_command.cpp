@@ -44,6 +44,8 @@ constexpr Method kMethods[] = {
     {"tectonic", generate::generate_tectonic},
     {"coast", generate::generate_coast},
     {"planar", generate::generate_planar},
+    {"window", generate::generate_window},
+    {"river", generate::generate_river},
 };
 
 std::string method_names() {
@@ -74,14 +76,15 @@ class GenerateCommand final : public Command {
   void setup(CLI::App& app) override {
     app_ = &app;
     file_kind(app.add_option("OUT", output_, "Output GeoTIFF (float32 heights in metres)")->required(), FileKind::raster_out);
-    grid_.add(app, true, "dmmc: an unreferenced grid with its corner at 0,0; the other methods: ETRS89-LAEA Europe, "
+    grid_.add(app, true, "dmmc, window: an unreferenced grid with its corner at 0,0; the other methods: ETRS89-LAEA Europe, "
                          "EPSG:3035, the grid centred on 52N 10E");
-    app.add_option("--method", method_, "Generator: " + method_names() + " (see docs/terrain.md)")->capture_default_str();
-    app.add_option("--relief", relief_m_, "flow, tectonic: height (m) of the highest crest above the outlets")
+    app.add_option("--method", method_, "Generator: " + method_names() + " (see docs/terrain.md; river defaults to the thesis's "
+                                         "--hurst 0.4565 and --roughness equal to --relief)")->capture_default_str();
+    app.add_option("--relief", relief_m_, "flow, tectonic, river: height (m) of the highest crest above the outlets (river: the north-west corner)")
         ->capture_default_str()->check(CLI::PositiveNumber);
     file_kind(app.add_option("--ridges", lines_path_, "flow: ridge lines (any OGR vector file of lines; default: random ridges from --seed)"), FileKind::vector_in);
     file_kind(app.add_option("--mountains", points_path_, "tectonic: mountain points, one plate each (any OGR vector file of points; default: random)"), FileKind::vector_in);
-    file_kind(app.add_option("--constraints", sketch_, "dmmc: sketch raster: cells with a value are fixed heights (m), nodata cells are generated. "
+    file_kind(app.add_option("--constraints", sketch_, "dmmc, window: sketch raster: cells with a value are fixed heights (m), nodata cells are generated. "
                                              "Warped onto the grid if it has a CRS, else it must have the grid's size"), FileKind::raster_in);
     options_.add(app, false, 1000.0);
     skeleton_options_.add(app);
@@ -93,13 +96,19 @@ class GenerateCommand final : public Command {
     for (const auto& m : kMethods)
       if (method_ == m.name) method = &m;
     if (!method) throw bad_input("--method: unknown generator '" + method_ + "' (expected " + method_names() + ")");
-    const bool skeleton_method = method_ != "dmmc";
-    if (skeleton_method && !sketch_.empty()) throw bad_input("--constraints: only --method dmmc takes a sketch");
+    // dmmc and window fill a sketch; the others build a skeleton and write it with its report.
+    const bool skeleton_method = method_ != "dmmc" && method_ != "window";
+    if (skeleton_method && !sketch_.empty()) throw bad_input("--constraints: only --method dmmc and window take a sketch");
+    if (method_ == "window") check_window_options();
     if (!lines_path_.empty() && method_ != "flow") throw bad_input("--ridges: only --method flow takes ridge lines");
     if (!points_path_.empty() && method_ != "tectonic") throw bad_input("--mountains: only --method tectonic takes mountain points");
     if (skeleton_method && grid_.crs.empty()) default_local_grid();
     // Between a skeleton's cells the noise must stay below the relief it carves, or it makes pits.
     if (skeleton_method && app_->get_option("--roughness")->count() == 0) options_.roughness_m = 0.05 * relief_m_;
+    if (method_ == "river") {  // Belhadj §1.2.3.2: H = 0.4565 and s = 1, S = dim(T.a) s the whole altitude range
+      if (app_->get_option("--hurst")->count() == 0) options_.hurst = 0.4565;
+      if (app_->get_option("--roughness")->count() == 0) options_.roughness_m = relief_m_;
+    }
     terrain::FillParams params = options_.params();
     Raster<float> grid = grid_.make();
     OutputSet outputs("generate", {sketch_, lines_path_, points_path_, skeleton_options_.coast_path}, overwrite_);
@@ -122,6 +131,7 @@ class GenerateCommand final : public Command {
       std::size_t fixed = 0;
       for (std::size_t i = 0; i < grid.size(); ++i) fixed += std::isfinite(grid[i]) ? 1 : 0;
       context.log.info("generate: " + std::to_string(fixed) + " cells fixed by the sketch");
+      if (fixed == 0 && method_ == "window") throw bad_input(sketch_ + ": has no cell with a value (--method window grows from them)");
     }
     params.dmmc.low_pass = false;  // generation wants the fractal detail, not the smoothest surface
     generate::GenerateRequest request;
@@ -144,6 +154,11 @@ class GenerateCommand final : public Command {
     write.metadata = options_.metadata(false);
     write.metadata.emplace_back("TERRAPOLIS_GENERATOR", method_);
     if (skeleton_method) write.metadata.emplace_back("TERRAPOLIS_RELIEF_M", std::to_string(relief_m_));
+    if (method_ == "river") {
+      write.metadata.emplace_back("TERRAPOLIS_RIVER_CONVERGENCE", std::to_string(request.river.convergence));
+      write.metadata.emplace_back("TERRAPOLIS_RIVER_POWER", std::to_string(request.river.power));
+      write.metadata.emplace_back("TERRAPOLIS_RIVER_DROP_M", std::to_string(request.river.bed_drop_m));
+    }
     write_raster(out, terrain.dem, write);
     if (skeleton_method) {
       write_vector(skeleton_out, generate::river_ridge_layer(terrain.plan, terrain.dem.georef(), grid_.cell_m));
@@ -153,6 +168,12 @@ class GenerateCommand final : public Command {
   }
 
  private:
+  /// Alg. 1 is plain midpoint displacement from a sketch: no shaping, no bottom-up pass.
+  void check_window_options() const {
+    if (sketch_.empty()) throw bad_input("--method window: needs --constraints SKETCH.tif (the growing window grows from its cells)");
+    for (const char* name : {"--shape", "--shape-up", "--bottom-up"})
+      if (app_->get_option(name)->count() > 0) throw bad_input(std::string(name) + ": not used by --method window (Belhadj Alg. 1 has no shaping or bottom-up pass)");
+  }
   bool read_header_has_no_crs() const {
     try {
       (void)read_header(sketch_);

@@ -1,4 +1,4 @@
-// Options of `terrapolis generate --method coast | planar`. See generate_methods.hpp.
+// Options of `terrapolis generate --method coast | planar | river`. See generate_methods.hpp.
 // SPDX-License-Identifier: MIT
 #include "cli/generate_methods.hpp"
 
@@ -44,6 +44,13 @@ void CoastPlanarOptions::add(CLI::App& app) {
   app.add_option("--fractalisations", p.fractalisations, "planar: global fractalisations, x4 facets each")->capture_default_str()->check(CLI::Range(0, 7));
   app.add_option("--meander", p.meander, "planar: C_PONDERAL, pull of a new river vertex towards a facet centre (0: straight)")
       ->capture_default_str()->check(CLI::NonNegativeNumber);
+  auto& r = river;
+  app.add_option("--river-convergence", r.convergence, "river: I of Belhadj eq. 1.3, p = (1 - r/r_max)^I pulls the river vertices to the bed")
+      ->capture_default_str()->check(CLI::Range(1.0, 1000.0));
+  app.add_option("--river-power", r.power, "river: f of Belhadj eq. 1.2, the negative displacement -X S 2^(r^f - r D H) of the river vertices")
+      ->capture_default_str()->check(CLI::Range(0.0, 4.0));
+  river_drop = app.add_option("--river-drop", r.bed_drop_m, "river: fall (m) of the bed from the source to the mouth (default: 5 % of --relief)")
+                   ->check(CLI::NonNegativeNumber);
 }
 
 void CoastPlanarOptions::apply(generate::GenerateRequest& request) const {
@@ -58,6 +65,8 @@ void CoastPlanarOptions::apply(generate::GenerateRequest& request) const {
   request.coast.p_asymmetric = pa;
   request.planar = planar;
   request.planar.uniform_tree = tree_law == "uniform";
+  request.river = river;
+  if (river_drop->count() == 0) request.river.bed_drop_m = river_drop_share * request.relief_m;
 }
 
 }  // namespace terrapolis::cli

@@ -10,6 +10,7 @@
 #include "core/progress.hpp"
 #include "core/raster.hpp"
 #include "generate/planar_basins.hpp"
+#include "generate/river_fractal.hpp"
 #include "generate/river_grammar.hpp"
 #include "generate/river_ridge_plan.hpp"
 #include "terrain/subdivision.hpp"
@@ -27,6 +28,7 @@ struct GenerateRequest {
   std::vector<std::vector<GridPoint>> polygons;  ///< user polygon rings (coast: the land; empty: a seeded island)
   CoastParams coast;             ///< coast: Génévaux et al.'s parameters (seed taken from `seed`)
   PlanarParams planar;           ///< planar: the planar-maps chapter's parameters (seed taken from `seed`)
+  RiverFractalParams river;      ///< river: eq. 1.2-1.3 and the bed (top_down and relief taken from dmmc and relief_m)
   Progress* progress = nullptr;
 };
 

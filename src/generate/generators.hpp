@@ -21,4 +21,12 @@ GeneratedTerrain generate_coast(const GenerateRequest& request);
 /// ridge altitudes by linear programming, fractalised facets.
 GeneratedTerrain generate_planar(const GenerateRequest& request);
 
+/// Belhadj 2007 §2.1, Alg. 1 (growing_window.cpp): the sketch in request.grid (finite cells, kept
+/// exactly) dilated scale by scale by small midpoint displacements (request.dmmc.top_down).
+GeneratedTerrain generate_window(const GenerateRequest& request);
+
+/// Belhadj 2007 §1.2.3 (river_fractal.cpp): a Mandelbrot necklace from two sides of the grid, its
+/// edge labels in a binary search tree, and the midpoint displacement converging to its bed.
+GeneratedTerrain generate_river(const GenerateRequest& request);
+
 }  // namespace terrapolis::generate

@@ -34,7 +34,30 @@ cmp "$T/m.tif" "$T/m1.tif"
 from osgeo import gdal; import numpy as np, sys
 ds = gdal.Open('$T/m.tif'); a = ds.GetRasterBand(1).ReadAsArray()
 sys.exit(0 if np.all(a[48, 10:120] == 800) and np.isfinite(a).all() and ds.GetMetadataItem('TERRAPOLIS_BOTTOM_UP') == 'mean' else 1)"
+# The growing window (Belhadj Alg. 1) from the same sketch: the ridge kept exactly, same bytes at 1 thread.
+"$BIN" --quiet generate "$T/w.tif" --method window --size 129x97 --cell 30 --crs EPSG:32632 --origin 500000,5000000 --constraints "$T/sketch.tif" --roughness 100
+"$BIN" --quiet --threads 1 generate "$T/w1.tif" --method window --size 129x97 --cell 30 --crs EPSG:32632 --origin 500000,5000000 --constraints "$T/sketch.tif" --roughness 100
+cmp "$T/w.tif" "$T/w1.tif"
+/usr/bin/python3 -c "
+from osgeo import gdal; import numpy as np, sys
+ds = gdal.Open('$T/w.tif'); a = ds.GetRasterBand(1).ReadAsArray()
+sys.exit(0 if np.all(a[48, 10:120] == 800) and np.isfinite(a).all() and ds.GetMetadataItem('TERRAPOLIS_GENERATOR') == 'window' else 1)"
+/usr/bin/python3 - "$T/empty_sketch.tif" <<'PY'
+import sys
+import numpy as np
+from osgeo import gdal, osr
+ds = gdal.GetDriverByName("GTiff").Create(sys.argv[1], 129, 97, 1, gdal.GDT_Float32)
+ds.SetGeoTransform((500000, 30, 0, 5000000, 0, -30))
+s = osr.SpatialReference(); s.ImportFromEPSG(32632); ds.SetProjection(s.ExportToWkt())
+b = ds.GetRasterBand(1); b.SetNoDataValue(-1); b.WriteArray(np.full((97, 129), -1, np.float32)); ds = None
+PY
 set +e
+"$BIN" generate "$T/bad.tif" --method window --size 65x65 --cell 30 2>"$T/err"; rc=$?
+[ $rc -eq 2 ] && [ $(wc -l <"$T/err") -eq 1 ] && grep -q -- "--method window: needs --constraints" "$T/err" && [ ! -e "$T/bad.tif" ] || { echo "window without sketch: rc=$rc"; cat "$T/err"; exit 1; }
+"$BIN" generate "$T/bad.tif" --method window --size 129x97 --cell 30 --crs EPSG:32632 --origin 500000,5000000 --constraints "$T/empty_sketch.tif" 2>"$T/err"; rc=$?
+[ $rc -eq 2 ] && grep -q "has no cell with a value" "$T/err" && [ ! -e "$T/bad.tif" ] || { echo "window, empty sketch: rc=$rc"; cat "$T/err"; exit 1; }
+"$BIN" generate "$T/bad.tif" --method window --size 129x97 --cell 30 --crs EPSG:32632 --origin 500000,5000000 --constraints "$T/sketch.tif" --shape 2 2>"$T/err"; rc=$?
+[ $rc -eq 2 ] && grep -q -- "--shape: not used by --method window" "$T/err" && [ ! -e "$T/bad.tif" ] || { echo "window with --shape: rc=$rc"; cat "$T/err"; exit 1; }
 "$BIN" generate "$T/bad.tif" --size 65x65 --cell 30 --bottom-up mean --shape-up 1 2>"$T/err"; rc=$?
 [ $rc -eq 2 ] && grep -q -- "--shape-up: needs --bottom-up weighted" "$T/err" && [ ! -e "$T/bad.tif" ] || { echo "mean with shape-up: rc=$rc"; cat "$T/err"; exit 1; }
 "$BIN" generate "$T/bad.tif" --size 65x65 --cell 30 --bottom-up thesis 2>"$T/err"; rc=$?

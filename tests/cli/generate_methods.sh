@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# terrapolis generate --method flow | tectonic | coast | planar: the DEM holds the generator's rivers. The report's
+# terrapolis generate --method flow | tectonic | coast | planar | river: the DEM holds the generator's rivers. The report's
 # figures must be in range, and an independent check (Python, on `terrapolis hydro`'s own streams
 # and the skeleton GeoJSON) must find the same consistency. Same seed, same bytes at any thread count.
 set -euo pipefail
@@ -85,6 +85,29 @@ done
 # A different seed gives a different region.
 "$BIN" --quiet generate "$T/other.tif" --method flow --size 257x257 --cell 30 --seed 4
 ! cmp -s "$T/flow.tif" "$T/other.tif"
+# The one-river fractal (Belhadj §1.2.3): same bytes at 1 thread, one river into no pit, every river
+# cell draining into the river, D8 streams along it, the thesis's H by default.
+"$BIN" --quiet generate "$T/river.tif" --method river --size 257x257 --cell 30 --seed 2
+"$BIN" --quiet --threads 1 generate "$T/river1.tif" --method river --size 257x257 --cell 30 --seed 2
+cmp "$T/river.tif" "$T/river1.tif"
+cmp "$T/river.skeleton.geojson" "$T/river1.skeleton.geojson"
+cmp "$T/river.report.json" "$T/river1.report.json"
+/usr/bin/python3 - "$T/river" <<'PY'
+import json, sys
+from osgeo import gdal
+base = sys.argv[1]
+r = json.load(open(base + ".report.json")); f = r["figures"]
+ds = gdal.Open(base + ".tif")
+problems = []
+if r["river_reaches"] != 1 or r["d8_consistency"]["mouths_ending_in_pit"] != 0: problems.append("reaches or pits: %s" % r)
+if f["river_cells_draining_into_river_share"] < 0.99: problems.append("draining share %s" % f)
+if f["river_line_within_1_cell_of_d8_stream_share"] < 0.85: problems.append("stream share %s" % f)
+if ds.GetMetadataItem("TERRAPOLIS_HURST") != "0.456500" or ds.GetMetadataItem("TERRAPOLIS_GENERATOR") != "river": problems.append("metadata")
+if problems:
+    print(base + ": " + "; ".join(problems)); sys.exit(1)
+PY
+"$BIN" --quiet generate "$T/river_other.tif" --method river --size 257x257 --cell 30 --seed 3
+! cmp -s "$T/river.tif" "$T/river_other.tif"
 # Ridges given as lines: the flow method follows them.
 /usr/bin/python3 - "$T/ridges.geojson" <<'PY'
 import json, sys
@@ -110,6 +133,10 @@ set +e
 [ $rc -eq 2 ] && grep -q -- "--method" "$T/err" && [ ! -e "$T/bad.tif" ] || { echo "bad method: rc=$rc"; cat "$T/err"; exit 1; }
 "$BIN" generate "$T/bad.tif" --method tectonic --size 65x65 --cell 30 --ridges "$T/ridges.geojson" 2>"$T/err"; rc=$?
 [ $rc -eq 2 ] && grep -q -- "--ridges" "$T/err" && [ ! -e "$T/bad.tif" ] || { echo "ridges for tectonic: rc=$rc"; cat "$T/err"; exit 1; }
+"$BIN" generate "$T/bad.tif" --method river --size 2x65 --cell 30 2>"$T/err"; rc=$?
+[ $rc -eq 2 ] && [ $(wc -l <"$T/err") -eq 1 ] && grep -q -- "--size: the river method needs 3 to 65535 cells" "$T/err" && [ ! -e "$T/bad.tif" ] && [ ! -e "$T/bad.report.json" ] || { echo "river, thin grid: rc=$rc"; cat "$T/err"; exit 1; }
+"$BIN" generate "$T/bad.tif" --method river --size 65x65 --cell 30 --river-convergence 0 2>"$T/err"; rc=$?
+[ $rc -eq 2 ] && grep -q -- "--river-convergence" "$T/err" && [ ! -e "$T/bad.tif" ] || { echo "river, bad convergence: rc=$rc"; cat "$T/err"; exit 1; }
 echo '{"type":"FeatureCollection","features":[]}' > "$T/empty.geojson"
 "$BIN" generate "$T/bad.tif" --method flow --size 65x65 --cell 30 --ridges "$T/empty.geojson" 2>"$T/err"; rc=$?
 [ $rc -eq 2 ] && grep -q "empty.geojson" "$T/err" && [ ! -e "$T/bad.tif" ] && [ ! -e "$T/bad.skeleton.geojson" ] || { echo "empty ridges: rc=$rc"; cat "$T/err"; exit 1; }
