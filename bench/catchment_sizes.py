@@ -7,8 +7,10 @@ nearest settlement centre (catchments), and candidate size models are scored wit
 on the region runs, plus the default run's largest on the bundled DEM (run_default).
 Models: the fixed rank-size law as run; pure catchments (sizes proportional to M^gamma, Bettencourt
 2007's agglomeration exponent gamma); the rank-size law over the same settlements with its exponent
-read from the catchments of 1,000 or more (sites.sizes = catchment); the default run also with the
-settled share of the people (sites.urban_share). Scores only: no parameter is fitted here.
+read from the catchments of 1,000 or more (sites.sizes = catchment); the density-mass law (issue 30:
+sizes proportional to the density mass within R = 5 or 10 km of each centre, to the power gamma,
+overlaps counted for each); the default run also with the settled share of the people
+(sites.urban_share). Scores only: no parameter is fitted here.
 Usage: bench/catchment_sizes.py KEPT_DIR  (the runs realism.sh kept, made with sites.sizes = rank_size)"""
 import glob
 import json
@@ -47,7 +49,12 @@ def catchments(run):
     lat0 = np.radians(np.mean(y))
     metric = (lambda a, b: np.c_[a * 111320 * np.cos(lat0), b * 110574]) if geo else (lambda a, b: np.c_[a, b])
     _, nearest = cKDTree(metric(pts[:, 0], pts[:, 1])).query(metric(x, y))
-    return np.bincount(nearest, weights=w, minlength=len(pts)) / w.sum(), s, [f["properties"]["population"] for f in cities]
+    masses = {"catchment": np.bincount(nearest, weights=w, minlength=len(pts)) / w.sum()}
+    cells = cKDTree(metric(x, y))
+    for r_km in (5, 10):  # the density-mass law: the people within r_km of each centre
+        within = cells.query_ball_point(metric(pts[:, 0], pts[:, 1]), r_km * 1000.0)
+        masses[f"{r_km} km"] = np.array([w[i].sum() for i in within]) / w.sum()
+    return masses, s, [f["properties"]["population"] for f in cities]
 
 
 def law_from_catchments(shares, settled, m=1000):
@@ -58,16 +65,21 @@ def law_from_catchments(shares, settled, m=1000):
 
 
 runs = {p.split("/run_")[-1]: catchments(p) for p in sorted(glob.glob(f"{sys.argv[1]}/run_*"))}
-models = {"rank-size law as run (q = 1)": lambda M, T, pops: np.array(pops, float)}
+models = {"rank-size law as run (q = 1)": ("catchment", lambda M, T, pops: np.array(pops, float))}
 for g in (0.8, 1.0, 1.2, 1.4):
-    models[f"catchments, M^{g}"] = lambda M, T, pops, g=g: T * M ** g / np.sum(M ** g)
-models["law, q from the catchments (sites.sizes = catchment)"] = lambda M, T, pops: law_from_catchments(M, T)
+    models[f"catchments, M^{g}"] = ("catchment", lambda M, T, pops, g=g: T * M ** g / np.sum(M ** g))
+models["law, q from the catchments (sites.sizes = catchment)"] = ("catchment", lambda M, T, pops: law_from_catchments(M, T))
+for r_km in (5, 10):
+    for g in (1.0, 1.5, 2.0):
+        models[f"density mass within {r_km} km, M^{g}"] = (f"{r_km} km", lambda M, T, pops, g=g: T * M ** g / np.sum(M ** g))
+    models[f"law, q from the masses within {r_km} km"] = (f"{r_km} km", lambda M, T, pops: law_from_catchments(M, T))
 print("| model | count within x1.5 | largest within x2 | exponent within 0.25 | default run: largest / 5,552 (urban_share 1, 0.55) |")
 print("|---|---|---|---|---|")
-for label, model in models.items():
+for label, (mass, model) in models.items():
     bars = [0, 0, 0]
     default = []
-    for name, (M, s, pops) in runs.items():
+    for name, (masses, s, pops) in runs.items():
+        M = masses[mass]
         ref = s["realism"]
         for share in ((1.0, 0.55) if name == "default" else (1.0,)):
             sizes = sorted((p for p in model(M, share * s["sites"]["target_population"], pops) if p >= 1000), reverse=True)

@@ -27,6 +27,7 @@
 #include "pipeline/places.hpp"
 #include "pipeline/scenario.hpp"
 #include "pipeline/stage_options.hpp"
+#include "pipeline/stages.hpp"
 #include "sites/sites.hpp"
 
 namespace terrapolis::cli {
@@ -296,11 +297,15 @@ class CalibrateCommand final : public Command {
   Region load_region(const std::string& dem_path, const std::string& places_path, const pipeline::Scenario& scenario, double min_population,
                      Context& context) {
     const Dem dem = dem_.read(dem_path);
-    hydro::HydroResult hydro = hydro::run_hydro(dem, pipeline::hydro_options(scenario), context.progress);
+    // The terms a run's density reads: the same hydrometry, rivers and inland water (the lakes the
+    // DEM flattens, water.water_mask, the reservoirs), so that the fitted weights are the run's.
+    pipeline::HydroForDensity hydro = pipeline::hydro_for_density(scenario, dem, pipeline::inland_water_settings(scenario),
+                                                                  pipeline::hydro_options(scenario), true, true, context.progress, context.log);
     density::DensityOptions options = pipeline::density_options(scenario);
-    pipeline::read_density_files(scenario, dem, scenario.path("/water/water_mask"), options);
+    pipeline::read_density_files(scenario, dem, "", options);
+    options.water_mask = std::move(hydro.water);
     options.terrain_terms = true;
-    options.rivers = pipeline::river_cells(hydro.accumulation, scenario);
+    options.rivers = std::move(*hydro.rivers);
     const density::DensityResult model = density::compute_density(dem, hydro.hydrometry, options, context.progress);
     const std::vector<std::uint8_t> land = density::land_cells(model);
     Region r;
