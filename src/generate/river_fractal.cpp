@@ -3,9 +3,6 @@
 // SPDX-License-Identifier: MIT
 #include "generate/river_fractal.hpp"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -275,27 +272,7 @@ void river_fractal(Raster<float>& raster, const Necklace& necklace, const RiverF
     grid.z[i] = std::max(float(z), bank[i]);
     grid.state[i] = terrain::CellState::known;
   };
-  const auto& ax = tree.x();
-  const auto& ay = tree.y();
-  std::vector<int> lattice_x = ax.created[0], lattice_y = ay.created[0];
-  for (int level = 1; level <= tree.levels(); ++level) {
-    const auto& new_x = ax.created[std::size_t(level)];
-    const auto& new_y = ay.created[std::size_t(level)];
-    // As terrain::midpoint_displacement: centres, then edge midpoints; each reads earlier cells only.
-    auto rows_of = [&](const std::vector<int>& ys, const std::vector<int>& xs) {
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ys.size()), [&](const tbb::blocked_range<std::size_t>& b) {
-        for (std::size_t j = b.begin(); j != b.end(); ++j)
-          for (const int col : xs) compute(col, ys[j]);
-      });
-    };
-    rows_of(new_y, new_x);
-    rows_of(new_y, lattice_x);
-    rows_of(lattice_y, new_x);
-    lattice_x.insert(lattice_x.end(), new_x.begin(), new_x.end());
-    std::sort(lattice_x.begin(), lattice_x.end());
-    lattice_y.insert(lattice_y.end(), new_y.begin(), new_y.end());
-    std::sort(lattice_y.begin(), lattice_y.end());
-  }
+  terrain::for_each_created_cell(tree, compute);  // as terrain::midpoint_displacement
   raster.values() = std::move(grid.z);
 }
 

@@ -156,6 +156,30 @@ int SubdivisionTree::parents(Subdivision scheme, int col, int row, int (&pc)[4],
   return n;
 }
 
+void for_each_created_cell(const SubdivisionTree& tree, const std::function<void(int, int)>& visit,
+                           const std::function<void(int)>& level_done) {
+  const auto rows_of = [&](const std::vector<int>& ys, const std::vector<int>& xs) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ys.size()), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t j = r.begin(); j != r.end(); ++j)
+        for (const int col : xs) visit(col, ys[j]);
+    });
+  };
+  // Lattice coordinates (created at or before a level) per axis, grown level by level.
+  std::vector<int> lattice_x = tree.x().created[0], lattice_y = tree.y().created[0];
+  for (int level = 1; level <= tree.levels(); ++level) {
+    const auto& new_x = tree.x().created[std::size_t(level)];
+    const auto& new_y = tree.y().created[std::size_t(level)];
+    rows_of(new_y, new_x);      // square step: rectangle centres
+    rows_of(new_y, lattice_x);  // edge step: midpoints of the edges
+    rows_of(lattice_y, new_x);
+    lattice_x.insert(lattice_x.end(), new_x.begin(), new_x.end());
+    std::sort(lattice_x.begin(), lattice_x.end());
+    lattice_y.insert(lattice_y.end(), new_y.begin(), new_y.end());
+    std::sort(lattice_y.begin(), lattice_y.end());
+    if (level_done) level_done(level);
+  }
+}
+
 void midpoint_displacement(SubdivisionGrid& grid, const MidpointParams& params, Progress* progress) {
   const int cols = grid.cols, rows = grid.rows;
   if (cols < 1 || rows < 1) return;
@@ -195,33 +219,9 @@ void midpoint_displacement(SubdivisionGrid& grid, const MidpointParams& params, 
     grid.z[i] = float(shape_curve(a, d, d_max, params.shape) + displacement(col, row, tree.level(col, row)));
     grid.state[i] = CellState::known;
   };
-  const auto& ax = tree.x();
-  const auto& ay = tree.y();
-  // Lattice coordinates (created at or before a level) per axis, grown level by level.
-  std::vector<int> lattice_x = ax.created[0], lattice_y = ay.created[0];
-  for (int level = 1; level <= tree.levels(); ++level) {
-    const auto& new_x = ax.created[std::size_t(level)];
-    const auto& new_y = ay.created[std::size_t(level)];
-    // Square step: rectangle centres. Each cell depends only on earlier levels, so rows run in parallel.
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, new_y.size()), [&](const tbb::blocked_range<std::size_t>& r) {
-      for (std::size_t j = r.begin(); j != r.end(); ++j)
-        for (const int col : new_x) compute(col, new_y[j]);
-    });
-    // Edge step: midpoints of the edges (they may read this level's centres).
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, new_y.size()), [&](const tbb::blocked_range<std::size_t>& r) {
-      for (std::size_t j = r.begin(); j != r.end(); ++j)
-        for (const int col : lattice_x) compute(col, new_y[j]);
-    });
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, lattice_y.size()), [&](const tbb::blocked_range<std::size_t>& r) {
-      for (std::size_t j = r.begin(); j != r.end(); ++j)
-        for (const int col : new_x) compute(col, lattice_y[j]);
-    });
-    lattice_x.insert(lattice_x.end(), new_x.begin(), new_x.end());
-    std::sort(lattice_x.begin(), lattice_x.end());
-    lattice_y.insert(lattice_y.end(), new_y.begin(), new_y.end());
-    std::sort(lattice_y.begin(), lattice_y.end());
+  for_each_created_cell(tree, compute, [&](int level) {
     if (step) step->update(double(level) / double(tree.levels()));
-  }
+  });
 }
 
 namespace {

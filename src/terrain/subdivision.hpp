@@ -2,6 +2,7 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "core/progress.hpp"
@@ -97,6 +98,13 @@ class SubdivisionTree {
   Axis x_, y_;
   int levels_ = 0;
 };
+
+/// Visits every cell the tree creates after the corners in midpoint displacement's order: per level
+/// the rectangle centres, then the edge midpoints (which may read those centres); the rows of one
+/// step in parallel, each cell reading earlier steps only, so any thread count gives the same
+/// cells. `level_done(level)` after each level (progress).
+void for_each_created_cell(const SubdivisionTree& tree, const std::function<void(int col, int row)>& visit,
+                           const std::function<void(int level)>& level_done = {});
 
 /// Top-down constrained midpoint displacement: computes every unknown cell from its parents, level
 /// by level, keeping known and constrained cells (Belhadj §1.1.1, `dm`/`dmm` of Alg. 10/11 with the
