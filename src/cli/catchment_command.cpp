@@ -72,7 +72,15 @@ class CatchmentCommand final : public Command {
     const auto d8 = d8_directions(filled, metrics, sea, context.progress);
     const FlowRouter router(filled, d8, metrics, FlowMethod::d8);
     const auto area = accumulate(filled, router, metrics, {}, context.progress);
-    const Catchment c = delineate_catchment(d8, area, metrics, x, y, snap_m_, context.progress);
+    const Catchment c = [&] {
+      try {
+        return delineate_catchment(d8, area, metrics, x, y, snap_m_, context.progress);
+      } catch (const Error& e) {  // the module names its inputs; this command knows them by its flags
+        std::string m = e.what();
+        if (m.starts_with("outlet: ")) m = "--" + m;
+        throw Error(e.kind(), m);
+      }
+    }();
     write_vector(out, c.polygon);
     if (!mask.empty()) {
       WriteOptions w;

@@ -105,13 +105,13 @@ Raster<std::uint32_t> drainage_basins(const Raster<std::uint8_t>& d8) {
 
 Catchment delineate_catchment(const Raster<std::uint8_t>& d8, const Raster<double>& area, const CellMetrics& metrics,
                               double x, double y, double snap_radius_m, Progress& progress) {
-  if (!(snap_radius_m >= 0) || !std::isfinite(snap_radius_m)) throw bad_input("--snap-radius: must be >= 0 metres");
+  if (!(snap_radius_m >= 0) || !std::isfinite(snap_radius_m)) throw bad_input("snap radius: must be >= 0 metres");
   ProgressStep step(progress, "catchment");
   const GridLocator locator(d8.georef());
   const auto px = locator.crs_to_pixel(x, y);
   const int pc = int(std::floor(px[0])), pr = int(std::floor(px[1]));
   if (!std::isfinite(px[0]) || !d8.inside(pc, pr))
-    throw bad_input("--outlet: the point is outside the DEM");
+    throw bad_input("outlet: the point is outside the DEM");
   // Snap: highest upstream area within the radius (ties: lowest row, then column).
   const double cell_min = std::min(metrics.width_m[std::size_t(pr)], metrics.height_m[std::size_t(pr)]);
   const int reach = int(std::ceil(snap_radius_m / cell_min)) + 1;
@@ -131,7 +131,7 @@ Catchment delineate_catchment(const Raster<std::uint8_t>& d8, const Raster<doubl
         best_r = r;
       }
     }
-  if (best_c < 0) throw bad_input("--outlet: no valid DEM cell within the snap radius of the point");
+  if (best_c < 0) throw bad_input("outlet: no valid DEM cell within the snap radius of the point");
   Catchment out;
   out.outlet_col = best_c;
   out.outlet_row = best_r;

@@ -20,7 +20,7 @@ ones=$(gdalinfo -hist "$work/vt_mask.tif" | awk '/buckets/ {getline; print $2}')
 "$bin" -q catchment "$dem" --outlet 675807,4885699 --outlet-crs dem --snap-radius 0 "$work/utm.geojson"
 cmp <(ogrinfo -al "$work/vt.geojson" | grep -E "area_km2|cells") <(ogrinfo -al "$work/utm.geojson" | grep -E "area_km2|cells")
 
-expect_fail 2 "outside the DEM" "$bin" -q catchment "$dem" --outlet 10,10 "$work/bad1.geojson"
+expect_fail 2 "error: --outlet: the point is outside the DEM" "$bin" -q catchment "$dem" --outlet 10,10 "$work/bad1.geojson"
 [[ ! -e $work/bad1.geojson ]]
 expect_fail 2 "--outlet" "$bin" -q catchment "$dem" --outlet abc "$work/bad2.geojson"
 expect_fail 2 "geojson" "$bin" -q catchment "$dem" --outlet=-72.8,44.1 "$work/bad3.shp"
