@@ -28,7 +28,7 @@ generate::GeneratedTerrain generate_dmmc(const generate::GenerateRequest& reques
   generate::GeneratedTerrain out;
   out.dem = request.grid;
   const auto t0 = std::chrono::steady_clock::now();
-  terrain::dmmc(out.dem, request.dmmc, request.progress);
+  terrain::dmmc(out.dem, request.dmmc, request.progress, request.labels);
   out.timings.emplace_back("dmmc", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   return out;
 }
@@ -86,6 +86,9 @@ class GenerateCommand final : public Command {
     file_kind(app.add_option("--mountains", points_path_, "tectonic: mountain points, one plate each (any OGR vector file of points; default: random)"), FileKind::vector_in);
     file_kind(app.add_option("--constraints", sketch_, "dmmc, window: sketch raster: cells with a value are fixed heights (m), nodata cells are generated. "
                                              "Warped onto the grid if it has a CRS, else it must have the grid's size"), FileKind::raster_in);
+    file_kind(app.add_option("--labels", labels_path_, "dmmc: which way each sketch cell extrapolates in the bottom-up pass (Belhadj §5.1.1): "
+                                                     "1 river (up, I_-1 = -|shape-up|), 2 ridge (down, +|shape-up|), 0 or nodata --shape-up as given. "
+                                                     "Same grid rules as --constraints"), FileKind::raster_in);
     options_.add(app, false, 1000.0);
     skeleton_options_.add(app);
     add_overwrite_flag(app, overwrite_);
@@ -111,23 +114,15 @@ class GenerateCommand final : public Command {
     }
     terrain::FillParams params = options_.params();
     Raster<float> grid = grid_.make();
-    OutputSet outputs("generate", {sketch_, lines_path_, points_path_, skeleton_options_.coast_path}, overwrite_);
+    check_labels_options();
+    OutputSet outputs("generate", {sketch_, labels_path_, lines_path_, points_path_, skeleton_options_.coast_path}, overwrite_);
     const std::string out = outputs.file(output_);
     const std::string skeleton_out = skeleton_method ? outputs.file(stem_of(output_) + ".skeleton.geojson") : "";
     const std::string report_out = skeleton_method ? outputs.file(stem_of(output_) + ".report.json") : "";
+    std::vector<terrain::ExtrapolationLabel> labels;
+    if (!labels_path_.empty()) labels = read_labels(grid);
     if (!sketch_.empty()) {
-      const RasterHeader header = read_header(sketch_, ReadOptions{std::nullopt, std::string("EPSG:4326")});
-      Raster<float> sketch;
-      const bool sketch_has_crs = !read_header_has_no_crs();
-      if (!grid.georef().crs.empty() && sketch_has_crs) {
-        sketch = read_resampled(sketch_, grid.georef(), grid.cols(), grid.rows(), Resampling::nearest);
-      } else {
-        if (header.cols != grid.cols() || header.rows != grid.rows())
-          throw bad_input(sketch_ + ": is " + std::to_string(header.cols) + "x" + std::to_string(header.rows) +
-                          " cells but the grid is " + grid_.size + " and one of them has no CRS to warp it");
-        sketch = read_sketch_pixels();
-      }
-      grid.values() = sketch.values();
+      grid.values() = read_on_grid(sketch_, grid).values();
       std::size_t fixed = 0;
       for (std::size_t i = 0; i < grid.size(); ++i) fixed += std::isfinite(grid[i]) ? 1 : 0;
       context.log.info("generate: " + std::to_string(fixed) + " cells fixed by the sketch");
@@ -139,6 +134,7 @@ class GenerateCommand final : public Command {
     request.seed = options_.seed;
     request.relief_m = relief_m_;
     request.dmmc = params.dmmc;
+    request.labels = std::move(labels);
     request.progress = &context.progress;
     if (!lines_path_.empty()) request.lines = read_lines(lines_path_, grid.georef());
     if (!points_path_.empty()) request.points = read_points(points_path_, grid.georef());
@@ -153,6 +149,7 @@ class GenerateCommand final : public Command {
     write.description = "generated elevation (m)";
     write.metadata = options_.metadata(false);
     write.metadata.emplace_back("TERRAPOLIS_GENERATOR", method_);
+    if (!request.labels.empty()) write.metadata.emplace_back("TERRAPOLIS_LABELS", labels_summary(request.labels));
     if (skeleton_method) write.metadata.emplace_back("TERRAPOLIS_RELIEF_M", std::to_string(relief_m_));
     if (method_ == "river") {
       write.metadata.emplace_back("TERRAPOLIS_RIVER_CONVERGENCE", std::to_string(request.river.convergence));
@@ -174,22 +171,62 @@ class GenerateCommand final : public Command {
     for (const char* name : {"--shape", "--shape-up", "--bottom-up"})
       if (app_->get_option(name)->count() > 0) throw bad_input(std::string(name) + ": not used by --method window (Belhadj Alg. 1 has no shaping or bottom-up pass)");
   }
-  bool read_header_has_no_crs() const {
+  /// §5.1.1's labels shape the weighted extrapolation of a sketch by |I_-1|: they need all three.
+  void check_labels_options() const {
+    if (labels_path_.empty()) return;
+    if (method_ != "dmmc") throw bad_input("--labels: only --method dmmc takes labels (its bottom-up pass uses them)");
+    if (sketch_.empty()) throw bad_input("--labels: needs --constraints SKETCH.tif (the labels are of its cells)");
+    if (options_.bottom_up != "weighted") throw bad_input("--labels: needs --bottom-up weighted (Belhadj Alg. 10 has no extrapolation shaping)");
+    if (options_.shape_up == 0.0) throw bad_input("--labels: needs --shape-up I (labelled cells extrapolate with |I|, up or down)");
+  }
+  /// The labels raster on the grid: 0 or nodata global, 1 river, 2 ridge; any other value is refused.
+  std::vector<terrain::ExtrapolationLabel> read_labels(const Raster<float>& grid) const {
+    const Raster<float> values = read_on_grid(labels_path_, grid);
+    std::vector<terrain::ExtrapolationLabel> labels(values.size(), terrain::ExtrapolationLabel::global);
+    for (std::size_t i = 0; i < values.size(); ++i) {
+      const float v = values[i];
+      if (!std::isfinite(v) || v == 0.0f) continue;
+      if (v != 1.0f && v != 2.0f)
+        throw bad_input(labels_path_ + ": cell " + std::to_string(i % std::size_t(values.cols())) + "," + std::to_string(i / std::size_t(values.cols())) +
+                        " holds " + std::to_string(v) + "; expected 0, 1 (river) or 2 (ridge)");
+      labels[i] = v == 1.0f ? terrain::ExtrapolationLabel::river : terrain::ExtrapolationLabel::ridge;
+    }
+    return labels;
+  }
+  static std::string labels_summary(const std::vector<terrain::ExtrapolationLabel>& labels) {
+    std::size_t river = 0, ridge = 0;
+    for (const auto l : labels) {
+      river += l == terrain::ExtrapolationLabel::river ? 1 : 0;
+      ridge += l == terrain::ExtrapolationLabel::ridge ? 1 : 0;
+    }
+    return std::to_string(river) + " river cells, " + std::to_string(ridge) + " ridge cells";
+  }
+  /// A raster given for the grid: warped (nearest) if both have a CRS, else read as is, and then
+  /// it must have the grid's size.
+  Raster<float> read_on_grid(const std::string& path, const Raster<float>& grid) const {
+    const RasterHeader header = read_header(path, ReadOptions{std::nullopt, std::string("EPSG:4326")});
+    if (!grid.georef().crs.empty() && !has_no_crs(path)) return read_resampled(path, grid.georef(), grid.cols(), grid.rows(), Resampling::nearest);
+    if (header.cols != grid.cols() || header.rows != grid.rows())
+      throw bad_input(path + ": is " + std::to_string(header.cols) + "x" + std::to_string(header.rows) +
+                      " cells but the grid is " + grid_.size + " and one of them has no CRS to warp it");
+    return read_pixels(path);
+  }
+  static bool has_no_crs(const std::string& path) {
     try {
-      (void)read_header(sketch_);
+      (void)read_header(path);
       return false;
     } catch (const Error&) {
       return true;  // read_header refuses a file without a CRS; the assumed-CRS read above proved it is readable
     }
   }
-  Raster<float> read_sketch_pixels() const {
+  static Raster<float> read_pixels(const std::string& path) {
     ReadOptions read;
     read.assume_crs = "EPSG:4326";  // only the pixel values are used
     try {
-      return read_dem(sketch_, read);
+      return read_dem(path, read);
     } catch (const Error& e) {
       // A sketch may hold nothing but nodata; everything is then generated.
-      const RasterHeader header = read_header(sketch_, read);
+      const RasterHeader header = read_header(path, read);
       Raster<float> empty(header.cols, header.rows, header.georef, std::numeric_limits<float>::quiet_NaN());
       if (std::string(e.what()).find("no data") != std::string::npos) return empty;
       throw;
@@ -251,7 +288,7 @@ class GenerateCommand final : public Command {
     return points;
   }
 
-  std::string output_, sketch_, lines_path_, points_path_, method_ = "dmmc";
+  std::string output_, sketch_, labels_path_, lines_path_, points_path_, method_ = "dmmc";
   double relief_m_ = 1500;
   CLI::App* app_ = nullptr;
   GridOptions grid_;

@@ -23,6 +23,8 @@ struct GenerateRequest {
   std::uint64_t seed = 1;
   double relief_m = 1000;        ///< height of the highest crest above the outlets
   terrain::DmmcParams dmmc;      ///< the DMMC that fills between the skeleton's cells
+  /// dmmc: which way each sketch cell extrapolates (grid's size, row-major; empty: the global rule)
+  std::vector<terrain::ExtrapolationLabel> labels;
   std::vector<std::vector<GridPoint>> lines;  ///< user lines (flow: ridges), cell coordinates
   std::vector<GridPoint> points;               ///< user points (tectonic: mountain points)
   std::vector<std::vector<GridPoint>> polygons;  ///< user polygon rings (coast: the land; empty: a seeded island)

@@ -11,6 +11,7 @@
 #include <optional>
 #include <utility>
 
+#include "core/error.hpp"
 #include "core/random.hpp"
 
 namespace terrapolis::terrain {
@@ -226,6 +227,26 @@ void midpoint_displacement(SubdivisionGrid& grid, const MidpointParams& params, 
 
 namespace {
 
+/// I_-1 of eq. 3.5 for a child labelled `label` (Belhadj §5.1.1: rivière up, crête down).
+double child_shape(ExtrapolationLabel label, double shape) {
+  switch (label) {
+    case ExtrapolationLabel::river: return -std::abs(shape);
+    case ExtrapolationLabel::ridge: return std::abs(shape);
+    case ExtrapolationLabel::global: break;
+  }
+  return shape;
+}
+
+/// The label a parent takes from its children links[g, h): theirs if they all agree, else global,
+/// so a chain of river cells keeps rising up the tree and a river beside a ridge follows the rule.
+ExtrapolationLabel parent_label(const SubdivisionGrid& grid, const std::vector<std::pair<std::uint32_t, std::uint32_t>>& links,
+                                std::size_t g, std::size_t h) {
+  const ExtrapolationLabel first = grid.label[links[g].second];
+  for (std::size_t k = g + 1; k < h; ++k)
+    if (grid.label[links[k].second] != first) return ExtrapolationLabel::global;
+  return first;
+}
+
 /// The altitude of unknown parent p from its children links[g, h) (all known at the start of the round).
 double extrapolate(const SubdivisionGrid& grid, const std::vector<std::pair<std::uint32_t, std::uint32_t>>& links,
                    std::size_t g, std::size_t h, double d_max, const BottomUpParams& params, std::uint64_t seed) {
@@ -241,7 +262,7 @@ double extrapolate(const SubdivisionGrid& grid, const std::vector<std::pair<std:
       continue;
     }
     const double weight = params.weight_by_distance ? d : 1.0 / d;
-    a += weight * shape_curve(grid.z[e], d, d_max, params.shape);
+    a += weight * shape_curve(grid.z[e], d, d_max, grid.label.empty() ? params.shape : child_shape(grid.label[e], params.shape));
     weight_sum += weight;
   }
   if (params.rule == BottomUpRule::weighted) return a / weight_sum;
@@ -286,6 +307,7 @@ std::size_t bottom_up(SubdivisionGrid& grid, Subdivision scheme, const BottomUpP
       std::size_t h = g;
       while (h < links.size() && links[h].first == p) ++h;
       grid.z[p] = float(extrapolate(grid, links, g, h, d_max, params, seed));
+      if (!grid.label.empty()) grid.label[p] = parent_label(grid, links, g, h);
       grid.state[p] = CellState::known;
       active.push_back(p);
       ++set;
@@ -324,8 +346,12 @@ void run_dmmc(SubdivisionGrid& grid, const DmmcParams& params, Progress* progres
 
 }  // namespace
 
-int dmmc(Raster<float>& raster, const DmmcParams& params, Progress* progress) {
+int dmmc(Raster<float>& raster, const DmmcParams& params, Progress* progress, const std::vector<ExtrapolationLabel>& labels) {
   SubdivisionGrid grid = SubdivisionGrid::from_raster(raster);
+  if (!labels.empty()) {
+    if (labels.size() != raster.size()) throw processing_error("dmmc: " + std::to_string(labels.size()) + " labels for " + std::to_string(raster.size()) + " cells");
+    grid.label = labels;
+  }
   int passes = 0;
   if (params.low_pass) {
     // §5.2.1 smooths while the error falls; the true error is unknown in practice, so a share of the

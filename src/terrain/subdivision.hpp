@@ -45,6 +45,14 @@ enum class BottomUpRule {
   mean,
 };
 
+/// Which way a cell extrapolates its parents in the bottom-up pass (Belhadj §5.1.1: sketch cells
+/// labelled *rivière* extrapolate up, *crête* cells down, eq. 3.5 with I_-1 < 0 or > 0).
+enum class ExtrapolationLabel : std::uint8_t {
+  global = 0,  ///< BottomUpParams::shape as given
+  river = 1,   ///< I_-1 = -|shape|: the parents rise above the cell (a valley floor)
+  ridge = 2,   ///< I_-1 = +|shape|: the parents fall below the cell (a crest)
+};
+
 /// Parameters of the bottom-up pass (Belhadj Alg. 10 or 11, eq. 3.5).
 struct BottomUpParams {
   BottomUpRule rule = BottomUpRule::weighted;
@@ -70,6 +78,9 @@ struct SubdivisionGrid {
   int cols = 0, rows = 0;
   std::vector<float> z;            ///< metres; meaningless where state is unknown
   std::vector<CellState> state;
+  /// Per cell, for the weighted bottom-up rule; empty: every cell follows BottomUpParams::shape.
+  /// bottom_up gives a parent its children's label when they all share it, else global.
+  std::vector<ExtrapolationLabel> label;
   /// A grid from a raster: finite cells become constrained, NaN cells unknown.
   static SubdivisionGrid from_raster(const Raster<float>& raster);
 };
@@ -129,8 +140,10 @@ struct DmmcParams {
 
 /// Belhadj's DMMC (the bottom-up pass, Alg. 11 or 10, seeded by top_down.seed, then the top-down
 /// pass; §5.2.1 low-pass when asked). Cells of `raster` that are finite are kept exactly; NaN cells
-/// are computed. Returns the number of low-pass passes.
-int dmmc(Raster<float>& raster, const DmmcParams& params, Progress* progress = nullptr);
+/// are computed. `labels` (raster's size, row-major; empty: none) sets which way each cell
+/// extrapolates (weighted rule only). Returns the number of low-pass passes.
+int dmmc(Raster<float>& raster, const DmmcParams& params, Progress* progress = nullptr,
+         const std::vector<ExtrapolationLabel>& labels = {});
 
 /// One 3x3 mean pass over the cells whose state is not constrained (double-buffered, deterministic).
 void low_pass(SubdivisionGrid& grid);

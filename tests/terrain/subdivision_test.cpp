@@ -8,6 +8,7 @@
 #include <cstring>
 #include <limits>
 
+#include "core/error.hpp"
 #include "terrain/fill.hpp"
 #include "terrain/spline.hpp"
 #include "terrain/subdivision.hpp"
@@ -300,6 +301,102 @@ TEST(BottomUpMean, DmmcKeepsConstraintsAndIsThreadIndependent) {
       }
     }
   }
+}
+
+namespace {
+
+/// Eq. 3.5 written out: f_-1(a, d) = a (1 - sigma(I) (1 - (1 - d / d_max)^|I|)).
+double f_minus_1(double a, double d, double d_max, double shape) {
+  return a * (1 - (shape >= 0 ? 1 : -1) * (1 - std::pow(1 - d / d_max, std::abs(shape))));
+}
+
+/// 5x5 Triangle-Edge grid, (1,0) = 10 and (3,4) = 20 fixed, weighted bottom-up with I_-1 = `shape`.
+/// Round 1: (1,0) alone feeds its edge ends (0,0), (2,0) at d = 1; (3,4) alone feeds (2,4), (4,4)
+/// at d = 1. Round 2: (2,0) alone feeds (4,0) at d = 2 (its other end is known); (2,4) alone feeds
+/// (0,4) at d = 2. Every parent has one child, so Alg. 11's weights cancel: parent = f_-1(child, d).
+SubdivisionGrid labelled_grid(double shape, const std::vector<ExtrapolationLabel>& labels) {
+  Raster<float> r(5, 5, unit_georef(), nan_f);
+  r(1, 0) = 10;
+  r(3, 4) = 20;
+  SubdivisionGrid g = SubdivisionGrid::from_raster(r);
+  g.label = labels;
+  BottomUpParams p;
+  p.shape = shape;
+  bottom_up(g, Subdivision::triangle_edge, p);
+  return g;
+}
+
+}  // namespace
+
+TEST(BottomUpLabels, RiverCellsExtrapolateUpRidgeCellsDown) {
+  const double d_max = std::hypot(5.0, 5.0), shape = 2;
+  std::vector<ExtrapolationLabel> labels(25, ExtrapolationLabel::global);
+  labels[1] = ExtrapolationLabel::river;       // (1,0)
+  labels[4 * 5 + 3] = ExtrapolationLabel::ridge;  // (3,4)
+  const SubdivisionGrid g = labelled_grid(shape, labels);
+  // By hand: 1 - (1 - 1/sqrt 50)^2 = 0.262843, 1 - (1 - 2/sqrt 50)^2 = 0.485686.
+  EXPECT_NEAR(z_at(g, 0, 0), 10 * 1.262843, 1e-4);  // river: above its child
+  EXPECT_NEAR(z_at(g, 2, 0), 10 * 1.262843, 1e-4);
+  EXPECT_NEAR(z_at(g, 4, 0), 10 * 1.262843 * 1.485686, 1e-3);  // the parent inherits "river" and rises again
+  EXPECT_NEAR(z_at(g, 2, 4), 20 * 0.737157, 1e-4);  // ridge: below its child
+  EXPECT_NEAR(z_at(g, 4, 4), 20 * 0.737157, 1e-4);
+  EXPECT_NEAR(z_at(g, 0, 4), 20 * 0.737157 * 0.514314, 1e-3);
+  EXPECT_FLOAT_EQ(z_at(g, 4, 0), float(f_minus_1(f_minus_1(10, 1, d_max, -shape), 2, d_max, -shape)));
+  EXPECT_EQ(g.label[4], ExtrapolationLabel::river);           // (4,0)
+  EXPECT_EQ(g.label[4 * 5 + 0], ExtrapolationLabel::ridge);   // (0,4)
+  // Whatever the sign of --shape-up, the labels set the direction, |I_-1| the amount.
+  const SubdivisionGrid negative = labelled_grid(-shape, labels);
+  EXPECT_EQ(std::memcmp(negative.z.data(), g.z.data(), g.z.size() * sizeof(float)), 0);
+  // Without labels I_-1 = 2 lowers both.
+  const SubdivisionGrid plain = labelled_grid(shape, {});
+  EXPECT_NEAR(z_at(plain, 0, 0), 10 * 0.737157, 1e-4);
+  EXPECT_NEAR(z_at(plain, 2, 4), 20 * 0.737157, 1e-4);
+}
+
+TEST(BottomUpLabels, AParentOfARiverAndARidgeFollowsBothAndTakesTheGlobalRule) {
+  // (1,0) river = 10 and (3,0) ridge = 20 share the parent (2,0), both at d = 1 (weights equal).
+  Raster<float> r(5, 5, unit_georef(), nan_f);
+  r(1, 0) = 10;
+  r(3, 0) = 20;
+  SubdivisionGrid g = SubdivisionGrid::from_raster(r);
+  g.label.assign(25, ExtrapolationLabel::global);
+  g.label[1] = ExtrapolationLabel::river;
+  g.label[3] = ExtrapolationLabel::ridge;
+  BottomUpParams p;
+  p.shape = 2;
+  bottom_up(g, Subdivision::triangle_edge, p);
+  EXPECT_NEAR(z_at(g, 2, 0), (10 * 1.262843 + 20 * 0.737157) / 2, 1e-4);
+  EXPECT_EQ(g.label[2], ExtrapolationLabel::global);
+  EXPECT_EQ(g.label[0], ExtrapolationLabel::river);
+  EXPECT_EQ(g.label[4], ExtrapolationLabel::ridge);
+}
+
+TEST(BottomUpLabels, AllGlobalLabelsGiveTheBytesOfNoLabelsAtAnyThreadCount) {
+  const Raster<float> input = sample(smooth_surface(200, 130), 0.03, 3);
+  auto run = [&](int threads, const std::vector<ExtrapolationLabel>& labels) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
+    Raster<float> d = input;
+    DmmcParams dp;
+    dp.top_down.scale_m = 500;
+    dp.bottom_up.shape = 3;
+    dmmc(d, dp, nullptr, labels);
+    return d;
+  };
+  std::vector<ExtrapolationLabel> global(input.size(), ExtrapolationLabel::global), mixed = global;
+  for (std::size_t i = 0; i < mixed.size(); ++i)
+    if (std::isfinite(input[i])) mixed[i] = i % 2 ? ExtrapolationLabel::river : ExtrapolationLabel::ridge;
+  const Raster<float> none = run(2, {}), all_global = run(1, global);
+  EXPECT_EQ(std::memcmp(none.values().data(), all_global.values().data(), none.size() * sizeof(float)), 0);
+  const Raster<float> one = run(1, mixed), two = run(2, mixed);
+  EXPECT_EQ(std::memcmp(one.values().data(), two.values().data(), one.size() * sizeof(float)), 0);
+  EXPECT_NE(std::memcmp(one.values().data(), none.values().data(), one.size() * sizeof(float)), 0);
+  for (std::size_t i = 0; i < input.size(); ++i)
+    if (std::isfinite(input[i])) {
+      EXPECT_EQ(one[i], input[i]);
+    }
+  std::vector<ExtrapolationLabel> wrong(3, ExtrapolationLabel::river);
+  Raster<float> d = input;
+  EXPECT_THROW(dmmc(d, DmmcParams{}, nullptr, wrong), Error);
 }
 
 TEST(Reconstruction, ErrorFallsAsSamplesGrowDenser) {
