@@ -14,11 +14,14 @@
 #include "cli/terrain_options.hpp"
 #include "cli/schema_options.hpp"
 #include "core/error.hpp"
+#include "core/geodesy.hpp"
+#include "erode/erosion.hpp"
 #include "io/output_set.hpp"
 #include "io/raster_io.hpp"
 #include "io/text_io.hpp"
 #include "io/vector_io.hpp"
 #include "generate/generators.hpp"
+#include "pipeline/stage_options.hpp"
 #include "terrain/subdivision.hpp"
 
 namespace terrapolis::cli {
@@ -91,6 +94,7 @@ class GenerateCommand final : public Command {
                                                      "Same grid rules as --constraints"), FileKind::raster_in);
     options_.add(app, false, 1000.0);
     skeleton_options_.add(app);
+    erode_schema_.setup(app, name());  // --erode-iterations, --erode-process (the erode section)
     add_overwrite_flag(app, overwrite_);
   }
 
@@ -99,6 +103,8 @@ class GenerateCommand final : public Command {
     for (const auto& m : kMethods)
       if (method_ == m.name) method = &m;
     if (!method) throw bad_input("--method: unknown generator '" + method_ + "' (expected " + method_names() + ")");
+    const pipeline::Scenario erode_scenario = erode_schema_.scenario();
+    const erode::ErodeOptions erode_options = erode_schema_.settings([&] { return pipeline::erode_options(erode_scenario); });
     // dmmc and window fill a sketch; the others build a skeleton and write it with its report.
     const bool skeleton_method = method_ != "dmmc" && method_ != "window";
     if (skeleton_method && !sketch_.empty()) throw bad_input("--constraints: only --method dmmc and window take a sketch");
@@ -141,9 +147,16 @@ class GenerateCommand final : public Command {
     if (!skeleton_options_.coast_path.empty()) request.polygons = read_rings(skeleton_options_.coast_path, grid.georef());
     skeleton_options_.apply(request);
     request.grid = std::move(grid);
-    const generate::GeneratedTerrain terrain = method->generate(request);
+    generate::GeneratedTerrain terrain = method->generate(request);
     for (const auto& [phase, seconds] : terrain.timings)
       context.log.detail("generate: " + phase + " in " + std::to_string(seconds) + " s");
+    if (erode_options.iterations > 0) {  // an older landscape; the report then measures the eroded DEM's rivers
+      erode::ErodeReport report;
+      const CellMetrics metrics = cell_metrics(terrain.dem.georef(), terrain.dem.cols(), terrain.dem.rows());
+      terrain.dem = erode::erode(terrain.dem, metrics, erode_options, nullptr, context.progress, &report);
+      context.log.info("generate: eroded " + std::to_string(report.iterations) + " iterations, " + std::to_string(std::llround(report.eroded_m3)) +
+                       " m3 moved, largest lowering " + std::to_string(report.max_lowering_m) + " m");
+    }
 
     WriteOptions write;
     write.description = "generated elevation (m)";
@@ -151,6 +164,7 @@ class GenerateCommand final : public Command {
     write.metadata.emplace_back("TERRAPOLIS_GENERATOR", method_);
     if (!request.labels.empty()) write.metadata.emplace_back("TERRAPOLIS_LABELS", labels_summary(request.labels));
     if (skeleton_method) write.metadata.emplace_back("TERRAPOLIS_RELIEF_M", std::to_string(relief_m_));
+    if (erode_options.iterations > 0) write.metadata.emplace_back("TERRAPOLIS_ERODE", erode_scenario.resolved["erode"].dump());
     if (method_ == "river") {
       write.metadata.emplace_back("TERRAPOLIS_RIVER_CONVERGENCE", std::to_string(request.river.convergence));
       write.metadata.emplace_back("TERRAPOLIS_RIVER_POWER", std::to_string(request.river.power));
@@ -295,6 +309,7 @@ class GenerateCommand final : public Command {
   TerrainOptions options_;
   CoastPlanarOptions skeleton_options_;
   bool overwrite_ = false;
+  SchemaOptions erode_schema_;
 };
 
 }  // namespace
