@@ -11,6 +11,9 @@
 
 #include "generate/generators.hpp"
 #include "generate/growing_window.hpp"
+#include "support/determinism.hpp"
+#include "support/georefs.hpp"
+#include "support/sketches.hpp"
 
 using namespace terrapolis;
 using namespace terrapolis::generate;
@@ -19,26 +22,9 @@ namespace {
 
 constexpr float nan_f = std::numeric_limits<float>::quiet_NaN();
 
-Georef unit_georef() {
-  Georef g;
-  g.transform = {0, 30, 0, 0, 0, -30};
-  return g;
-}
+Georef unit_georef() { return test::projected(30); }
 
-/// Belhadj fig. 1.2: two crossed diagonals at `ridge_m`, the counter-diagonal shifted one cell
-/// right; fig. 2.3 adds the borders fixed at zero.
-Raster<float> cross_skeleton(int n, float ridge_m, bool zero_borders) {
-  Raster<float> r(n, n, unit_georef(), nan_f);
-  for (int i = 0; i < n; ++i) {
-    r(i, i) = ridge_m;
-    if (i > 0) r(n - i, i) = ridge_m;
-  }
-  if (zero_borders)
-    for (int i = 0; i < n; ++i) r(i, 0) = r(i, n - 1) = r(0, i) = r(n - 1, i) = 0.0f;
-  else  // fig. 1.2: "les coins du MNT initial étant à une altitude nulle"
-    r(0, 0) = r(n - 1, 0) = r(0, n - 1) = r(n - 1, n - 1) = 0.0f;
-  return r;
-}
+Raster<float> cross_skeleton(int n, float ridge_m, bool zero_borders) { return test::cross_skeleton(unit_georef(), n, ridge_m, zero_borders); }
 
 /// Largest height difference between two 8-neighbours, at least one of them computed, both at
 /// least `margin` cells from the border (where a ridge meets the zero border every method jumps).
@@ -55,19 +41,7 @@ double largest_jump(const Raster<float>& sketch, const Raster<float>& result, in
   return worst;
 }
 
-/// Largest difference between a constrained cell and a computed 8-neighbour, away from the borders.
-double largest_jump_at_constraints(const Raster<float>& sketch, const Raster<float>& result) {
-  double worst = 0;
-  const int margin = result.cols() / 8;
-  for (int y = margin; y < result.rows() - margin; ++y)
-    for (int x = margin; x < result.cols() - margin; ++x) {
-      if (std::isnan(sketch(x, y))) continue;
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx)
-          if (std::isnan(sketch(x + dx, y + dy))) worst = std::max(worst, std::abs(double(result(x + dx, y + dy)) - result(x, y)));
-    }
-  return worst;
-}
+using test::largest_jump_at_constraints;
 
 /// A sparse sketch: about `share` of the cells fixed, heights from a smooth surface.
 Raster<float> sparse_sketch(int cols, int rows, double share, std::uint64_t seed) {
@@ -146,12 +120,8 @@ TEST(GrowingWindow, SameSeedSameBytesWhateverTheThreads) {
     request.dmmc.top_down.seed = seed;
     return generate_window(request).dem.values();
   };
-  for (const auto scheme : {terrain::Subdivision::triangle_edge, terrain::Subdivision::diamond_square}) {
-    const auto one = run(1, 5, scheme), two = run(2, 5, scheme), other = run(2, 6, scheme);
-    ASSERT_EQ(one.size(), two.size());
-    EXPECT_EQ(std::memcmp(one.data(), two.data(), one.size() * sizeof(float)), 0);
-    EXPECT_NE(std::memcmp(one.data(), other.data(), one.size() * sizeof(float)), 0);
-  }
+  for (const auto scheme : {terrain::Subdivision::triangle_edge, terrain::Subdivision::diamond_square})
+    test::expect_same_bytes_at_any_thread_count([&](int threads, std::uint64_t seed) { return run(threads, seed, scheme); });
 }
 
 TEST(GrowingWindow, NoTearAlongTheShiftedDiagonal) {
@@ -165,10 +135,7 @@ TEST(GrowingWindow, NoTearAlongTheShiftedDiagonal) {
     terrain::MidpointParams p;
     p.subdivision = scheme;
     growing_window(r, p);
-    terrain::SubdivisionGrid plain = terrain::SubdivisionGrid::from_raster(sketch);
-    terrain::midpoint_displacement(plain, p);
-    Raster<float> plain_r = sketch;
-    plain_r.values() = plain.z;
+    const Raster<float> plain_r = test::plain_subdivision(sketch, p);
     const double jump = largest_jump_at_constraints(sketch, r), jump_plain = largest_jump_at_constraints(sketch, plain_r);
     std::printf("fig. 1.2, scheme %d: largest jump at a constraint: growing window %.1f m, plain subdivision %.1f m\n", int(scheme), jump,
                 jump_plain);

@@ -12,6 +12,9 @@
 #include "terrain/fill.hpp"
 #include "terrain/spline.hpp"
 #include "terrain/subdivision.hpp"
+#include "support/determinism.hpp"
+#include "support/georefs.hpp"
+#include "support/sketches.hpp"
 
 using namespace terrapolis;
 using namespace terrapolis::terrain;
@@ -20,12 +23,7 @@ namespace {
 
 constexpr float nan_f = std::numeric_limits<float>::quiet_NaN();
 
-Georef unit_georef() {
-  Georef g;
-  g.transform = {500000, 30, 0, 4000000, 0, -30};
-  g.crs.wkt = "LOCAL_CS[\"test\"]";
-  return g;
-}
+Georef unit_georef() { return test::projected(30); }
 
 /// Random sparse constraints: a share of the cells of `truth`, chosen by a hash.
 Raster<float> sample(const Raster<float>& truth, double share, std::uint64_t seed) {
@@ -36,34 +34,9 @@ Raster<float> sample(const Raster<float>& truth, double share, std::uint64_t see
   return r;
 }
 
-/// The thesis's skeleton (Belhadj fig. 1.2, 3.3): two crossed diagonals at `ridge_m`, the
-/// counter-diagonal shifted one cell right, borders fixed at zero.
-Raster<float> cross_skeleton(int n, float ridge_m) {
-  Raster<float> r(n, n, unit_georef(), nan_f);
-  for (int i = 0; i < n; ++i) {
-    r(i, i) = ridge_m;
-    if (n - i < n) r(n - i, i) = ridge_m;  // counter-diagonal shifted by one
-  }
-  for (int i = 0; i < n; ++i) r(i, 0) = r(i, n - 1) = r(0, i) = r(n - 1, i) = 0.0f;
-  return r;
-}
+Raster<float> cross_skeleton(int n, float ridge_m) { return test::cross_skeleton(unit_georef(), n, ridge_m); }
 
-/// Largest height difference between a constrained cell and an 8-neighbour that was computed, away
-/// from the borders (where a ridge meets the zero border any neighbour jumps by half the ridge).
-double largest_jump_at_constraints(const Raster<float>& constraints, const Raster<float>& result) {
-  double worst = 0;
-  const int margin = result.cols() / 8;
-  for (int y = margin; y < result.rows() - margin; ++y)
-    for (int x = margin; x < result.cols() - margin; ++x) {
-      if (std::isnan(constraints(x, y))) continue;
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) {
-          if (!result.inside(x + dx, y + dy) || !std::isnan(constraints(x + dx, y + dy))) continue;
-          worst = std::max(worst, std::abs(double(result(x + dx, y + dy)) - result(x, y)));
-        }
-    }
-  return worst;
-}
+using test::largest_jump_at_constraints;
 
 double rmse_hidden(const Raster<float>& truth, const Raster<float>& input, const Raster<float>& result) {
   double s = 0;
@@ -178,10 +151,7 @@ TEST(MidpointDisplacement, SameSeedSameBytesWhateverTheThreads) {
     d.values().insert(d.values().end(), s.values().begin(), s.values().end());
     return d.values();
   };
-  const auto one = run(1, 5), two = run(2, 5), other = run(2, 6);
-  ASSERT_EQ(one.size(), two.size());
-  EXPECT_EQ(std::memcmp(one.data(), two.data(), one.size() * sizeof(float)), 0);
-  EXPECT_NE(std::memcmp(one.data(), other.data(), one.size() * sizeof(float)), 0);
+  test::expect_same_bytes_at_any_thread_count(run);
 }
 
 TEST(Dmmc, BottomUpDownDoesNotTearAlongTheShiftedDiagonal) {
@@ -191,12 +161,9 @@ TEST(Dmmc, BottomUpDownDoesNotTearAlongTheShiftedDiagonal) {
   const float ridge = 1000;
   const Raster<float> skeleton = cross_skeleton(n, ridge);
   for (const auto scheme : {Subdivision::triangle_edge, Subdivision::diamond_square}) {
-    SubdivisionGrid plain = SubdivisionGrid::from_raster(skeleton);
     MidpointParams p;
     p.subdivision = scheme;
-    midpoint_displacement(plain, p);
-    Raster<float> plain_r = skeleton;
-    plain_r.values() = plain.z;
+    const Raster<float> plain_r = test::plain_subdivision(skeleton, p);
     const double jump_plain = largest_jump_at_constraints(skeleton, plain_r);
     EXPECT_GT(jump_plain, 0.4 * ridge) << int(scheme);
     for (const auto rule : {BottomUpRule::weighted, BottomUpRule::mean}) {
