@@ -131,7 +131,7 @@ class DensityCommand final : public Command {
     const std::clock_t cpu2 = std::clock();
     const auto t2 = clock::now();
 
-    write_rasters(result, options, [&](const std::string& n) { return (dir / (n + ".tif")).string(); });
+    write_rasters(result, options, terms(scenario), [&](const std::string& n) { return (dir / (n + ".tif")).string(); });
     outputs.commit();
     const auto t3 = clock::now();
     context.log.detail("density: read " + seconds(t0, t1) + " s, model " + seconds(t1, t2) + " s (cpu " +
@@ -140,16 +140,22 @@ class DensityCommand final : public Command {
   }
 
  private:
+  /// What the descriptions say of the hydrometry: the hydro section's method, or the file it was read from.
+  pipeline::DescriptionTerms terms(const pipeline::Scenario& scenario) const {
+    pipeline::DescriptionTerms t = pipeline::description_terms(scenario);
+    if (!hydrometry_path_.empty()) t.hydrometry = "read from " + fs::path(hydrometry_path_).filename().string();
+    return t;
+  }
   /// The rasters of `result` (the whole grid's or a tile's), each to path(name), concurrently.
   void write_rasters(const density::DensityResult& result, const density::DensityOptions& options,
-                     const std::function<std::string(const std::string&)>& path) const {
+                     const pipeline::DescriptionTerms& terms, const std::function<std::string(const std::string&)>& path) const {
     const auto metadata = provenance(options);
     std::vector<std::function<void()>> writes;
     auto write = [&](const std::string& n, const auto& raster) {
       writes.emplace_back([&, n] {
         WriteOptions w;
         w.cog = cog_;
-        w.description = pipeline::describe_output(n == "hydrometry" ? "density_hydrometry.tif" : n + ".tif");
+        w.description = pipeline::describe_output(n + ".tif", terms);
         w.metadata = metadata;
         write_raster(path(n), raster, w);
       });
@@ -205,7 +211,7 @@ class DensityCommand final : public Command {
     const density::TiledDensityReport report = density::run_tiled_density(
         h.cols, h.rows, h.georef, read, options, tiles.tile_size, tiles.limit_mb(),
         [&](int t, int across, const density::DensityResult& tile) {
-          write_rasters(tile, options, [&](const std::string& n) { return tile_file(dir.string(), n, t, across); });
+          write_rasters(tile, options, terms(scenario), [&](const std::string& n) { return tile_file(dir.string(), n, t, across); });
         },
         context.progress);
     for (const char* l : layers)

@@ -40,7 +40,6 @@ std::string describe_output(const std::string& file, const DescriptionTerms& t) 
   if (file == "plain.tif") return "Plain: 1 - standard deviation of altitude within r_min / maximum variation, clamped (0..1; 0 on water)";
   if (file == "buildable.tif") return "Buildable: 1 habitable, 0 uninhabitable (water, too high, too steep, river bed, excluded), 255 no data";
   if (file == "density.tif") return "Human population density model (MNDPH, Belhadj 2007 4.2): weighted characteristics, 0..1, 0 where uninhabitable";
-  if (file == "density_hydrometry.tif") return "Hydrometry used by the density model (0..1)";  // the density command's hydrometry.tif
   // sites, network
   if (file == "cities.geojson") return "City centres with radius, class, population, parent and depth";
   if (file == "city_extents.geojson") return "City discs (geodesic circles)";

@@ -4,7 +4,6 @@
 
 #include <cstdint>
 
-#include "pipeline/descriptions.hpp"
 #include "terrapolis/version.hpp"
 
 namespace terrapolis::pipeline {
@@ -35,7 +34,7 @@ Style style_from_name(const std::string& name) {
 template <class T>
 void RunState::write(const std::string& stage, const std::string& name, const Raster<T>& raster,
                      Style style, const std::vector<std::pair<std::string, std::string>>& metadata) {
-  const std::string description = describe_output(name, description_terms(scenario));
+  const std::string description = describe_output(name, terms);
   // The output folder is where, not what: it stays out of the provenance so runs compare byte for byte.
   nlohmann::ordered_json parameters = scenario.resolved;
   parameters.erase("output");
@@ -67,7 +66,7 @@ template void RunState::write(const std::string&, const std::string&, const Rast
                               const std::vector<std::pair<std::string, std::string>>&);
 
 void RunState::write(const std::string& stage, const std::string& name, const VectorLayer& layer, Style style) {
-  const std::string description = describe_output(name, description_terms(scenario));
+  const std::string description = describe_output(name, terms);
   write_vector((folder / name).string(), layer, true);
   outputs.push_back({name, stage, description, style, false, layer.features.size()});
   vectors.emplace_back(style, layer);

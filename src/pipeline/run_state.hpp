@@ -12,6 +12,7 @@
 #include "core/raster.hpp"
 #include "io/raster_io.hpp"
 #include "io/vector_io.hpp"
+#include "pipeline/descriptions.hpp"
 #include "pipeline/scenario.hpp"
 #include "pipeline/stage_options.hpp"
 #include "plugin/plugin.hpp"
@@ -40,7 +41,7 @@ struct OutputFile {
 
 struct RunState {
   RunState(const Scenario& s, std::filesystem::path run_folder, std::string sha256, Dem elevation)
-      : scenario(s), folder(std::move(run_folder)), dem_sha256(std::move(sha256)), dem(std::move(elevation)) {}
+      : scenario(s), folder(std::move(run_folder)), dem_sha256(std::move(sha256)), dem(std::move(elevation)), terms(description_terms(s)) {}
 
   const Scenario& scenario;
   StageSettings settings;  ///< every stage's settings, prepared before the first stage runs
@@ -55,6 +56,7 @@ struct RunState {
   std::optional<Raster<std::uint8_t>> buildable;  ///< density: 1 habitable, 0 not, 255 nodata
   std::vector<sites::Site> sites;                 ///< sites: sorted by radius, decreasing
   std::optional<VectorLayer> cities, network;     ///< sites and network layers, in the DEM's CRS
+  DescriptionTerms terms;  ///< what the scenario decides of the outputs' descriptions
   std::vector<OutputFile> outputs;
   std::vector<std::pair<Style, VectorLayer>> vectors;  ///< vector layers written, kept for the preview
   nlohmann::ordered_json summary = nlohmann::ordered_json::object();  ///< per-stage figures for the summary and compare

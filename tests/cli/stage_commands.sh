@@ -43,9 +43,10 @@ import sys; from osgeo import gdal; import numpy as np
 a, b = (gdal.Open(p).ReadAsArray() for p in sys.argv[1:])
 sys.exit(0 if a.shape == b.shape and np.array_equal(a, b, equal_nan=True) else 1)" "$1" "$2"
 }
-same_description() {  # A B: one description per output (pipeline::describe_output)
-  [[ "$(gdalinfo "$1" | grep -A1 'Band 1' | tail -1)" == "$(gdalinfo "$2" | grep -A1 'Band 1' | tail -1)" ]] ||
-    fail "$1 and $2 carry different descriptions"
+same_description() {  # A B: one description per output (pipeline::describe_output), and not an empty one
+  local a b
+  a=$(gdalinfo "$1" | grep -m1 '^  Description = ') b=$(gdalinfo "$2" | grep -m1 '^  Description = ')
+  [[ -n $a && $a == "$b" ]] || fail "$1 and $2 carry different descriptions: '$a' and '$b'"
 }
 for f in access_minutes.tif access_nearest.tif; do
   same_pixels run/$f access/$f || fail "access: the command and the run differ in $f"
