@@ -5,7 +5,6 @@
 #include <tbb/parallel_for.h>
 
 #include <array>
-#include <cmath>
 #include <cstdint>
 #include <numeric>
 #include <vector>
@@ -38,11 +37,6 @@ struct Domain {
   bool inside(int c, int r, int k) const {
     const int cc = c + dcol[k], rr = r + drow[k];
     return on_grid(cc, rr) && in[index(cc, rr)];
-  }
-  /// Neighbour k of (c, r) when it has data (inside the domain or a fixed cell outside the mask).
-  bool has_data(int c, int r, int k) const {
-    const int cc = c + dcol[k], rr = r + drow[k];
-    return on_grid(cc, rr) && !std::isnan(height[index(cc, rr)]);
   }
 };
 
@@ -121,7 +115,7 @@ class GlobalErosion {
   std::vector<Chord> sphere(int r) const;  // the columns within radius_m of a cell of row r
   double accessibility(int c, int r, const std::vector<Chord>& chords) const;
   double strength(double z) const;  // S(p) at height z, per iteration
-  bool exposed(int c, int r) const;
+  bool exposed(std::size_t i) const;
   double weather(int r);  // one row of step()
 
   Domain& d_;

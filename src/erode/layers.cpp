@@ -71,17 +71,12 @@ double GlobalErosion::strength(double z) const {
   return (bed & 1) ? o_.erodibility * o_.hard_ratio : o_.erodibility;
 }
 
-// Peytavie: "seules les couches de roches voisines d'une couche d'air sont converties en voxel".
-// The rock of a cell touches the air when no loose material covers it, or on its side when a
-// neighbour's surface lies below the top of the rock.
-bool GlobalErosion::exposed(int c, int r) const {
-  const std::size_t i = d_.index(c, r);
-  if (d_.loose[i] <= stable_m) return true;
-  const double top = d_.height[i] - d_.loose[i];
-  for (int k = 0; k < 8; ++k)
-    if (d_.has_data(c, r, k) && d_.height[d_.index(c + dcol[k], r + drow[k])] < top) return true;
-  return false;
-}
+// Peytavie: "seules les couches de roches voisines d'une couche d'air sont converties en voxel": the
+// rock of a cell touches the air when no loose material covers it. (Not on its sides: between two
+// columns of a height field there is a step at every slope, not a rock face, and counting it would
+// let rock weather under any scree on a slope steeper than the scree is thick. A real face is steeper
+// than the angle of repose, so its scree slides off and it is bare anyway.)
+bool GlobalErosion::exposed(std::size_t i) const { return d_.loose[i] <= stable_m; }
 
 double GlobalErosion::weather(int r) {
   const std::vector<Chord> chords = sphere(r);
@@ -89,7 +84,7 @@ double GlobalErosion::weather(int r) {
   double loosened = 0;
   for (int c = 0; c < d_.cols; ++c) {
     const std::size_t i = d_.index(c, r);
-    if (!d_.in[i] || !exposed(c, r)) continue;
+    if (!d_.in[i] || !exposed(i)) continue;
     const double voxel_middle = d_.height[i] - d_.loose[i] - 0.5 * o_.voxel_m;
     eta_[i] -= accessibility(c, r, chords) * strength(voxel_middle);  // Peytavie: eta~ = eta - a(p) S(p)
     if (eta_[i] > 0) continue;
