@@ -49,14 +49,15 @@ Domain make_domain(const Dem& dem, const CellMetrics& metrics, const Raster<std:
   return d;
 }
 
-/// The loose layer of a layered ground: the given thickness on the domain's cells, 0 elsewhere.
+/// The loose layer of a layered ground: the given thickness on the cells with data (outside the mask
+/// it stays as given), 0 elsewhere.
 void add_loose_layer(Domain& d, const Raster<float>* loose_m) {
   d.loose.assign(d.height.size(), 0.0);
   if (!loose_m) return;
   if (loose_m->cols() != d.cols || loose_m->rows() != d.rows) throw bad_input("/erode/loose: not on the DEM's grid");
   for (std::size_t i = 0; i < d.loose.size(); ++i) {
     const double t = (*loose_m)[i];
-    if (!d.in[i] || std::isnan(t)) continue;
+    if (std::isnan(d.height[i]) || std::isnan(t)) continue;
     if (!(t >= 0 && std::isfinite(t))) throw bad_input("/erode/loose: thickness " + std::to_string(t) + " m is not a finite value >= 0");
     d.loose[i] = t;
   }
@@ -86,6 +87,16 @@ struct Processes {
     return water || weathering || moved > 0;
   }
 };
+
+/// The loose thickness at the end, m (0 without a loose layer, NaN on nodata; a film of rounding
+/// below 0 left by a cell that sent all it held shows as 0).
+Raster<float> loose_thickness(const Dem& dem, const Domain& domain) {
+  Raster<float> loose = dem.like<float>(0);
+  for (std::size_t i = 0; i < loose.size(); ++i)
+    if (std::isnan(dem[i])) loose[i] = NAN;
+    else if (!domain.loose.empty()) loose[i] = float(std::max(0.0, domain.loose[i]));
+  return loose;
+}
 
 /// The report's volumes from the float output against the float input (one pass, in cell order).
 void measure(const Dem& before, const Dem& after, const CellMetrics& metrics, ErodeReport& report) {
@@ -122,11 +133,7 @@ Dem erode(const Dem& dem, const CellMetrics& metrics, const ErodeOptions& option
   Dem out = dem;
   for (std::size_t i = 0; i < out.size(); ++i)
     if (domain.in[i]) out[i] = float(domain.height[i]);
-  if (loose) {
-    *loose = dem.like<float>(0);
-    for (std::size_t i = 0; i < out.size(); ++i)
-      (*loose)[i] = std::isnan(dem[i]) ? NAN : domain.loose.empty() ? 0.0f : float(std::max(0.0, domain.loose[i]));
-  }
+  if (loose) *loose = loose_thickness(dem, domain);
   if (report) {
     report->iterations = done;
     measure(dem, out, metrics, *report);

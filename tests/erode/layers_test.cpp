@@ -181,6 +181,28 @@ TEST(LayeredErosion, BalancesOnGeographicCellsWithNodata) {
   for (std::size_t i = 0; i < dem.size(); ++i) EXPECT_EQ(std::isnan(out[i]), std::isnan(dem[i])) << i;
 }
 
+TEST(LayeredErosion, OutsideTheMaskNothingChanges) {
+  const Dem dem = random_dem(30, 24, 31, 40);
+  Raster<std::uint8_t> mask = dem.like<std::uint8_t>(0);
+  for (int r = 0; r < dem.rows(); ++r)
+    for (int c = 0; c < 15; ++c) mask(c, r) = 1;
+  const Raster<float> loose = dem.like<float>(2.0f);
+  ErodeOptions o = layered(40, 0.3);
+  o.layered.loose_m = &loose;
+  Raster<float> loose_end;
+  const Dem out = run(dem, o, nullptr, &mask, &loose_end);
+  int changed = 0;
+  for (int r = 0; r < dem.rows(); ++r)
+    for (int c = 0; c < dem.cols(); ++c) {
+      if (c >= 15) {
+        EXPECT_EQ(out(c, r), dem(c, r)) << c << "," << r;
+        EXPECT_EQ(loose_end(c, r), 2.0f) << c << "," << r;
+      }
+      changed += c < 15 && loose_end(c, r) != 2.0f;
+    }
+  EXPECT_GT(changed, 100);
+}
+
 TEST(LayeredErosion, OneAndTwoThreadsGiveTheSameBytes) {
   const Dem dem = random_dem(64, 96, 29, 30);
   Raster<float> rockfall = dem.like<float>(0);
