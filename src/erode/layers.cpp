@@ -43,7 +43,7 @@ std::vector<GlobalErosion::Chord> GlobalErosion::sphere(int r) const {
   return chords;
 }
 
-// Beardall et al. 2007 (Peytavie's BFO+07): the accessibility of a point is the share of a sphere
+// Beardall et al. 2007, "Goblins by spheroidal weathering" (Peytavie's BFO+07): the accessibility of a point is the share of a sphere
 // around it that is air. On a grid, each column within the radius cuts a vertical chord of the
 // sphere, [z - half, z + half], of which the part above the column's surface is air; the chords
 // are weighted by their volume (2 half x area). Flat ground: 1/2; a peak or an edge: more; a
@@ -52,9 +52,8 @@ double GlobalErosion::accessibility(int c, int r, const std::vector<Chord>& chor
   const double z = d_.height[d_.index(c, r)];
   double air = 0, all = 0;
   for (const Chord& k : chords) {
-    const int cc = c + k.dc;
-    if (cc < 0 || cc >= d_.cols) continue;
-    const double h = d_.height[d_.index(cc, r + k.dr)];
+    if (!d_.on_grid(c + k.dc, r + k.dr)) continue;
+    const double h = d_.height[d_.index(c + k.dc, r + k.dr)];
     if (std::isnan(h)) continue;
     air += std::clamp((z + k.half_m - h) / (2 * k.half_m), 0.0, 1.0) * k.weight_m4;
     all += k.weight_m4;
