@@ -1,4 +1,4 @@
-// The state both erosions share: heights in double, which cells may change, cell sizes (internal).
+// The state the erosions share: heights in double, the loose layer, which cells may change, cell sizes (internal).
 // SPDX-License-Identifier: MIT
 #pragma once
 #include <tbb/blocked_range.h>
@@ -15,19 +15,28 @@
 
 namespace terrapolis::erode {
 
+/// Excess heights and loose films thinner than this (m) are stable: the relaxation converges
+/// geometrically, and heights are written as float32 (a step of 6e-5 m at 1000 m) anyway.
+inline constexpr double stable_m = 1e-6;
+
 /// Heights (m) and the domain: cells with data inside the mask. Cells outside the domain never
 /// change; the processes treat them as outside the grid.
 struct Domain {
   int cols = 0, rows = 0;
-  std::vector<double> height;      ///< m, NaN outside the data
+  std::vector<double> height;      ///< the surface, m, NaN outside the data
+  /// Loose material on the bedrock, m >= 0 (the bedrock is height - loose); empty: one material that
+  /// all moves (hydraulic, thermal), filled: only this layer slides (layered, Peytavie 2010 §2.3).
+  std::vector<double> loose;
   std::vector<std::uint8_t> in;    ///< 1: may change
   const CellMetrics* metrics = nullptr;
 
   std::size_t index(int c, int r) const { return std::size_t(r) * std::size_t(cols) + std::size_t(c); }
+  /// Cell (c, r) lies on the grid.
+  bool on_grid(int c, int r) const { return c >= 0 && r >= 0 && c < cols && r < rows; }
   /// Neighbour k of (c, r) when it is inside the domain.
   bool inside(int c, int r, int k) const {
     const int cc = c + dcol[k], rr = r + drow[k];
-    return cc >= 0 && rr >= 0 && cc < cols && rr < rows && in[index(cc, rr)];
+    return on_grid(cc, rr) && in[index(cc, rr)];
   }
 };
 
@@ -84,8 +93,40 @@ class Thermal {
 
   Domain& d_;
   double rate_;
-  std::vector<double> tan_, next_;
+  std::vector<double> tan_, next_, next_loose_;
   std::vector<std::array<double, 8>> out_;  ///< m³ sent to neighbour k (neighbours.hpp order)
 };
+
+/// Global erosion of the bedrock (Peytavie 2010 §2.3.2): each cell's top rock voxel weathers by
+/// eta <- eta - a(p) S(p) while it touches the air, and turns into loose material when eta reaches 0.
+class GlobalErosion {
+ public:
+  /// Throws bad_input naming /erode/radius_m when the sphere spans more than max_reach cells.
+  GlobalErosion(Domain& domain, const LayeredOptions& options);
+  /// One iteration; returns the rock turned loose, m³.
+  double step();
+  static constexpr int max_reach = 25;  ///< cells from the centre the sphere may reach
+
+ private:
+  struct Chord {
+    int dc, dr;
+    double half_m, weight_m4;  ///< half the sphere's vertical chord above the column, m; x 2 x area
+  };
+  std::vector<Chord> sphere(int r) const;  // the columns within radius_m of a cell of row r
+  double accessibility(int c, int r, const std::vector<Chord>& chords) const;
+  double strength(double z) const;  // S(p) at height z, per iteration
+  bool exposed(std::size_t i) const;
+  double weather(int r);  // one row of step()
+
+  Domain& d_;
+  LayeredOptions o_;
+  std::vector<double> eta_;  ///< erosion value of each cell's top rock voxel, 1: intact
+  int reach_c_ = 0, reach_r_ = 0;
+};
+
+/// Local erosion (Peytavie 2010 §2.3.3): breaks `rockfall_m` (m per cell, on the grid) of rock off
+/// into loose material inside the domain; returns the volume, m³. Throws bad_input on a value that is
+/// negative or infinite.
+double break_off(Domain& domain, const Raster<float>& rockfall_m);
 
 }  // namespace terrapolis::erode

@@ -1,4 +1,4 @@
-// The erosion run: the domain, the iterations of each process, and what they moved.
+// The erosion run: the domain (and its loose layer), the iterations of each process, and what they moved.
 // SPDX-License-Identifier: MIT
 #include "erode/erosion.hpp"
 
@@ -29,6 +29,10 @@ void check_settings(const ErodeOptions& o) {
     throw bad_input("/erode: dissolve and deposit must lie in [0, 1], evaporation in [0, 1)");
   if (!(o.thermal.angle_deg > 0 && o.thermal.angle_deg < 90)) throw bad_input("/erode/angle_deg: must lie in (0, 90) degrees");
   if (!(o.thermal.rate > 0 && o.thermal.rate <= 1)) throw bad_input("/erode: the thermal rate must lie in (0, 1]");
+  const LayeredOptions& l = o.layered;
+  if (!(l.erodibility >= 0 && l.erodibility <= 1)) throw bad_input("/erode/erodibility: must lie in [0, 1]");
+  if (!(l.voxel_m > 0) || !(l.radius_m > 0)) throw bad_input("/erode: voxel_m and radius_m must be > 0");
+  if (!(l.strata_m >= 0) || !(l.hard_ratio >= 0 && l.hard_ratio <= 1)) throw bad_input("/erode: strata_m must be >= 0, hard_ratio in [0, 1]");
 }
 
 namespace {
@@ -43,6 +47,55 @@ Domain make_domain(const Dem& dem, const CellMetrics& metrics, const Raster<std:
   d.in.resize(dem.size());
   for (std::size_t i = 0; i < dem.size(); ++i) d.in[i] = !std::isnan(dem[i]) && (!mask || (*mask)[i] != 0);
   return d;
+}
+
+/// The loose layer of a layered ground: the given thickness on the cells with data (outside the mask
+/// it stays as given), 0 elsewhere.
+void add_loose_layer(Domain& d, const Raster<float>* loose_m) {
+  d.loose.assign(d.height.size(), 0.0);
+  if (!loose_m) return;
+  if (loose_m->cols() != d.cols || loose_m->rows() != d.rows) throw bad_input("/erode/loose: not on the DEM's grid");
+  for (std::size_t i = 0; i < d.loose.size(); ++i) {
+    const double t = (*loose_m)[i];
+    if (std::isnan(d.height[i]) || std::isnan(t)) continue;
+    if (!(t >= 0 && std::isfinite(t))) throw bad_input("/erode/loose: thickness " + std::to_string(t) + " m is not a finite value >= 0");
+    d.loose[i] = t;
+  }
+}
+
+/// The processes of one run over a domain, each present when the options ask for it.
+struct Processes {
+  std::optional<Hydraulic> water;
+  std::optional<Thermal> slide;
+  std::optional<GlobalErosion> weathering;
+  double loosened_m3 = 0;
+
+  Processes(Domain& domain, const ErodeOptions& o) {
+    if (o.process == Process::layered) {
+      add_loose_layer(domain, o.layered.loose_m);
+      if (o.layered.rockfall_m) loosened_m3 = break_off(domain, *o.layered.rockfall_m);
+      if (o.layered.erodibility > 0) weathering.emplace(domain, o.layered);
+    }
+    if (o.process == Process::hydraulic || o.process == Process::both) water.emplace(domain, o.hydraulic);
+    if (o.process != Process::hydraulic) slide.emplace(domain, o.thermal);  // after the loose layer is laid
+  }
+  /// One iteration; false once nothing can change any more (only slides left, and none moved).
+  bool step() {
+    if (water) water->step();
+    if (weathering) loosened_m3 += weathering->step();
+    const double moved = slide ? slide->step() : 0.0;
+    return water || weathering || moved > 0;
+  }
+};
+
+/// The loose thickness at the end, m (0 without a loose layer, NaN on nodata; a film of rounding
+/// below 0 left by a cell that sent all it held shows as 0).
+Raster<float> loose_thickness(const Dem& dem, const Domain& domain) {
+  Raster<float> loose = dem.like<float>(0);
+  for (std::size_t i = 0; i < loose.size(); ++i)
+    if (std::isnan(dem[i])) loose[i] = NAN;
+    else if (!domain.loose.empty()) loose[i] = float(std::max(0.0, domain.loose[i]));
+  return loose;
 }
 
 /// The report's volumes from the float output against the float input (one pass, in cell order).
@@ -61,35 +114,32 @@ void measure(const Dem& before, const Dem& after, const CellMetrics& metrics, Er
 }  // namespace
 
 Dem erode(const Dem& dem, const CellMetrics& metrics, const ErodeOptions& options, const Raster<std::uint8_t>* mask,
-          Progress& progress, ErodeReport* report) {
+          Progress& progress, ErodeReport* report, Raster<float>* loose) {
   check_settings(options);
   const auto start = std::chrono::steady_clock::now();
   Domain domain = make_domain(dem, metrics, mask);
-  const bool hydraulic = options.process != Process::thermal, thermal = options.process != Process::hydraulic;
-  std::optional<Hydraulic> water;
-  std::optional<Thermal> slide;
-  if (hydraulic) water.emplace(domain, options.hydraulic);
-  if (thermal) slide.emplace(domain, options.thermal);
+  Processes run(domain, options);
   int done = 0;
   {
     ProgressStep step(progress, "erode");
-    while (done < options.iterations) {
-      if (water) water->step();
-      const double moved = slide ? slide->step() : 0.0;
+    bool changing = true;
+    while (changing && done < options.iterations) {
+      changing = run.step();  // stable: further iterations would change nothing
       ++done;
       step.update(double(done) / options.iterations);
-      if (!hydraulic && moved == 0) break;  // stable: further iterations would change nothing
     }
   }
-  if (water) water->settle();
+  if (run.water) run.water->settle();
   Dem out = dem;
   for (std::size_t i = 0; i < out.size(); ++i)
     if (domain.in[i]) out[i] = float(domain.height[i]);
+  if (loose) *loose = loose_thickness(dem, domain);
   if (report) {
     report->iterations = done;
     measure(dem, out, metrics, *report);
-    report->carried_out_m3 = water ? water->sediment_out_m3 : 0.0;
-    report->water_out_m3 = water ? water->water_out_m3 : 0.0;
+    report->carried_out_m3 = run.water ? run.water->sediment_out_m3 : 0.0;
+    report->water_out_m3 = run.water ? run.water->water_out_m3 : 0.0;
+    report->loosened_m3 = run.loosened_m3;
     report->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     report->seconds_per_iteration = done > 0 ? report->seconds / done : 0.0;
   }

@@ -1,7 +1,10 @@
 // Thermal erosion to the angle of repose: Musgrave, Kolb & Mace 1989 ("The synthesis and rendering
 // of eroded fractal terrains", SIGGRAPH, §4) with Peytavie's stabilisation (Peytavie 2010, thesis
-// §2.3.4): material above the angle of repose slides to the lower neighbours.
+// §2.3.4): material above the angle of repose slides to the lower neighbours; on a layered ground
+// only the loose layer does (Peytavie §2.1.1.1: "le moteur physique opère sur l'ensemble des
+// matériaux sauf la roche").
 // SPDX-License-Identifier: MIT
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -9,16 +12,9 @@
 #include "erode/domain.hpp"
 
 namespace terrapolis::erode {
-namespace {
-
-// Excess heights below this are stable: the relaxation converges geometrically, and heights are
-// written as float32 (a step of 6e-5 m at 1000 m) anyway.
-constexpr double stable_m = 1e-6;
-
-}  // namespace
 
 Thermal::Thermal(Domain& domain, const ThermalOptions& options)
-    : d_(domain), rate_(options.rate), tan_(domain.height.size(), 0.0), next_(domain.height),
+    : d_(domain), rate_(options.rate), tan_(domain.height.size(), 0.0), next_(domain.height), next_loose_(domain.loose),
       out_(domain.height.size(), {0, 0, 0, 0, 0, 0, 0, 0}) {
   const double deg = std::numbers::pi / 180;
   for (std::size_t i = 0; i < tan_.size(); ++i) {
@@ -53,8 +49,11 @@ double Thermal::outflows(int r) {
     }
     // Musgrave et al.: move c (d_max - T), shared in proportion to each neighbour's excess
     // (Peytavie's dz_i = a dh_i / sum dh_i); as a volume, so unequal cells conserve mass.
-    const double volume = total > 0 ? rate_ * largest * area : 0.0;
-    for (int k = 0; k < 8; ++k) out_[i][std::size_t(k)] = total > 0 ? volume * excess[std::size_t(k)] / total : 0.0;
+    double volume = total > 0 ? rate_ * largest * area : 0.0;
+    // Layered: no more than the loose material on the cell; steep bare rock stays (a film thinner
+    // than stable_m counts as bare, so that the last of a layer does not trickle for ever).
+    if (!d_.loose.empty()) volume = std::min(volume, d_.loose[i] > stable_m ? d_.loose[i] * area : 0.0);
+    for (int k = 0; k < 8; ++k) out_[i][std::size_t(k)] = volume > 0 ? volume * excess[std::size_t(k)] / total : 0.0;
     moved += volume;
   }
   return moved;
@@ -71,6 +70,7 @@ void Thermal::gather(int r) {
       if (d_.inside(c, r, k)) change += out_[d_.index(c + dcol[k], r + drow[k])][std::size_t(opposite(k))];
     }
     next_[i] = d_.height[i] + change / area;
+    if (!d_.loose.empty()) next_loose_[i] = d_.loose[i] + change / area;  // only loose material moved
   }
 }
 
@@ -79,6 +79,7 @@ double Thermal::step() {
   if (moved == 0) return 0;
   for_rows(d_.rows, [&](int r) { gather(r); });
   d_.height.swap(next_);
+  d_.loose.swap(next_loose_);
   return moved;
 }
 

@@ -209,7 +209,10 @@ erode::ErodeOptions erode_options(const Scenario& scenario) {
   const json& e = scenario.resolved["erode"];
   erode::ErodeOptions o;
   const std::string process = e["process"].get<std::string>();
-  o.process = process == "hydraulic" ? erode::Process::hydraulic : process == "thermal" ? erode::Process::thermal : erode::Process::both;
+  o.process = process == "hydraulic" ? erode::Process::hydraulic
+              : process == "thermal"  ? erode::Process::thermal
+              : process == "layered"  ? erode::Process::layered
+                                      : erode::Process::both;
   o.iterations = e["iterations"].get<int>();
   o.hydraulic.rain_m = e["rain_m"].get<double>();
   o.hydraulic.capacity_s = e["capacity_s"].get<double>();
@@ -219,6 +222,11 @@ erode::ErodeOptions erode_options(const Scenario& scenario) {
   o.hydraulic.dt_s = e["dt_s"].get<double>();
   const double angle = e["angle_deg"].get<double>();
   o.thermal.angle_deg = angle > 0 ? angle : erode::material_angle_deg(e["material"].get<std::string>());
+  o.layered.erodibility = e["erodibility"].get<double>();
+  o.layered.voxel_m = e["voxel_m"].get<double>();
+  o.layered.radius_m = e["radius_m"].get<double>();
+  o.layered.strata_m = e["strata_m"].get<double>();
+  o.layered.hard_ratio = e["hard_ratio"].get<double>();
   erode::check_settings(o);
   return o;
 }

@@ -47,7 +47,8 @@ lake::LakeSpec reservoir_spec(const nlohmann::ordered_json& item);
 /// The skeleton section (terrapolis skeleton, docs/skeleton.md).
 skeleton::SkeletonOptions skeleton_options(const Scenario& scenario);
 /// The erode section (terrapolis erode, docs/erode.md): the angle of repose from erode.angle_deg, or
-/// else erode.material; the files it names (erode.mask, erode.angles) are read by the caller.
+/// else erode.material; the files it names (erode.mask, erode.angles, erode.loose, erode.rockfall)
+/// are read by the caller.
 erode::ErodeOptions erode_options(const Scenario& scenario);
 /// Code convention of flowdir.tif.
 hydro::D8Codes d8_codes(const Scenario& scenario);

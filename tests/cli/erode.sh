@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # `terrapolis erode` on a real DEM: the grid, CRS and provenance kept, the report's mass balance,
 # zero iterations copy the DEM, any thread count gives the same bytes, nodata and the mask are
-# honoured, and bad input is refused with one line and nothing written.
+# honoured, the layered ground (Peytavie 2010 §2.3) balances its loose volume, and bad input is
+# refused with one line and nothing written.
 # SPDX-License-Identifier: MIT
 source "$(dirname "$0")/lib.sh" "$@"
 bin=$TP samples=$SAMPLES work=$WORK
@@ -59,6 +60,38 @@ assert np.array_equal(a[:, 58:][~hole[:, 58:]], b[:, 58:][~hole[:, 58:]]), "cell
 assert (a[:, :58] != b[:, :58]).sum() > 1000, "nothing eroded inside the mask"
 PY
 
+# Layered: a loose cover and a rockfall in the middle; the surface balances, the loose volume at the
+# end is the loose volume at the start plus the rock loosened, 1 and 2 threads give the same bytes.
+/usr/bin/python3 - "$dem" "$work/loose.tif" "$work/rockfall.tif" <<'PY'
+import sys
+from osgeo import gdal
+src = gdal.Open(sys.argv[1])
+for path, value in ((sys.argv[2], 0.5), (sys.argv[3], 0.0)):
+    out = gdal.GetDriverByName("GTiff").CreateCopy(path, src)
+    a = out.GetRasterBand(1).ReadAsArray() * 0 + value
+    if value == 0: a[50:60, 50:60] = 6
+    out.GetRasterBand(1).DeleteNoDataValue(); out.GetRasterBand(1).WriteArray(a); out = None
+PY
+for t in 1 2; do
+  "$bin" -q --threads $t erode "$dem" "$work/layered$t.tif" --process layered --iterations 30 --erodibility 0.2 --strata 20 \
+    --loose "$work/loose.tif" --rockfall "$work/rockfall.tif" --loose-out "$work/scree$t.tif" --report "$work/layered$t.json"
+done
+cmp -s "$work/layered1.tif" "$work/layered2.tif" && cmp -s "$work/scree1.tif" "$work/scree2.tif" || fail "layered: --threads 1 and 2 differ"
+/usr/bin/python3 - "$dem" "$work/layered1.tif" "$work/scree1.tif" "$work/layered1.json" <<'PY'
+import json, sys
+import numpy as np
+from osgeo import gdal
+src = gdal.Open(sys.argv[1]); gt = src.GetGeoTransform(); area = gt[1] * -gt[5]
+a = src.ReadAsArray().astype(float); b = gdal.Open(sys.argv[2]).ReadAsArray().astype(float)
+scree = gdal.Open(sys.argv[3]).ReadAsArray().astype(float); j = json.load(open(sys.argv[4]))
+tol = np.abs(a).sum() * area * 2.0 ** -23
+assert j["carried_out_m3"] == 0 and j["eroded_m3"] > 0 and abs(j["eroded_m3"] - j["deposited_m3"]) <= tol, j
+assert j["loosened_m3"] > 100 * 6 * area * 1.5, j  # the rockfall and more weathered rock
+loose_start = 0.5 * area * a.size
+assert abs(scree.sum() * area - loose_start - j["loosened_m3"]) <= tol, (scree.sum() * area, loose_start, j)
+assert scree.min() >= 0, scree.min()
+PY
+
 # Refused: one line naming the file or flag, exit 2, nothing written.
 expect_refused "$work/bad.tif" "missing.tif" "$bin" erode "$work/missing.tif" "$work/bad.tif"
 expect_refused "$work/bad.tif" "^terrapolis: error: --material" "$bin" erode "$dem" "$work/bad.tif" --material gravel
@@ -66,6 +99,8 @@ expect_refused "$work/bad.tif" "--dissolve" "$bin" erode "$dem" "$work/bad.tif" 
 expect_refused "$work/bad.tif" "--angle" "$bin" erode "$dem" "$work/bad.tif" --angle 95
 expect_refused "$work/bad.tif" "--iterations" "$bin" erode "$dem" "$work/bad.tif" --iterations -3
 expect_refused "$work/bad.tif" "nomask.tif" "$bin" erode "$dem" "$work/bad.tif" --mask "$work/nomask.tif"
+expect_refused "$work/bad.tif" "--erodibility" "$bin" erode "$dem" "$work/bad.tif" --process layered --erodibility 2
+expect_refused "$work/bad.tif" "--radius: .* at most 25" "$bin" erode "$dem" "$work/bad.tif" --process layered --radius 900
 [[ $(wc -l <"$work/stderr") -eq 1 ]] || fail "more than one line: $(cat "$work/stderr")"
 expect_fail 2 "out.tif" "$bin" erode "$dem" "$work/out.tif"  # exists, no --overwrite
 "$bin" -q erode "$dem" "$work/out.tif" --iterations 2 --overwrite

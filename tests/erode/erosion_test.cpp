@@ -8,58 +8,14 @@
 #include <cmath>
 #include <cstring>
 #include <numbers>
-#include <random>
 
 #include "core/error.hpp"
-#include "support/georefs.hpp"
+#include "erode/erode_grids.hpp"
 
 namespace terrapolis::erode {
 namespace {
 
-/// Rolling hills with noise, 300-700 m, on 1/1200 degree cells at 45 N (about 65 x 93 m).
-Dem random_dem(int cols, int rows, unsigned seed, double noise_m) {
-  Dem dem(cols, rows, test::geographic(45.0, 1.0 / 1200));
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u(-1, 1);
-  for (int r = 0; r < rows; ++r)
-    for (int c = 0; c < cols; ++c)
-      dem(c, r) = float(500 + 150 * std::sin(c * 0.3) * std::cos(r * 0.2) + 3 * c + noise_m * u(rng));
-  return dem;
-}
-
-/// A plane falling eastwards by `slope` (m/m) on 10 m cells.
-Dem ramp(int cols, int rows, double slope) {
-  Dem dem(cols, rows, test::projected(10));
-  for (int r = 0; r < rows; ++r)
-    for (int c = 0; c < cols; ++c) dem(c, r) = float(100 + slope * 10 * (cols - 1 - c));
-  return dem;
-}
-
-ErodeOptions with(Process process, int iterations) {
-  ErodeOptions o;
-  o.process = process;
-  o.iterations = iterations;
-  return o;
-}
-
-Dem run(const Dem& dem, const ErodeOptions& options, ErodeReport* report = nullptr, const Raster<std::uint8_t>* mask = nullptr) {
-  SilentProgress progress;
-  return erode(dem, cell_metrics(dem.georef(), dem.cols(), dem.rows()), options, mask, progress, report);
-}
-
-bool same_bytes(const Dem& a, const Dem& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
-}
-
-/// The float rounding of the heights written, summed over the grid: the precision of the balance.
-double float_tolerance_m3(const Dem& dem) {
-  const CellMetrics m = cell_metrics(dem.georef(), dem.cols(), dem.rows());
-  double tolerance = 0;
-  for (int r = 0; r < dem.rows(); ++r)
-    for (int c = 0; c < dem.cols(); ++c)
-      if (!std::isnan(dem(c, r))) tolerance += m.area_m2[std::size_t(r)] * std::abs(dem(c, r)) * 0x1p-23;
-  return tolerance;
-}
+using namespace test_grids;
 
 TEST(Erosion, HydraulicBalancesErodedDepositedAndCarriedOut) {
   Dem dem = random_dem(48, 40, 7, 5);
@@ -116,7 +72,7 @@ TEST(Erosion, GentleSlopeDoesNotMove) {
 TEST(Erosion, ZeroIterationsChangeNothing) {
   Dem dem = random_dem(20, 18, 5, 30);
   dem(3, 4) = NAN;
-  for (const Process p : {Process::hydraulic, Process::thermal, Process::both}) EXPECT_TRUE(same_bytes(run(dem, with(p, 0)), dem));
+  for (const Process p : {Process::hydraulic, Process::thermal, Process::both, Process::layered}) EXPECT_TRUE(same_bytes(run(dem, with(p, 0)), dem));
 }
 
 TEST(Erosion, OneAndTwoThreadsGiveTheSameBytes) {
