@@ -6,7 +6,7 @@ length over the geodesic distance of its ends) per link and between city pairs 1
 apart through the network (Dijkstra on the sections; real regional networks: about 1.2-1.4,
 Ballou, Rahardja & Sakai 2002, "Selected country circuity factors for road travel distance
 estimation", Transportation Research A 36), the share of surface length above each class's grade
-limit, and the surface length on water (no bridge).
+limit, the surface length on water (no bridge), and the road density the run states (run.json).
 Usage: network_quality.py RUN_FOLDER   (coordinates in lon/lat: the SRTM and GEBCO tiles)
 """
 import heapq
@@ -92,6 +92,13 @@ def main(folder):
     grades = ', '.join('%s %.1f %% over %s %% (longest %.0f m)' % (c, 100 * s[1] / s[0] if s[0] else 0, s[3], s[2])
                        for c, s in sorted(by_class.items()))
     print('  surface above the class grade limit: %s; on water without a structure: %.2f km' % (grades or 'no roads', water_km))
+    # Road density as the run states it (run.json): against France's 0.73 km/km2 of national and
+    # departmental roads and 2.0 km/km2 of all roads (Cour des comptes, ccomptes.fr/en/documents/59347).
+    run = os.path.join(folder, 'run.json')
+    figures = json.load(open(run))['summary'].get('roads', {}) if os.path.exists(run) else {}
+    if 'network_km_per_km2' in figures:
+        print('  road density: %.3f km per km2 of land (%.0f km2; France: 0.73 national and departmental, 2.0 all roads)' %
+              (figures['network_km_per_km2'], figures['land_km2']))
 
 
 if __name__ == '__main__':
