@@ -33,6 +33,37 @@ def load(folder, name):
     return json.load(open(path))['features'] if os.path.exists(path) else []
 
 
+def water_test(folder):
+    """A test of whether the straight line between two lon/lat points crosses water (the sea: at or
+    below 0 m or nodata in elevation.tif; the lakes of inland_water.tif), sampled every half cell;
+    None without GDAL's Python bindings or the rasters."""
+    try:
+        from osgeo import gdal
+    except ImportError:
+        return None
+    paths = [os.path.join(folder, f) for f in ('elevation.tif', 'inland_water.tif')]
+    if not all(os.path.exists(p) for p in paths):
+        return None
+    ds = gdal.Open(paths[0])
+    gt, band = ds.GetGeoTransform(), ds.GetRasterBand(1)
+    z, nodata = band.ReadAsArray(), band.GetNoDataValue()
+    lakes = gdal.Open(paths[1])  # kept open while its band is read (GDAL's bindings need the dataset)
+    lake = lakes.GetRasterBand(1).ReadAsArray()
+    rows, cols = z.shape
+
+    def wet(lon, lat):
+        c, r = int((lon - gt[0]) / gt[1]), int((lat - gt[3]) / gt[5])
+        if not (0 <= r < rows and 0 <= c < cols):
+            return True
+        v = z[r, c]
+        return lake[r, c] == 1 or v != v or (nodata is not None and v == nodata) or v <= 0
+
+    def crosses(a, b):
+        n = max(2, int(2 * max(abs(b[0] - a[0]) / abs(gt[1]), abs(b[1] - a[1]) / abs(gt[5]))))
+        return any(wet(a[0] + (b[0] - a[0]) * k / n, a[1] + (b[1] - a[1]) * k / n) for k in range(1, n))
+    return crosses
+
+
 def main(folder):
     roads = load(folder, 'roads.geojson')
     sections = load(folder, 'sections.geojson')
@@ -55,7 +86,8 @@ def main(folder):
         city.setdefault(r['properties']['from'], key(c[0]))
         city.setdefault(r['properties']['to'], key(c[-1]))
     ids = sorted(i for i in city if city[i] in graph)
-    pair, unreachable = [], 0
+    over_water = water_test(folder)
+    pair, land_pair, unreachable = [], [], 0
     for n, i in enumerate(ids):
         dist = {city[i]: 0.0}
         heap = [(0.0, city[i])]
@@ -73,6 +105,8 @@ def main(folder):
                 continue
             if city[j] in dist:
                 pair.append(dist[city[j]] / g)
+                if over_water and not over_water(city[i], city[j]):
+                    land_pair.append(dist[city[j]] / g)
             else:
                 unreachable += 1
     # Grades and water, per class, on the surface (no bridge or tunnel).
@@ -89,6 +123,9 @@ def main(folder):
           (km, len(roads), sum(r['properties']['length_m'] for r in roads) / 1000, len(sections), len(junctions)))
     print('  circuity per link: median %.2f p90 %.2f; city pairs >= 10 km: %d, median %.2f p90 %.2f (%d pairs not joined by road)' %
           (quantile(link, .5), quantile(link, .9), len(pair), quantile(pair, .5), quantile(pair, .9), unreachable))
+    if over_water:
+        print('  city pairs >= 10 km whose straight line stays on land (no sea or lake to go round): %d, median %.2f p90 %.2f' %
+              (len(land_pair), quantile(land_pair, .5), quantile(land_pair, .9)))
     grades = ', '.join('%s %.1f %% over %s %% (longest %.0f m)' % (c, 100 * s[1] / s[0] if s[0] else 0, s[3], s[2])
                        for c, s in sorted(by_class.items()))
     print('  surface above the class grade limit: %s; on water without a structure: %.2f km' % (grades or 'no roads', water_km))

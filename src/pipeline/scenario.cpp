@@ -51,6 +51,14 @@ json with_defaults(const json& doc, const json& defaults) {
 }
 
 
+/// Adds to `doc` what `values` has and it has not, object by object (nothing given is replaced).
+void fill_missing(json& doc, const json& values) {
+  for (const auto& [key, value] : values.items()) {
+    if (!doc.contains(key)) doc[key] = value;
+    else if (value.is_object() && doc[key].is_object()) fill_missing(doc[key], value);
+  }
+}
+
 void apply_set(json& doc, const std::string& set) {
   const auto eq = set.find('=');
   if (eq == std::string::npos || eq == 0) throw bad_input("--set " + set + ": expected stage.field=value");
@@ -124,14 +132,14 @@ void resolve(Scenario& s, json doc, const std::vector<std::string>& sets, std::o
   if (seed) doc["seed"] = *seed;
   const std::string problem = validate_scenario(doc);
   if (!problem.empty()) throw bad_input(s.source + ": " + problem);
-  // density.preset: its weights stand in for the schema's defaults of the weights not given.
+  // A section's preset (density.preset, network.preset): its settings stand in for the schema's
+  // defaults of the settings not given (x-presets of the section's preset field).
   const nlohmann::json schema_doc = nlohmann::json::parse(scenario_schema_text());
-  if (doc.contains("density") && doc["density"].contains("preset")) {
-    const std::string preset = doc["density"]["preset"].get<std::string>();
-    const auto& presets = schema_doc["properties"]["density"]["properties"]["preset"]["x-weights"];
-    if (presets.contains(preset))
-      for (const auto& [term, weight] : presets[preset].items())
-        if (!doc["density"].contains("weights") || !doc["density"]["weights"].contains(term)) doc["density"]["weights"][term] = weight;
+  for (const auto& [section, sub] : schema_doc["properties"].items()) {
+    if (!sub.contains("properties") || !sub["properties"].contains("preset") || !doc.contains(section) || !doc[section].contains("preset")) continue;
+    const json& presets = sub["properties"]["preset"]["x-presets"];
+    if (const std::string preset = doc[section]["preset"].get<std::string>(); presets.contains(preset))
+      fill_missing(doc[section], presets[preset]);
   }
   s.resolved = with_defaults(doc, schema_defaults());
   // Objects listed in a top-level array (plugins) get their own defaults too.

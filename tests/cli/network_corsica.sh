@@ -6,7 +6,8 @@ DEM=$SAMPLES/gebco2022_15s_north_corsica_capcorse.asc
 stand_in_density "$DEM" "$T/in"
 "$BIN" --quiet sites "$T/in" "$T/s" --seed 5 --quotas belhadj2007
 
-"$BIN" --quiet network "$T/s/cities.geojson" "$T/n" | tee "$T/out.txt"
+# The thesis's detour factor by its preset (the default, 1.5, is tested below).
+"$BIN" --quiet network "$T/s/cities.geojson" "$T/n" --preset belhadj2007 | tee "$T/out.txt"
 grep -q "k 1.80" "$T/out.txt"
 info=$(ogrinfo -so -al "$T/n/network.geojson")
 grep -q "Geometry: Line String" <<< "$info"
@@ -27,8 +28,16 @@ test "$(q "select count(*) as n from network where kept = 0")" -gt 0
 kept18=$(q "select count(*) as n from network where kept = 1")
 kept12=$(ogrinfo -q -dialect sqlite -sql "select count(*) as n from network where kept = 1" "$T/n2/network.geojson" | grep -o "n (Integer) = [0-9]*" | grep -o "[0-9]*$")
 test "$kept12" -gt "$kept18"
-"$BIN" --quiet network "$T/s/cities.geojson" "$T/n3"
+"$BIN" --quiet network "$T/s/cities.geojson" "$T/n3" --preset belhadj2007
 cmp "$T/n/network.geojson" "$T/n3/network.geojson"
+# The default k (1.5) keeps more links than the thesis's, and still every parent-child link.
+"$BIN" --quiet network "$T/s/cities.geojson" "$T/n4" | grep -q "k 1.50"
+kept15=$(ogrinfo -q -dialect sqlite -sql "select count(*) as n from network where kept = 1" "$T/n4/network.geojson" | grep -o "n (Integer) = [0-9]*" | grep -o "[0-9]*$")
+test "$kept15" -gt "$kept18"
+pc15=$(ogrinfo -q -dialect sqlite -sql "select count(*) as n from network where kind = 'parent_child' and kept = 1" "$T/n4/network.geojson" | grep -o "n (Integer) = [0-9]*" | grep -o "[0-9]*$")
+test "$pc15" -eq "$suburbs"
+# A --k given stands over the preset's.
+"$BIN" --quiet network "$T/s/cities.geojson" "$T/n5" --preset belhadj2007 --k 1.2 | grep -q "k 1.20"
 
 # A planner's own cities: ids of their choosing, one suburb.
 cat > "$T/plan.geojson" <<'JSON'
