@@ -11,8 +11,9 @@ namespace terrapolis::network {
 
 struct NetworkOptions {
   /// Detour factor k > 1: an edge of length D_d is removed when another path shorter than
-  /// k x D_d joins its ends (Belhadj §4.3.2, k = 1.8: "a detour under 80 % extra").
-  double k = 1.8;
+  /// k x D_d joins its ends (Belhadj §4.3.2 takes 1.8: "a detour under 80 % extra"; 1.5 joins
+  /// city pairs at the circuity of real networks, docs/sites.md).
+  double k = 1.5;
 };
 
 /// Where an edge comes from, in priority order when several triangulations give it.

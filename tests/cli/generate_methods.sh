@@ -151,7 +151,7 @@ done
 cmp "$T/e.tif" "$T/e1.tif" || { echo "erode: 1 and 2 threads differ"; exit 1; }
 cmp "$T/e0.tif" "$T/plain.tif" || { echo "erode: 0 iterations changed the DEM"; exit 1; }
 ! cmp -s "$T/e.tif" "$T/plain.tif" || { echo "erode: the DEM did not change"; exit 1; }
-gdalinfo "$T/e.tif" | grep -q 'TERRAPOLIS_ERODE=.*"process":"hydraulic"' || { echo "erode: no TERRAPOLIS_ERODE metadata"; exit 1; }
+grep -q 'TERRAPOLIS_ERODE=.*"process":"hydraulic"' <(gdalinfo "$T/e.tif") || { echo "erode: no TERRAPOLIS_ERODE metadata"; exit 1; }
 /usr/bin/python3 - "$T" <<'PY' || exit 1
 import json, sys
 share = lambda f: json.load(open(f"{sys.argv[1]}/{f}.report.json"))["d8_consistency"]["share_within_2_cells"]

@@ -124,7 +124,7 @@ void check_network(const std::vector<Site>& s, const Crs& crs, const SiteGraph& 
 }  // namespace
 
 // A(0,0) B(1000,0) C(500,100): AB (1000 m) is examined first (longest) and A-C-B, 1019.8 m,
-// is under 1.8 x 1000: AB goes. AC and BC then have no other path and stay.
+// is under k x 1000 (the default 1.5): AB goes. AC and BC then have no other path and stay.
 TEST(Network, GoldenTriangle) {
   const auto s = numbered({site(0, 0, 100), site(1000, 0, 100), site(500, 100, 100)});
   SilentProgress progress;
@@ -152,7 +152,7 @@ TEST(Network, ParentChildNeverRemoved) {
   const auto s = numbered({site(0, 0, 1000), site(500, 0, 400, 0), site(250, 10, 300, 0), site(5000, 0, 1000)});
   SilentProgress progress;
   const SiteGraph g = build_network(s, metres_crs(), {}, progress);
-  check_network(s, metres_crs(), g, 1.8);
+  check_network(s, metres_crs(), g, NetworkOptions{}.k);
   int family = 0;
   for (const Edge& e : g.edges) {
     if (e.kind == EdgeKind::parent_child) {
@@ -198,7 +198,7 @@ TEST(Network, ContainsEveryDelaunayEdgeOfAllSites) {
         if (!empty) continue;
         EXPECT_TRUE(pairs.count({i, j}) && pairs.count({i, k}) && pairs.count({j, k})) << i << " " << j << " " << k;
       }
-  check_network(s, metres_crs(), g, 1.8);
+  check_network(s, metres_crs(), g, NetworkOptions{}.k);
 }
 
 TEST(Network, CorsicaSitesReplay) {
@@ -210,7 +210,7 @@ TEST(Network, CorsicaSitesReplay) {
   const Crs& crs = sc.density.georef().crs;
   ASSERT_TRUE(crs.geographic);
   const SiteGraph g = build_network(placed.sites, crs, {}, progress);
-  check_network(placed.sites, crs, g, 1.8);
+  check_network(placed.sites, crs, g, NetworkOptions{}.k);
   int removed = 0, inter = 0;
   for (const Edge& e : g.edges) removed += !e.kept, inter += e.kind == EdgeKind::inter_urban;
   EXPECT_GT(removed, 0);
@@ -237,7 +237,7 @@ TEST(Network, CocircularGridIsDeterministic) {
   const SiteGraph b = build_network(s, metres_crs(), {}, progress);
   ASSERT_EQ(a.edges.size(), b.edges.size());
   for (std::size_t e = 0; e < a.edges.size(); ++e) EXPECT_TRUE(a.edges[e].from == b.edges[e].from && a.edges[e].to == b.edges[e].to);
-  check_network(s, metres_crs(), a, 1.8);
+  check_network(s, metres_crs(), a, NetworkOptions{}.k);
 }
 
 TEST(Network, BadInputs) {
@@ -263,7 +263,7 @@ TEST(Network, BadInputs) {
   const auto line = numbered({site(0, 0, 1), site(100, 0, 1), site(300, 0, 1), site(200, 0, 1)});
   const SiteGraph g = build_network(line, metres_crs(), {}, progress);
   EXPECT_EQ(g.edges.size(), 3u);
-  check_network(line, metres_crs(), g, 1.8);
+  check_network(line, metres_crs(), g, NetworkOptions{}.k);
 }
 
 // Geographic CRS far north, where the plane of the triangulations is most distorted and the
@@ -280,7 +280,7 @@ TEST(Network, HighLatitudeGeographicReplay) {
   s = numbered(s);
   SilentProgress progress;
   const SiteGraph g = build_network(s, crs, {}, progress);
-  check_network(s, crs, g, 1.8);
+  check_network(s, crs, g, NetworkOptions{}.k);
   NetworkOptions loose;
   loose.k = 3.0;
   check_network(s, crs, build_network(s, crs, loose, progress), 3.0);
