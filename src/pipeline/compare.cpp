@@ -62,6 +62,47 @@ std::string text(const json& v) {
   return v.dump();
 }
 
+/// A run's road km of one class (or the total for an empty class): new, drawn once, and given
+/// (roads.existing); null where its run.json does not say (a run from before new_km was written
+/// has only the whole network, all of it new).
+std::pair<json, json> road_km(const json& roads, const std::string& cls) {
+  const bool given = roads.contains("existing");
+  json existing = given ? (cls.empty() ? roads["existing"].value("total_km", json(nullptr)) : roads["existing"]["km"].value(cls, json(0.0)))
+                        : json(0.0);
+  json built = nullptr;
+  if (cls.empty() && roads.contains("new_network_km")) built = roads["new_network_km"];
+  else if (cls.empty() && !given && roads.contains("network_km")) built = roads["network_km"];
+  else if (!cls.empty() && roads.contains("new_km")) built = roads["new_km"].value(cls, json(0.0));
+  return {built, existing};
+}
+
+/// New and existing road km by class, both runs side by side (summary.roads.new_km and
+/// summary.roads.existing.km), with the change of the new km: what a scenario builds beyond the
+/// roads it was given. Empty when neither run has a roads stage.
+json road_table(const json& a, const json& b) {
+  const json none = json::object();
+  const json& ra = a.contains("summary") && a["summary"].contains("roads") ? a["summary"]["roads"] : none;
+  const json& rb = b.contains("summary") && b["summary"].contains("roads") ? b["summary"]["roads"] : none;
+  json rows = json::array();
+  if (ra.empty() && rb.empty()) return rows;
+  std::vector<std::string> classes;
+  for (const json* r : {&ra, &rb})
+    for (const char* key : {"new_km", "length_km"})
+      if (r->contains(key))
+        for (const auto& [cls, v] : (*r)[key].items())
+          if (std::find(classes.begin(), classes.end(), cls) == classes.end()) classes.push_back(cls);
+  classes.push_back("");  // the total
+  for (const auto& cls : classes) {
+    const auto [a_new, a_given] = ra.empty() ? std::pair<json, json>{nullptr, nullptr} : road_km(ra, cls);
+    const auto [b_new, b_given] = rb.empty() ? std::pair<json, json>{nullptr, nullptr} : road_km(rb, cls);
+    json row = {{"class", cls.empty() ? "total" : cls}, {"a_new_km", a_new}, {"a_existing_km", a_given}, {"b_new_km", b_new},
+                {"b_existing_km", b_given}};
+    if (a_new.is_number() && b_new.is_number()) row["new_change_km"] = b_new.get<double>() - a_new.get<double>();
+    rows.push_back(row);
+  }
+  return rows;
+}
+
 }  // namespace
 
 json load_manifest(const std::string& run_folder) {
@@ -88,7 +129,7 @@ json compare_runs(const json& a, const json& b) {
     if (p.a.is_number() && p.b.is_number()) row["change"] = p.b.get<double>() - p.a.get<double>();
     figures.push_back(row);
   }
-  return {{"parameters", params}, {"figures", figures}};
+  return {{"parameters", params}, {"figures", figures}, {"roads", road_table(a, b)}};
 }
 
 std::string format_comparison(const json& c) {
@@ -111,6 +152,31 @@ std::string format_comparison(const json& c) {
       change = buf;
     }
     row(f["figure"].get<std::string>(), text(f["a"]), text(f["b"]), change);
+  }
+  if (c.contains("roads") && !c["roads"].empty()) {
+    s << "\nRoads, new and existing, km (new: drawn once, off the given roads; existing: given by roads.existing):\n";
+    auto line = [&](const std::string& k, const std::string& an, const std::string& ae, const std::string& bn, const std::string& be,
+                    const std::string& d) {
+      char buf[512];
+      std::snprintf(buf, sizeof(buf), "  %-14s %12s %12s %12s %12s %14s\n", k.c_str(), an.c_str(), ae.c_str(), bn.c_str(), be.c_str(), d.c_str());
+      s << buf;
+    };
+    line("", "A new", "A existing", "B new", "B existing", "B - A new");
+    for (const auto& r : c["roads"]) {
+      std::string change;
+      if (r.contains("new_change_km")) {
+        char buf[64];
+        std::snprintf(buf, sizeof(buf), "%+.2f", r["new_change_km"].get<double>());
+        change = buf;
+      }
+      auto km = [](const json& v) {
+        if (!v.is_number()) return std::string("-");
+        char buf[64];
+        std::snprintf(buf, sizeof(buf), "%.2f", v.get<double>());
+        return std::string(buf);
+      };
+      line(r["class"].get<std::string>(), km(r["a_new_km"]), km(r["a_existing_km"]), km(r["b_new_km"]), km(r["b_existing_km"]), change);
+    }
   }
   return s.str();
 }

@@ -464,27 +464,33 @@ std::optional<roads::ExistingRoads> existing_roads(RunState& s, const roads::Ter
   return e;
 }
 
-/// The summary's figures of the given roads and of what is new: the network's sections off them
-/// (drawn once) by class, and those on them.
-json existing_figures(const roads::ExistingRoads& e, const roads::NetworkResult& r) {
+/// What is new, in every run (so that `compare` puts new and existing km side by side): the
+/// network's sections off the given roads (all of them when none is given), drawn once, by class.
+json new_figures(const roads::NetworkResult& r) {
   std::map<std::string, double> new_km;
-  double on_km = 0, new_total = 0;
-  for (const auto& section : r.layout.sections) {
+  double new_total = 0;
+  for (const auto& section : r.layout.sections)
+    if (!section.existing) new_km[std::string(roads::name_of(section.road_class))] += section.length_m / 1000, new_total += section.length_m / 1000;
+  json built = json::object();
+  for (const roads::RoadClassStyle& c : roads::kRoadClasses) built[std::string(c.name)] = round_to(new_km[std::string(c.name)], 0.01);
+  return {{"new_km", built}, {"new_network_km", round_to(new_total, 0.01)}};
+}
+
+/// The summary's figures of the given roads (roads.existing) and of the new links' sections on them.
+json existing_figures(const roads::ExistingRoads& e, const roads::NetworkResult& r) {
+  double on_km = 0;
+  for (const auto& section : r.layout.sections)
     if (section.existing) on_km += section.length_m / 1000;
-    else new_km[std::string(roads::name_of(section.road_class))] += section.length_m / 1000, new_total += section.length_m / 1000;
-  }
-  json given = json::object(), built = json::object();
+  json given = json::object();
   double given_total = 0;
   for (const roads::RoadClassStyle& c : roads::kRoadClasses) {
-    const std::string name(c.name);
-    built[name] = round_to(new_km[name], 0.01);
     if (c.road_class == roads::RoadClass::maritime) continue;
-    given[name] = round_to(e.length_m[std::size_t(c.road_class)] / 1000, 0.01);
+    given[std::string(c.name)] = round_to(e.length_m[std::size_t(c.road_class)] / 1000, 0.01);
     given_total += e.length_m[std::size_t(c.road_class)] / 1000;
   }
   return {{"existing", {{"lines", e.lines}, {"outside_dem", e.outside}, {"ferries_left_out", e.ferries}, {"km", given},
                         {"total_km", round_to(given_total, 0.01)}}},
-          {"new_km", built}, {"new_network_km", round_to(new_total, 0.01)}, {"on_existing_km", round_to(on_km, 0.01)}};
+          {"on_existing_km", round_to(on_km, 0.01)}};
 }
 
 void roads_run(RunState& s, Progress& progress, const Log& log) {
@@ -530,6 +536,7 @@ void roads_run(RunState& s, Progress& progress, const Log& log) {
                         {"network_km", round_to(network_km, 0.01)}, {"over_grade_limit_m", round_to(over_limit_m, 0.1)},
                         {"on_water_m", round_to(water_m, 0.1)}};
   if (existing) s.summary["roads"].update(existing_figures(*existing, r));
+  s.summary["roads"].update(new_figures(r));
   if (!corridor.is_null()) s.summary["roads"]["corridor"] = corridor;
 }
 
