@@ -51,6 +51,15 @@ std::vector<Pair> paired(const json& a, const json& b) {
   return out;
 }
 
+/// `value` padded to `width` characters (UTF-8: a place name such as L'Île-Rousse is one column per
+/// character, not per byte), on the left (`left`) or right.
+std::string padded(const std::string& value, std::size_t width, bool left) {
+  std::size_t chars = 0;
+  for (const unsigned char c : value) chars += (c & 0xC0) != 0x80;
+  const std::string fill(width > chars ? width - chars : 0, ' ');
+  return left ? value + fill : fill + value;
+}
+
 std::string text(const json& v) {
   if (v.is_null()) return "-";
   if (v.is_string()) return v.get<std::string>();
@@ -135,9 +144,7 @@ json compare_runs(const json& a, const json& b) {
 std::string format_comparison(const json& c) {
   std::ostringstream s;
   auto row = [&](const std::string& a, const std::string& b, const std::string& cc, const std::string& d) {
-    char buf[512];
-    std::snprintf(buf, sizeof(buf), "  %-40s %16s %16s %14s\n", a.c_str(), b.c_str(), cc.c_str(), d.c_str());
-    s << buf;
+    s << "  " << padded(a, 40, true) << ' ' << padded(b, 16, false) << ' ' << padded(cc, 16, false) << ' ' << padded(d, 14, false) << '\n';
   };
   s << "Parameters that differ:\n";
   if (c["parameters"].empty()) s << "  (none)\n";
