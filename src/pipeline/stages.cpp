@@ -572,6 +572,13 @@ void roads_summary(const json& figures, SummaryText& out) {
   } else {
     for (const auto& [cls, km] : r["length_km"].items()) out.line("           %-13s %9.1f km\n", cls.c_str(), km.get<double>());
   }
+  if (r.contains("corridor")) {  // roads.corridor.enabled: the earthworks, of the new stretches only when roads are given
+    const json& c = r["corridor"];
+    out.line("           corridors%s: land take %.1f ha, cut %.0f m3, fill %.0f m3", r.contains("existing") ? " of the new roads only" : "",
+             c["land_take_ha"].get<double>(), c["cut_m3"].get<double>(), c["fill_m3"].get<double>());
+    if (c.contains("cleared_ha")) out.line(", cleared %.1f ha", c["cleared_ha"].get<double>());
+    out.line("%s", "\n");
+  }
 }
 
 // ---- access (Tobler 1993; Weiss et al. 2018; docs/access.md) ---------------------------------

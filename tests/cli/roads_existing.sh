@@ -25,6 +25,15 @@ for f in roads.geojson sections.geojson existing_roads.geojson corridors.geojson
   cmp -s half/$f half1/$f || fail "$f differs between 1 thread and all"
 done
 run run -o all --set roads.existing="$WORK/full/roads.geojson"
+# The printed summary gives the earthworks, of the new roads only, as run.json does.
+"$TP" --progress none run -o half_txt --set dem="$dem" --set outputs.preview=false --set roads.corridor.enabled=true \
+  --set roads.existing="$WORK/half.geojson" > half.txt 2>/dev/null
+/usr/bin/python3 - <<'PY' || fail "no corridor line in the summary: $(grep -A3 '  roads' half.txt)"
+import json
+c = json.load(open("half/run.json"))["summary"]["roads"]["corridor"]
+want = "corridors of the new roads only: land take %.1f ha, cut %.0f m3, fill %.0f m3" % (c["land_take_ha"], c["cut_m3"], c["fill_m3"])
+assert want in open("half.txt").read(), want
+PY
 /usr/bin/python3 - <<'PY' || fail "existing roads in the run"
 import json
 full = json.load(open("full/run.json"))["summary"]["roads"]
