@@ -252,6 +252,20 @@ json growth_figures(const sites::SitesResult& r, const sites::SitesOptions& opti
           {"new_largest", largest}};
 }
 
+/// The warnings of sites.existing, also in run.json: the places left out or moved (by name), a
+/// population given below the places' people, a settled share the places already hold.
+std::vector<std::string> existing_warnings(const ExistingPlaces& existing, const sites::SitesOptions& options, const sites::SitesResult& r) {
+  std::vector<std::string> out = existing_place_warnings(existing);
+  const std::string people = std::to_string(std::llround(r.existing_population));
+  if (options.population > 0 && r.existing_population > options.population)
+    out.push_back("sites.population (" + std::to_string(std::llround(options.population)) + ") is below the " + people +
+                  " people of sites.existing: the region holds at least them");
+  if (options.growth == 0 && r.existing_population >= std::round(options.urban_share * r.target_population) && r.settled_population > 0)
+    out.push_back("sites.existing: the given places hold " + people + " people, the settled share (" +
+                  std::to_string(std::llround(options.urban_share * r.target_population)) + ") or more: no settlement generated");
+  return out;
+}
+
 void sites_run(RunState& s, Progress& progress, const Log& log) {
   sites::SitesOptions options = s.settings.sites;
   // The land of the density stage (water and nodata excluded), for the default population.
@@ -262,7 +276,6 @@ void sites_run(RunState& s, Progress& progress, const Log& log) {
   if (!existing_file.empty()) {
     existing = read_existing_places(existing_file, *s.buildable);
     options.existing = existing.sites;
-    if (existing.outside > 0) log.warn("sites.existing: " + std::to_string(existing.outside) + " places outside the DEM left out");
   }
   const sites::SitesResult r = sites::place_sites(*s.density, *s.buildable, options, progress);
   const Crs& crs = s.dem.georef().crs;
@@ -295,6 +308,9 @@ void sites_run(RunState& s, Progress& progress, const Log& log) {
     summary["population_source"] = source;
     summary["urban_share"] = options.urban_share;
     summary["settled_population"] = r.settled_population;  // urban_share x target_population, in the settlements
+    // Everyone else lives in hamlets and scattered houses over the land (the density spreads them,
+    // as the access stage counts them): settled + scattered = target_population.
+    summary["scattered_population"] = r.target_population - r.settled_population;
     summary["sizes"] = options.sizes == sites::SitesOptions::Sizes::catchment ? "catchment" : "rank_size";
     summary["sizes_exponent"] = r.sizes_exponent;  // q of the law that split the settled people
     summary["room"] = r.room;  // settlements the land holds at sites.spacing_km; 0: no limit
@@ -313,12 +329,10 @@ void sites_run(RunState& s, Progress& progress, const Log& log) {
                            {"outside_dem", existing.outside}, {"without_people", existing.without_people},
                            {"generated", r.sites.size() - existing.sites.size()},
                            {"generated_people", population - std::llround(r.existing_population) - r.growth_to_existing}};
-    if (r.existing_population >= r.settled_population && r.settled_population > 0)
-      log.warn("sites.existing: the given places hold " + std::to_string(std::llround(r.existing_population)) + " people, the settled share (" +
-               std::to_string(std::llround(r.settled_population)) + ") or more: no settlement generated");
   }
   if (options.growth > 0) summary["growth"] = growth_figures(r, options, s.dem.georef().crs);
-  std::vector<std::string> warnings = settlement_warnings(s, r);
+  std::vector<std::string> warnings = existing_file.empty() ? std::vector<std::string>() : existing_warnings(existing, options, r);
+  for (auto& w : settlement_warnings(s, r)) warnings.push_back(std::move(w));
   const std::string reference = s.scenario.path("/sites/reference");
   const json realism = reference.empty() ? json() : realism_figures(s, density_inputs(s), r, reference, warnings, progress);
   for (const auto& w : warnings) log.warn(w);
@@ -372,6 +386,16 @@ void sites_summary(const json& figures, SummaryText& out) {
     out.line("           %.0f of them in the settlements (sites.urban_share %g), split by a rank-size law of exponent %.2f (%s)\n",
              c["settled_population"].get<double>(), c["urban_share"].get<double>(), c["sizes_exponent"].get<double>(),
              c["sizes"] == "catchment" ? "read from the catchments" : "sites.zipf_exponent");
+  if (c.contains("scattered_population"))
+    out.line("           %.0f scattered over the land (hamlets and houses, spread by the density): %.0f settled + %.0f = %.0f\n",
+             c["scattered_population"].get<double>(), c["settled_population"].get<double>(), c["scattered_population"].get<double>(),
+             c["target_population"].get<double>());
+  if (c.contains("existing")) {
+    const json& e = c["existing"];
+    out.line("           existing %d places, %.0f people (%d moved to land, %d outside the DEM left out, %d without people); %d generated, %lld people\n",
+             e["places"].get<int>(), e["people"].get<double>(), e["moved_to_land"].get<int>(), e["outside_dem"].get<int>(),
+             e["without_people"].get<int>(), e["generated"].get<int>(), e["generated_people"].get<long long>());
+  }
   if (c.value("count_limited_by_spacing", false))
     out.line("           count held to the %lld settlements the land holds at sites.spacing_km (closer where denser than an urban centre)\n",
              c["room"].get<long long>());
