@@ -141,6 +141,32 @@ json compare_runs(const json& a, const json& b) {
   return {{"parameters", params}, {"figures", figures}, {"roads", road_table(a, b)}};
 }
 
+namespace {
+
+/// A number of a comparison by a printf format, or `missing` where it is not one.
+std::string formatted(const json& v, const char* format, const std::string& missing) {
+  if (!v.is_number()) return missing;
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), format, v.get<double>());
+  return buf;
+}
+
+/// The new and existing road km of the two runs, by class (compare_runs' "roads").
+void format_road_table(const json& rows, std::ostringstream& s) {
+  s << "\nRoads, new and existing, km (new: drawn once, off the given roads; existing: given by roads.existing):\n";
+  auto line = [&](const std::string& k, const std::string& an, const std::string& ae, const std::string& bn, const std::string& be,
+                  const std::string& d) {
+    s << "  " << padded(k, 14, true) << ' ' << padded(an, 12, false) << ' ' << padded(ae, 12, false) << ' ' << padded(bn, 12, false) << ' '
+      << padded(be, 12, false) << ' ' << padded(d, 14, false) << '\n';
+  };
+  line("", "A new", "A existing", "B new", "B existing", "B - A new");
+  for (const auto& r : rows)
+    line(r["class"].get<std::string>(), formatted(r["a_new_km"], "%.2f", "-"), formatted(r["a_existing_km"], "%.2f", "-"),
+         formatted(r["b_new_km"], "%.2f", "-"), formatted(r["b_existing_km"], "%.2f", "-"), formatted(r.value("new_change_km", json()), "%+.2f", ""));
+}
+
+}  // namespace
+
 std::string format_comparison(const json& c) {
   std::ostringstream s;
   auto row = [&](const std::string& a, const std::string& b, const std::string& cc, const std::string& d) {
@@ -151,40 +177,8 @@ std::string format_comparison(const json& c) {
   for (const auto& p : c["parameters"]) row(p["parameter"].get<std::string>(), text(p["a"]), text(p["b"]), "");
   s << "\nFigures:\n";
   row("", "A", "B", "B - A");
-  for (const auto& f : c["figures"]) {
-    std::string change;
-    if (f.contains("change")) {
-      char buf[64];
-      std::snprintf(buf, sizeof(buf), "%+.6g", f["change"].get<double>());
-      change = buf;
-    }
-    row(f["figure"].get<std::string>(), text(f["a"]), text(f["b"]), change);
-  }
-  if (c.contains("roads") && !c["roads"].empty()) {
-    s << "\nRoads, new and existing, km (new: drawn once, off the given roads; existing: given by roads.existing):\n";
-    auto line = [&](const std::string& k, const std::string& an, const std::string& ae, const std::string& bn, const std::string& be,
-                    const std::string& d) {
-      char buf[512];
-      std::snprintf(buf, sizeof(buf), "  %-14s %12s %12s %12s %12s %14s\n", k.c_str(), an.c_str(), ae.c_str(), bn.c_str(), be.c_str(), d.c_str());
-      s << buf;
-    };
-    line("", "A new", "A existing", "B new", "B existing", "B - A new");
-    for (const auto& r : c["roads"]) {
-      std::string change;
-      if (r.contains("new_change_km")) {
-        char buf[64];
-        std::snprintf(buf, sizeof(buf), "%+.2f", r["new_change_km"].get<double>());
-        change = buf;
-      }
-      auto km = [](const json& v) {
-        if (!v.is_number()) return std::string("-");
-        char buf[64];
-        std::snprintf(buf, sizeof(buf), "%.2f", v.get<double>());
-        return std::string(buf);
-      };
-      line(r["class"].get<std::string>(), km(r["a_new_km"]), km(r["a_existing_km"]), km(r["b_new_km"]), km(r["b_existing_km"]), change);
-    }
-  }
+  for (const auto& f : c["figures"]) row(f["figure"].get<std::string>(), text(f["a"]), text(f["b"]), formatted(f.value("change", json()), "%+.6g", ""));
+  if (c.contains("roads") && !c["roads"].empty()) format_road_table(c["roads"], s);
   return s.str();
 }
 
