@@ -58,6 +58,7 @@ class SitesCommand final : public Command {
     if (!existing_file.empty()) {
       existing = pipeline::read_existing_places(existing_file, in.buildable);
       options.existing = existing.sites;
+      for (const auto& w : pipeline::existing_place_warnings(existing)) context.log.warn(w);
     }
     const auto t1 = std::chrono::steady_clock::now();
     const sites::SitesResult result = sites::place_sites(in.density, in.buildable, options, context.progress);

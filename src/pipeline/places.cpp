@@ -136,6 +136,7 @@ ExistingPlaces read_existing_places(const std::string& path, const Raster<std::u
     const auto [col, row] = std::isfinite(p.x) && std::isfinite(p.y) ? cell_of(buildable.georef(), p.x, p.y) : std::array<int, 2>{-1, -1};
     if (!buildable.inside(col, row)) {
       ++out.outside;
+      out.outside_names.push_back(name);
       continue;
     }
     // Its cell, or the nearest free buildable one within two cells (a coastal town on a sea cell of
@@ -149,7 +150,7 @@ ExistingPlaces read_existing_places(const std::string& path, const Raster<std::u
       }
     if (best_c < 0)
       throw bad_input(path + ": " + name + ": lies on water, nodata or unbuildable land with no free buildable cell within two cells; move it or leave it out");
-    out.moved += best_d > 0;
+    if (best_d > 0) ++out.moved, out.moved_names.push_back(name);
     taken[buildable.index(best_c, best_r)] = 1;
     sites::Site s;
     s.col = best_c, s.row = best_r;
@@ -161,6 +162,23 @@ ExistingPlaces read_existing_places(const std::string& path, const Raster<std::u
     out.sites.push_back(std::move(s));
   }
   if (out.sites.empty()) throw bad_input(path + ": no place with people lies on the DEM");
+  return out;
+}
+
+std::vector<std::string> existing_place_warnings(const ExistingPlaces& places) {
+  const auto listed = [](const std::vector<std::string>& names) {
+    std::string list;
+    for (std::size_t k = 0; k < std::min<std::size_t>(10, names.size()); ++k) list += (k ? ", " : "") + names[k];
+    if (names.size() > 10) list += " and " + std::to_string(names.size() - 10) + " more";
+    return list;
+  };
+  const auto count = [](std::size_t n) { return std::to_string(n) + (n == 1 ? " place " : " places "); };
+  std::vector<std::string> out;
+  if (!places.outside_names.empty())
+    out.push_back("sites.existing: " + count(places.outside_names.size()) + "outside the DEM left out: " + listed(places.outside_names));
+  if (!places.moved_names.empty())
+    out.push_back("sites.existing: " + count(places.moved_names.size()) + "on water or unbuildable land moved to the nearest free buildable cell: " +
+                  listed(places.moved_names));
   return out;
 }
 

@@ -26,7 +26,12 @@ std::vector<density::Place> read_places(const std::string& path, const Dem& dem,
 struct ExistingPlaces {
   std::vector<sites::Site> sites;  ///< largest first, existing = true, name set
   int outside = 0, without_people = 0, moved = 0;
+  std::vector<std::string> outside_names, moved_names;  ///< the places left out off the DEM, moved to land
 };
+
+/// The run's and the command's warnings about a places file: those outside the DEM (left out) and
+/// those moved to land, by name (the first ten, then how many more).
+std::vector<std::string> existing_place_warnings(const ExistingPlaces& places);
 /// Throws bad_input naming the file and the place when one lies farther than two cells from a free
 /// buildable cell, or its population is negative; and when no place with people lies on the grid.
 ExistingPlaces read_existing_places(const std::string& path, const Raster<std::uint8_t>& buildable);

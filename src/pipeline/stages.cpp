@@ -252,6 +252,20 @@ json growth_figures(const sites::SitesResult& r, const sites::SitesOptions& opti
           {"new_largest", largest}};
 }
 
+/// The warnings of sites.existing, also in run.json: the places left out or moved (by name), a
+/// population given below the places' people, a settled share the places already hold.
+std::vector<std::string> existing_warnings(const ExistingPlaces& existing, const sites::SitesOptions& options, const sites::SitesResult& r) {
+  std::vector<std::string> out = existing_place_warnings(existing);
+  const std::string people = std::to_string(std::llround(r.existing_population));
+  if (options.population > 0 && r.existing_population > options.population)
+    out.push_back("sites.population (" + std::to_string(std::llround(options.population)) + ") is below the " + people +
+                  " people of sites.existing: the region holds at least them");
+  if (options.growth == 0 && r.existing_population >= std::round(options.urban_share * r.target_population) && r.settled_population > 0)
+    out.push_back("sites.existing: the given places hold " + people + " people, the settled share (" +
+                  std::to_string(std::llround(options.urban_share * r.target_population)) + ") or more: no settlement generated");
+  return out;
+}
+
 void sites_run(RunState& s, Progress& progress, const Log& log) {
   sites::SitesOptions options = s.settings.sites;
   // The land of the density stage (water and nodata excluded), for the default population.
@@ -262,7 +276,6 @@ void sites_run(RunState& s, Progress& progress, const Log& log) {
   if (!existing_file.empty()) {
     existing = read_existing_places(existing_file, *s.buildable);
     options.existing = existing.sites;
-    if (existing.outside > 0) log.warn("sites.existing: " + std::to_string(existing.outside) + " places outside the DEM left out");
   }
   const sites::SitesResult r = sites::place_sites(*s.density, *s.buildable, options, progress);
   const Crs& crs = s.dem.georef().crs;
@@ -295,6 +308,9 @@ void sites_run(RunState& s, Progress& progress, const Log& log) {
     summary["population_source"] = source;
     summary["urban_share"] = options.urban_share;
     summary["settled_population"] = r.settled_population;  // urban_share x target_population, in the settlements
+    // Everyone else lives in hamlets and scattered houses over the land (the density spreads them,
+    // as the access stage counts them): settled + scattered = target_population.
+    summary["scattered_population"] = r.target_population - r.settled_population;
     summary["sizes"] = options.sizes == sites::SitesOptions::Sizes::catchment ? "catchment" : "rank_size";
     summary["sizes_exponent"] = r.sizes_exponent;  // q of the law that split the settled people
     summary["room"] = r.room;  // settlements the land holds at sites.spacing_km; 0: no limit
@@ -313,12 +329,10 @@ void sites_run(RunState& s, Progress& progress, const Log& log) {
                            {"outside_dem", existing.outside}, {"without_people", existing.without_people},
                            {"generated", r.sites.size() - existing.sites.size()},
                            {"generated_people", population - std::llround(r.existing_population) - r.growth_to_existing}};
-    if (r.existing_population >= r.settled_population && r.settled_population > 0)
-      log.warn("sites.existing: the given places hold " + std::to_string(std::llround(r.existing_population)) + " people, the settled share (" +
-               std::to_string(std::llround(r.settled_population)) + ") or more: no settlement generated");
   }
   if (options.growth > 0) summary["growth"] = growth_figures(r, options, s.dem.georef().crs);
-  std::vector<std::string> warnings = settlement_warnings(s, r);
+  std::vector<std::string> warnings = existing_file.empty() ? std::vector<std::string>() : existing_warnings(existing, options, r);
+  for (auto& w : settlement_warnings(s, r)) warnings.push_back(std::move(w));
   const std::string reference = s.scenario.path("/sites/reference");
   const json realism = reference.empty() ? json() : realism_figures(s, density_inputs(s), r, reference, warnings, progress);
   for (const auto& w : warnings) log.warn(w);
@@ -372,6 +386,16 @@ void sites_summary(const json& figures, SummaryText& out) {
     out.line("           %.0f of them in the settlements (sites.urban_share %g), split by a rank-size law of exponent %.2f (%s)\n",
              c["settled_population"].get<double>(), c["urban_share"].get<double>(), c["sizes_exponent"].get<double>(),
              c["sizes"] == "catchment" ? "read from the catchments" : "sites.zipf_exponent");
+  if (c.contains("scattered_population"))
+    out.line("           %.0f scattered over the land (hamlets and houses, spread by the density): %.0f settled + %.0f = %.0f\n",
+             c["scattered_population"].get<double>(), c["settled_population"].get<double>(), c["scattered_population"].get<double>(),
+             c["target_population"].get<double>());
+  if (c.contains("existing")) {
+    const json& e = c["existing"];
+    out.line("           existing %d places, %.0f people (%d moved to land, %d outside the DEM left out, %d without people); %d generated, %lld people\n",
+             e["places"].get<int>(), e["people"].get<double>(), e["moved_to_land"].get<int>(), e["outside_dem"].get<int>(),
+             e["without_people"].get<int>(), e["generated"].get<int>(), e["generated_people"].get<long long>());
+  }
   if (c.value("count_limited_by_spacing", false))
     out.line("           count held to the %lld settlements the land holds at sites.spacing_km (closer where denser than an urban centre)\n",
              c["room"].get<long long>());
@@ -464,27 +488,33 @@ std::optional<roads::ExistingRoads> existing_roads(RunState& s, const roads::Ter
   return e;
 }
 
-/// The summary's figures of the given roads and of what is new: the network's sections off them
-/// (drawn once) by class, and those on them.
-json existing_figures(const roads::ExistingRoads& e, const roads::NetworkResult& r) {
+/// What is new, in every run (so that `compare` puts new and existing km side by side): the
+/// network's sections off the given roads (all of them when none is given), drawn once, by class.
+json new_figures(const roads::NetworkResult& r) {
   std::map<std::string, double> new_km;
-  double on_km = 0, new_total = 0;
-  for (const auto& section : r.layout.sections) {
+  double new_total = 0;
+  for (const auto& section : r.layout.sections)
+    if (!section.existing) new_km[std::string(roads::name_of(section.road_class))] += section.length_m / 1000, new_total += section.length_m / 1000;
+  json built = json::object();
+  for (const roads::RoadClassStyle& c : roads::kRoadClasses) built[std::string(c.name)] = round_to(new_km[std::string(c.name)], 0.01);
+  return {{"new_km", built}, {"new_network_km", round_to(new_total, 0.01)}};
+}
+
+/// The summary's figures of the given roads (roads.existing) and of the new links' sections on them.
+json existing_figures(const roads::ExistingRoads& e, const roads::NetworkResult& r) {
+  double on_km = 0;
+  for (const auto& section : r.layout.sections)
     if (section.existing) on_km += section.length_m / 1000;
-    else new_km[std::string(roads::name_of(section.road_class))] += section.length_m / 1000, new_total += section.length_m / 1000;
-  }
-  json given = json::object(), built = json::object();
+  json given = json::object();
   double given_total = 0;
   for (const roads::RoadClassStyle& c : roads::kRoadClasses) {
-    const std::string name(c.name);
-    built[name] = round_to(new_km[name], 0.01);
     if (c.road_class == roads::RoadClass::maritime) continue;
-    given[name] = round_to(e.length_m[std::size_t(c.road_class)] / 1000, 0.01);
+    given[std::string(c.name)] = round_to(e.length_m[std::size_t(c.road_class)] / 1000, 0.01);
     given_total += e.length_m[std::size_t(c.road_class)] / 1000;
   }
   return {{"existing", {{"lines", e.lines}, {"outside_dem", e.outside}, {"ferries_left_out", e.ferries}, {"km", given},
                         {"total_km", round_to(given_total, 0.01)}}},
-          {"new_km", built}, {"new_network_km", round_to(new_total, 0.01)}, {"on_existing_km", round_to(on_km, 0.01)}};
+          {"on_existing_km", round_to(on_km, 0.01)}};
 }
 
 /// Land the roads serve, km²: cells with data that are not water (the sea, the inland water).
@@ -543,6 +573,7 @@ void roads_run(RunState& s, Progress& progress, const Log& log) {
                         {"over_grade_limit_m", round_to(over_limit_m, 0.1)},
                         {"on_water_m", round_to(water_m, 0.1)}};
   if (existing) s.summary["roads"].update(existing_figures(*existing, r));
+  s.summary["roads"].update(new_figures(r));
   if (!corridor.is_null()) s.summary["roads"]["corridor"] = corridor;
 }
 
@@ -583,6 +614,13 @@ void roads_summary(const json& figures, SummaryText& out) {
       out.line("           %-13s %9.1f %9.1f %9.1f km\n", cls.c_str(), km.get<double>(), r["new_km"].value(cls, 0.0), e["km"].value(cls, 0.0));
   } else {
     for (const auto& [cls, km] : r["length_km"].items()) out.line("           %-13s %9.1f km\n", cls.c_str(), km.get<double>());
+  }
+  if (r.contains("corridor")) {  // roads.corridor.enabled: the earthworks, of the new stretches only when roads are given
+    const json& c = r["corridor"];
+    out.line("           corridors%s: land take %.1f ha, cut %.0f m3, fill %.0f m3", r.contains("existing") ? " of the new roads only" : "",
+             c["land_take_ha"].get<double>(), c["cut_m3"].get<double>(), c["fill_m3"].get<double>());
+    if (c.contains("cleared_ha")) out.line(", cleared %.1f ha", c["cleared_ha"].get<double>());
+    out.line("%s", "\n");
   }
 }
 

@@ -165,6 +165,10 @@ QuotaTable rank_size_table(const Raster<float>& density, const Raster<std::uint8
     result.existing_population += double(e.population);
     if (double(e.population) >= options.min_population) ++first_rank;
   }
+  // The given places are people that exist: the region holds at least them, and so do its
+  // settlements (a total given below them, a settled share they already pass).
+  result.target_population = std::max(result.target_population, result.existing_population);
+  result.settled_population = std::max(result.settled_population, result.existing_population);
   double to_place = std::max(0.0, result.settled_population - result.existing_population);
   if (options.growth > 0) {
     // Growth scenario: the existing places are today's settled people; the region grows by

@@ -162,8 +162,8 @@ struct SitesResult {
   double dr_m = 0;                  ///< class step used, metres
   int candidates = 0;               ///< M, candidates drawn
   std::uint64_t seed = 1;           ///< seed used
-  double target_population = 0;     ///< rank_size: the region's people
-  double settled_population = 0;    ///< rank_size: urban_share x target_population, split over the settlements
+  double target_population = 0;     ///< rank_size: the region's people (at least the existing places')
+  double settled_population = 0;    ///< rank_size: urban_share x target_population (at least the existing places' people), split over the settlements
   double sizes_exponent = 0;        ///< rank_size: q of the law that split them (zipf_exponent, or read from the catchments)
   double land_area_km2 = 0;         ///< rank_size: the land area used for the default population
   bool population_assumed = false;  ///< rank_size: target from people_per_km2 (no census figure given)

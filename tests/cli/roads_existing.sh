@@ -25,13 +25,25 @@ for f in roads.geojson sections.geojson existing_roads.geojson corridors.geojson
   cmp -s half/$f half1/$f || fail "$f differs between 1 thread and all"
 done
 run run -o all --set roads.existing="$WORK/full/roads.geojson"
+# The printed summary gives the earthworks, of the new roads only, as run.json does.
+"$TP" --progress none run -o half_txt --set dem="$dem" --set outputs.preview=false --set roads.corridor.enabled=true \
+  --set roads.existing="$WORK/half.geojson" > half.txt 2>/dev/null
+/usr/bin/python3 - <<'PY' || fail "no corridor line in the summary: $(grep -A3 '  roads' half.txt)"
+import json
+c = json.load(open("half/run.json"))["summary"]["roads"]["corridor"]
+want = "corridors of the new roads only: land take %.1f ha, cut %.0f m3, fill %.0f m3" % (c["land_take_ha"], c["cut_m3"], c["fill_m3"])
+assert want in open("half.txt").read(), want
+PY
 /usr/bin/python3 - <<'PY' || fail "existing roads in the run"
 import json
 full = json.load(open("full/run.json"))["summary"]["roads"]
 half = json.load(open("half/run.json"))["summary"]["roads"]
 every = json.load(open("all/run.json"))["summary"]["roads"]
 given = json.load(open("half.geojson"))["features"]
-assert "existing" not in full and "new_km" not in full, full
+assert "existing" not in full, full
+# Every run says what is new, drawn once by class (without given roads: the whole network), so
+# that `compare` can put new and existing km side by side.
+assert abs(sum(full["new_km"].values()) - full["network_km"]) < 0.05 and full["new_network_km"] == full["network_km"], full
 e = half["existing"]
 assert e["lines"] == len(given) and e["outside_dem"] == 0, e
 km = sum(f["properties"]["length_m"] for f in given) / 1000
@@ -67,6 +79,27 @@ assert len(json.load(open("half/existing_roads.geojson"))["features"]) >= len(gi
 assert half["corridor"]["cut_m3"] < full["corridor"]["cut_m3"] and half["corridor"]["land_take_ha"] < full["corridor"]["land_take_ha"], (half, full)
 # Every road of the full run given: every link runs along them and adds no new km.
 assert every["new_network_km"] == 0 and every["roads"] == 0 and every["redundant"] == full["roads"] + full["redundant"], every
+PY
+
+# compare puts the new and the existing road km by class side by side, with the change of the new.
+"$TP" compare full half --json > compare.json
+"$TP" compare full half > compare.txt
+/usr/bin/python3 - <<'PY' || fail "compare: new and existing road km: $(cat compare.txt)"
+import json
+full = json.load(open("full/run.json"))["summary"]["roads"]
+half = json.load(open("half/run.json"))["summary"]["roads"]
+rows = {r["class"]: r for r in json.load(open("compare.json"))["roads"]}
+t = rows["total"]
+assert t["a_new_km"] == full["network_km"] and t["a_existing_km"] == 0, t
+assert t["b_new_km"] == half["new_network_km"] and t["b_existing_km"] == half["existing"]["total_km"], t
+assert abs(t["new_change_km"] - (half["new_network_km"] - full["network_km"])) < 1e-6, t
+d = rows["departmental"]
+assert d["b_new_km"] == half["new_km"]["departmental"] and d["b_existing_km"] == half["existing"]["km"]["departmental"] > 0, d
+text = open("compare.txt").read()
+head = "Roads, new and existing, km"
+assert head in text, text
+line = [l for l in text[text.index(head):].splitlines() if l.split()[:1] == ["departmental"]][0].split()
+assert [float(v) for v in line[1:5]] == [round(x, 2) for x in (d["a_new_km"], d["a_existing_km"], d["b_new_km"], d["b_existing_km"])], line
 PY
 
 # The roads command takes them too.

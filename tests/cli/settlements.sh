@@ -26,6 +26,8 @@ assert 1400 < land < 1700 and abs(s["target_population"] - round(60 * land)) <= 
 # the law whose exponent the density's catchments give.
 assert s["sizes"] == "catchment" and s["settled_population"] == round(s["urban_share"] * s["target_population"]), s
 assert s["population"] == s["settled_population"], s
+# Every person accounted for: the settled and the scattered make the region's people.
+assert s["settled_population"] + s["scattered_population"] == s["target_population"] and s["scattered_population"] > 0, s
 assert 0 <= s["suburbs"] < s["cities"], s  # spaced central places: few in a larger one's reach (Suburbs.* test them)
 # Right in magnitude: the total within a factor 3 of the real places' sum (43,093).
 assert r["total"]["reference"] == 43093 and 1 / 3 < r["total"]["ratio"] < 3, r["total"]

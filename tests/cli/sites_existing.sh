@@ -19,7 +19,7 @@ json.dump({"type": "FeatureCollection", "features": g["features"] + [place("Nega
 PY
 
 "$TP" -q run -o run --set dem="$dem" --set sites.existing="$WORK/with_outside.geojson" --set outputs.preview=false 2> stderr
-grep -q "sites.existing: 1 places outside the DEM left out" stderr || fail "no line about the place outside: $(cat stderr)"
+grep -q "sites.existing: 1 place outside the DEM left out: Outside" stderr || fail "no line naming the place outside: $(cat stderr)"
 /usr/bin/python3 - "$places" <<'PY' || fail "existing places in the run"
 import json, sys
 real = {f["properties"]["name"]: f for f in json.load(open(sys.argv[1]))["features"]}
@@ -38,6 +38,9 @@ e = s["existing"]
 assert e["places"] == len(real) and e["outside_dem"] == 1 and e["people"] == sum(f["properties"]["population"] for f in real.values()), e
 assert e["generated"] == len(cities) - len(real) and e["generated"] > 0, e
 assert s["population"] == e["people"] + e["generated_people"] == s["settled_population"], s
+assert s["settled_population"] + s["scattered_population"] == s["target_population"], s
+# The place left out is named in run.json too.
+assert "sites.existing: 1 place outside the DEM left out: Outside" in s["warnings"], s["warnings"]
 # Ids run largest first; every settlement, given or generated, is an end of a kept link.
 pops = [c["properties"]["population"] for c in cities]
 assert pops == sorted(pops, reverse=True), pops
@@ -60,8 +63,33 @@ json.dump({"type": "FeatureCollection", "features": [{"type": "Feature", "proper
 PY
 "$TP" -q run -o moved --set dem="$dem" --set sites.existing="$WORK/harbour.geojson" --set outputs.preview=false 2> /dev/null
 /usr/bin/python3 -c "
-import json; e = json.load(open('moved/run.json'))['summary']['sites']['existing']
-assert e['places'] == 1 and e['moved_to_land'] == 1, e" || fail "a place on a coastal sea cell was not moved to land"
+import json; s = json.load(open('moved/run.json'))['summary']['sites']; e = s['existing']
+assert e['places'] == 1 and e['moved_to_land'] == 1, e
+assert s['warnings'][0] == 'sites.existing: 1 place on water or unbuildable land moved to the nearest free buildable cell: Harbour', s" \
+  || fail "a place on a coastal sea cell was not moved to land, by name"
+
+# The given places hold more than the settled share, or more people than the population given:
+# the settlements hold them all, the region at least them, and run.json says so.
+"$TP" run -o over --until sites --set dem="$dem" --set sites.existing="$places" --set sites.urban_share=0.3 --set outputs.preview=false \
+  > over.txt 2>/dev/null
+"$TP" -q run -o below --until sites --set dem="$dem" --set sites.existing="$places" --set sites.population=30000 --set outputs.preview=false \
+  2>/dev/null
+grep -q "existing 15 places, 43093 people (0 moved to land, 0 outside the DEM left out, 0 without people); 0 generated, 0 people" over.txt \
+  || fail "no summary line for the given places: $(cat over.txt)"
+grep -q "scattered over the land (hamlets and houses, spread by the density): 43093 settled + 51254 = 94347" over.txt \
+  || fail "no line for the scattered people: $(cat over.txt)"
+/usr/bin/python3 - <<'PY' || fail "given places above the settled share or the population"
+import json
+over = json.load(open("over/run.json"))["summary"]["sites"]
+assert over["population"] == over["settled_population"] == 43093 and over["target_population"] == 94347, over
+assert over["scattered_population"] == 94347 - 43093 and over["existing"]["generated"] == 0, over
+assert any("the settled share (28304) or more: no settlement generated" in w for w in over["warnings"]), over["warnings"]
+below = json.load(open("below/run.json"))["summary"]["sites"]
+assert below["population"] == below["settled_population"] == below["target_population"] == 43093, below
+assert below["scattered_population"] == 0, below
+assert any(w.startswith("sites.population (30000) is below the 43093 people of sites.existing") for w in below["warnings"]), below["warnings"]
+assert json.load(open("below/run.json"))["summary"].get("access", {"people": 43093})["people"] == 43093
+PY
 
 # The sites command on a DEM takes them too.
 "$TP" sites "$dem" s --existing "$places" > out.txt

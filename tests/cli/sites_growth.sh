@@ -49,6 +49,11 @@ grep -Eq "growth \+20%: 8619 new settled people, 4309 to the existing places, 43
 # compare: each place's gain beside the region as it is.
 "$TP" compare today mixed > compare.txt
 grep -Eq "^  sites\.growth\.gained\.Biguglia +- +[0-9]+" compare.txt || fail "compare has no per-place gain: $(grep growth compare.txt | head -3)"
+# Its columns line up in characters, not bytes: a name with an accent (L'Île-Rousse) is not a column off.
+/usr/bin/python3 - <<'PY' || fail "compare: columns off after a name with an accent: $(grep -a "Rousse\|Biguglia" compare.txt)"
+rows = [l for l in open("compare.txt", encoding="utf-8").read().splitlines() if l.startswith("  sites.growth.gained.")]
+assert any("Île-Rousse" in r for r in rows) and len({len(r) for r in rows}) == 1, [(len(r), r) for r in rows]
+PY
 
 # The sites command takes it too.
 "$TP" sites "$dem" s --existing "$places" --growth 0.2 > out.txt
