@@ -169,6 +169,10 @@ QuotaTable rank_size_table(const Raster<float>& density, const Raster<std::uint8
   // settlements (a total given below them, a settled share they already pass).
   result.target_population = std::max(result.target_population, result.existing_population);
   result.settled_population = std::max(result.settled_population, result.existing_population);
+  // Without a census figure the given places are the region's settlements as it is: an assumed
+  // density (people_per_km2) invents no town beside them, so a growth of 0 adds nothing and a
+  // growth scenario compares with that run. sites.population asks for the towns beyond them.
+  if (!options.existing.empty() && result.population_assumed) result.settled_population = result.existing_population;
   double to_place = std::max(0.0, result.settled_population - result.existing_population);
   if (options.growth > 0) {
     // Growth scenario: the existing places are today's settled people; the region grows by

@@ -36,7 +36,8 @@ for c in given:
 s = run["summary"]["sites"]
 e = s["existing"]
 assert e["places"] == len(real) and e["outside_dem"] == 1 and e["people"] == sum(f["properties"]["population"] for f in real.values()), e
-assert e["generated"] == len(cities) - len(real) and e["generated"] > 0, e
+# No census figure: the given places are the region as it is, nothing invented beside them.
+assert e["generated"] == len(cities) - len(real) == 0, e
 assert s["population"] == e["people"] + e["generated_people"] == s["settled_population"], s
 assert s["settled_population"] + s["scattered_population"] == s["target_population"], s
 # The place left out is named in run.json too.
@@ -47,6 +48,17 @@ assert pops == sorted(pops, reverse=True), pops
 links = [f["properties"] for f in json.load(open("run/network.geojson"))["features"] if f["properties"]["kept"] == 1]
 ends = {l["from"] for l in links} | {l["to"] for l in links}
 assert ends == {c["properties"]["id"] for c in cities}, (ends, len(cities))
+PY
+
+# With the region's people given, the model places the settled people beyond the given places.
+"$TP" -q run -o census --set dem="$dem" --set sites.existing="$places" --set sites.population=94347 --set outputs.preview=false --until sites 2>/dev/null ||
+  fail "run with sites.population"
+/usr/bin/python3 - <<'PY' || fail "existing places with the region's people"
+import json
+s = json.load(open("census/run.json"))["summary"]["sites"]
+e = s["existing"]
+assert e["generated"] > 0 and s["population"] == e["people"] + e["generated_people"] == s["settled_population"], s
+assert s["settled_population"] == round(0.55 * 94347), s
 PY
 
 # A place on a sea cell next to the coast is moved to the nearest buildable cell.
