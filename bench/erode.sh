@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Erosion benchmark: `terrapolis erode` (hydraulic, thermal, both) on a 513 x 513 crop of an SRTM 3"
+# Erosion benchmark: `terrapolis erode` (hydraulic, thermal, both, layered) on a 513 x 513 crop of an SRTM 3"
 # tile and on the whole tile (1201 x 1201): time per iteration (from --report), the hypsometric
 # integral (mean - min) / (max - min) before and after (Strahler 1952), and the pits (cells lower
 # than all 8 neighbours) before and after. One run per row.
@@ -51,7 +51,7 @@ echo "|---|---|---|---|---|---|---|---|---|"
 for input in "$tmp/crop513.tif" "$dem"; do
   name=$(basename "$input"); [[ $name == crop513.tif ]] && name="$(basename "$dem") 513² crop"
   size=$(gdalinfo "$input" | sed -n 's/^Size is \([0-9]*\), \([0-9]*\)/\1x\2/p')
-  for process in hydraulic thermal both; do
+  for process in hydraulic thermal both layered; do
     "$bin" -q --threads "$threads" erode "$input" "$tmp/out.tif" --process "$process" --iterations "$iterations" \
       --report "$tmp/report.json" --overwrite
     read -r ms done eroded out < <(/usr/bin/python3 -c "import json,sys; j=json.load(open(sys.argv[1])); print('%.1f %d %.4g %.4g' % (1000*j['seconds_per_iteration'], j['iterations'], j['eroded_m3'], j['carried_out_m3']))" "$tmp/report.json")

@@ -40,16 +40,21 @@ double volume_m3(const Raster<float>& thickness) {
   return v;
 }
 
+/// The layered process at a 30 degree angle of repose on `dem` under `loose`, run until stable.
+Dem relax_at_30_degrees(const Dem& dem, const Raster<float>& loose, ErodeReport& report, Raster<float>& loose_end) {
+  ErodeOptions o = layered(100000, 0);
+  o.thermal.angle_deg = 30;
+  o.layered.loose_m = &loose;
+  return run(dem, o, &report, nullptr, &loose_end);
+}
+
 TEST(LayeredErosion, LooseSlopeRelaxesToTheAngleOfRepose) {
   const Dem dem = ramp(24, 5, 1.0);  // 45 degrees, all of it loose down to the foot (100 m)
   Raster<float> loose = dem.like<float>();
   for (std::size_t i = 0; i < dem.size(); ++i) loose[i] = dem[i] - 100.0f;
-  ErodeOptions o = layered(100000, 0);
-  o.thermal.angle_deg = 30;
-  o.layered.loose_m = &loose;
   ErodeReport report;
   Raster<float> loose_end;
-  const Dem out = run(dem, o, &report, nullptr, &loose_end);
+  const Dem out = relax_at_30_degrees(dem, loose, report, loose_end);
   EXPECT_LT(report.iterations, 100000);  // stable before the end
   const double limit = std::tan(30 * std::numbers::pi / 180);
   EXPECT_LE(steepest_fall(out), limit + 1e-3);
@@ -74,12 +79,9 @@ TEST(LayeredErosion, BareRockSteeperThanTheAngleDoesNotMove) {
 TEST(LayeredErosion, OnlyTheLooseLayerSlides) {
   const Dem dem = ramp(24, 5, 1.0);
   Raster<float> loose = dem.like<float>(0.5f);  // a thin cover: it slides off, the rock under it stays
-  ErodeOptions o = layered(100000, 0);
-  o.thermal.angle_deg = 30;
-  o.layered.loose_m = &loose;
   ErodeReport report;
   Raster<float> loose_end;
-  const Dem out = run(dem, o, &report, nullptr, &loose_end);
+  const Dem out = relax_at_30_degrees(dem, loose, report, loose_end);
   for (std::size_t i = 0; i < dem.size(); ++i) {
     EXPECT_GE(loose_end[i], 0.0f) << i;
     EXPECT_NEAR(out[i] - loose_end[i], dem[i] - 0.5, 1e-3) << i;  // the bedrock did not move
