@@ -382,6 +382,9 @@ void sites_summary(const json& figures, SummaryText& out) {
   if (c.contains("growth"))
     out.line("           %.0f of them in the settlements (the existing places grown by %g%%), the new ones split by a rank-size law of exponent %.2f\n",
              c["settled_population"].get<double>(), 100 * c["growth"]["share"].get<double>(), c["sizes_exponent"].get<double>());
+  else if (c.contains("existing") && c["population_source"].get<std::string>().rfind("assumed", 0) == 0)
+    out.line("           %.0f of them in the given places (sites.existing): without sites.population none is generated beside them\n",
+             c["settled_population"].get<double>());
   else if (c.contains("settled_population"))
     out.line("           %.0f of them in the settlements (sites.urban_share %g), split by a rank-size law of exponent %.2f (%s)\n",
              c["settled_population"].get<double>(), c["urban_share"].get<double>(), c["sizes_exponent"].get<double>(),
