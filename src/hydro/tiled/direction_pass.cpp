@@ -104,7 +104,7 @@ void TiledRun::direct_tile(int t, const TileRect& r) {
       d8(c, row) = member[i] ? first[i] : drained[i];  // shared flats: drained by tiles later
       any_member |= member[i] != 0;
     }
-  if (any_member) share_tile_flats(t, r, near, first);
+  if (any_member) share_tile_flats(t, r, near, first, member);
   write_codes(codes_path(t), d8);
 }
 

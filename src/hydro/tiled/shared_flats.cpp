@@ -38,63 +38,138 @@ namespace {
 
 bool out_code(std::uint8_t v) { return v == kNoData || v == kTerminal; }  // drain_flats' "outside" cells
 
-/// The shared flats of one tile on `near`, the tile with a halo of one cell (first-pass codes
-/// `first`): their cells in the tile numbered by piece, and the two distances over their
-/// undrained cells. Halo cells only start paths, at the values their own tile gave them.
+// A tile cell's word: kNoPiece, or its piece with these bits.
+constexpr std::uint32_t kUndrained = 1u << 30, kHighEdge = 1u << 31, kPieceBits = kUndrained - 1;
+
+/// A tile's cells of shared flats as pass 2 finds them, kept on the scratch folder for the rounds:
+/// a word per cell (its piece, whether it is undrained and a high edge), the filled values of the
+/// tile's outer ring, and the filled values and first-pass codes of its halo: all that the two
+/// distances and the directions read (4 bytes a cell and 17 a ring cell).
+struct FlatCells {
+  std::vector<std::uint32_t> word;  // by tile cell, row-major
+  std::vector<float> ring_z;        // Ring(tile) order
+  std::vector<float> halo_z;        // Ring(window) order: the window's outer ring is the halo
+  std::vector<std::uint8_t> halo_code;
+  std::vector<FlatPiece> pieces;
+};
+
+TileRect window_of(const TileRect& r) { return {r.col0 - 1, r.row0 - 1, r.cols + 2, r.rows + 2}; }
+
+/// Pass 2: the cells of `near` (the tile `r` with a halo of one cell, first-pass codes `first`)
+/// in flats that reach the halo (`member`), numbered by piece (connected inside the tile).
+FlatCells find_flat_cells(const TileRect& r, const Dem& near, const Raster<std::uint8_t>& first, const std::vector<std::uint8_t>& member) {
+  FlatCells f;
+  f.word.assign(std::size_t(r.cols) * std::size_t(r.rows), kNoPiece);
+  std::vector<std::size_t> stack;
+  auto word = [&](int c, int row) -> std::uint32_t& { return f.word[std::size_t(row - 1) * std::size_t(r.cols) + std::size_t(c - 1)]; };
+  for (int row = 1; row <= r.rows; ++row)
+    for (int c = 1; c <= r.cols; ++c) {
+      if (!member[near.index(c, row)] || word(c, row) != kNoPiece) continue;
+      const std::uint32_t id = std::uint32_t(f.pieces.size());
+      if (id >= kPieceBits) throw processing_error("tiles: too many pieces of flats in a tile");
+      FlatPiece p{0, 0, 0};
+      word(c, row) = id;
+      stack.push_back(near.index(c, row));
+      while (!stack.empty()) {
+        const std::size_t i = stack.back();
+        stack.pop_back();
+        const int ic = int(i % std::size_t(near.cols())), ir = int(i / std::size_t(near.cols()));
+        (first[i] == kNoFlow ? p.undrained : p.draining) = 1;
+        for (int k = 0; k < 8; ++k) {
+          const int nc = ic + dcol[k], nr = ir + drow[k];
+          if (nc < 1 || nr < 1 || nc > r.cols || nr > r.rows || word(nc, nr) != kNoPiece) continue;
+          const std::size_t n = near.index(nc, nr);
+          if (!member[n] || near[n] != near[i]) continue;
+          word(nc, nr) = id;
+          stack.push_back(n);
+        }
+      }
+      f.pieces.push_back(p);
+    }
+  for (int row = 1; row <= r.rows; ++row)
+    for (int c = 1; c <= r.cols; ++c) {
+      std::uint32_t& w = word(c, row);
+      const std::size_t i = near.index(c, row);
+      if (w == kNoPiece || first[i] != kNoFlow) continue;
+      w |= kUndrained;
+      for (int k = 0; k < 8; ++k) {
+        const std::size_t n = near.index(c + dcol[k], row + drow[k]);
+        if (!out_code(first[n]) && near[n] > near[i]) w |= kHighEdge;  // Barnes 2014b's high edge
+      }
+    }
+  const Ring ring(r), halo(window_of(r));
+  f.ring_z.resize(ring.size());
+  f.halo_z.resize(halo.size());
+  f.halo_code.resize(halo.size());
+  for (int row = 0; row < near.rows(); ++row)
+    for (int c = 0; c < near.cols(); ++c) {
+      if (halo.contains(c, row)) {
+        f.halo_z[halo.index(c, row)] = near(c, row);
+        f.halo_code[halo.index(c, row)] = first(c, row);
+      } else if (ring.contains(c - 1, row - 1)) {
+        f.ring_z[ring.index(c - 1, row - 1)] = near(c, row);
+      }
+    }
+  return f;
+}
+
+/// The two distances and the directions of one tile's shared flats, on its FlatCells. Halo cells
+/// only start paths, at the values their own tile gave them; `halo(c, row)` (tile coordinates,
+/// one off the tile) gives that RingCell, or nullptr.
 class TileFlats {
  public:
-  TileFlats(const Dem& near, const Raster<std::uint8_t>& first)
-      : near_(near), first_(first), piece_(near.size(), kNoPiece), away_(near.size(), kFar), towards_(near.size(), kFar) {
-    for (int k = 0; k < 8; ++k) off_[k] = neighbour_offset(near.cols(), k);
-    number_pieces(flats_reaching_halo(near, first));
-  }
+  TileFlats(const TileRect& r, const FlatCells& f)
+      : cols_(r.cols), rows_(r.rows), ring_(r), halo_(window_of(r)), f_(f), away_(f.word.size(), kFar), towards_(f.word.size(), kFar) {}
 
-  std::vector<FlatPiece> pieces;
-
-  bool any_undrained() const {
-    return std::any_of(pieces.begin(), pieces.end(), [](const FlatPiece& p) { return p.undrained != 0; });
-  }
   std::uint64_t undrained_cells() const {
-    std::uint64_t n = 0;
-    for (std::size_t i = 0; i < near_.size(); ++i) n += undrained(i);
-    return n;
+    return std::uint64_t(std::count_if(f_.word.begin(), f_.word.end(), [](std::uint32_t w) { return undrained(w); }));
   }
 
-  /// The two distances, `halo(c, row)` giving the RingCell of a halo cell of `near` (or nullptr).
   template <class Halo>
-  void solve(Halo&& halo) {
+  void solve(Halo&& halo, std::vector<FlatPiece>& pieces) {
     std::vector<std::pair<std::int32_t, std::uint32_t>> from_higher, from_lower;
-    for (int row = 0; row < near_.rows(); ++row)
-      for (int c = 0; c < near_.cols(); ++c) {
-        const std::size_t i = near_.index(c, row);
-        if (out_code(first_[i])) continue;
-        if (!in_tile(c, row)) {
-          const RingCell* h = halo(c, row);
-          if (first_[i] == kNoFlow && h != nullptr && h->piece != kNoPiece) {
-            if (h->away < kFar) from_higher.emplace_back(h->away, std::uint32_t(i));
-            if (h->towards < kFar) from_lower.emplace_back(h->towards, std::uint32_t(i));
+    for (int row = 0; row < rows_; ++row)
+      for (int c = 0; c < cols_; ++c) {
+        const std::uint32_t i = std::uint32_t(index(c, row)), w = f_.word[i];
+        if (!undrained(w)) continue;
+        if (w & kHighEdge) from_higher.emplace_back(0, i);
+        bool low = false;  // next to a low edge, a draining cell of the flat
+        for (int k = 0; k < 8; ++k) {
+          const int nc = c + dcol[k], nr = row + drow[k];
+          if (inside(nc, nr)) {
+            const std::uint32_t wn = f_.word[index(nc, nr)];
+            low |= wn != kNoPiece && !undrained(wn) && same_piece(w, wn);
+          } else if (same_flat_in_halo(c, row, nc, nr)) {
+            if (f_.halo_code[halo_.index(nc + 1, nr + 1)] != kNoFlow) {
+              low = true;
+            } else if (const RingCell* h = halo(nc, nr); h != nullptr && h->piece != kNoPiece) {
+              if (h->away < kFar) from_higher.emplace_back(h->away + 1, i);
+              if (h->towards < kFar) from_lower.emplace_back(h->towards + 1, i);
+            }
           }
         }
-        if (first_[i] != kNoFlow && next_to_undrained(i)) from_lower.emplace_back(0, std::uint32_t(i));  // a low edge
-        if (undrained(i) && next_to_higher(i)) from_higher.emplace_back(0, std::uint32_t(i));        // a high edge
+        if (low) from_lower.emplace_back(1, i);
       }
     away_ = distances(std::move(from_higher));
     towards_ = distances(std::move(from_lower));
     for (FlatPiece& p : pieces) p.height = 0;
-    for (std::size_t i = 0; i < near_.size(); ++i)
-      if (undrained(i) && away_[i] < kFar) pieces[piece_[i]].height = std::max(pieces[piece_[i]].height, away_[i] + 1);
+    for (std::size_t i = 0; i < f_.word.size(); ++i)
+      if (undrained(f_.word[i]) && away_[i] < kFar) {
+        std::int32_t& h = pieces[f_.word[i] & kPieceBits].height;
+        h = std::max(h, away_[i] + 1);
+      }
   }
 
   /// The tile's outer ring (Ring order) as its neighbours will read it.
-  std::vector<RingCell> ring(const TileRect& r) const {
-    const Ring ring(r);
-    std::vector<RingCell> out(ring.size(), RingCell{kNoPiece, kFar, kFar});
-    for (int row = 0; row < r.rows; ++row)
-      for (int c = 0; c < r.cols; ++c) {
-        if (!ring.contains(c, row)) continue;
-        const std::size_t i = near_.index(c + 1, row + 1);
-        if (piece_[i] == kNoPiece) continue;
-        out[ring.index(c, row)] = first_[i] == kNoFlow ? RingCell{piece_[i], away_[i], towards_[i]} : RingCell{piece_[i], kFar, 0};
+  std::vector<RingCell> ring() const {
+    std::vector<RingCell> out(ring_.size(), RingCell{kNoPiece, kFar, kFar});
+    for (int row = 0; row < rows_; ++row)
+      for (int c = 0; c < cols_; ++c) {
+        if (!ring_.contains(c, row)) continue;
+        const std::size_t i = index(c, row);
+        const std::uint32_t w = f_.word[i];
+        if (w == kNoPiece) continue;
+        out[ring_.index(c, row)] = undrained(w) ? RingCell{w & kPieceBits, away_[i], towards_[i]} : RingCell{w & kPieceBits, kFar, 0};
       }
     return out;
   }
@@ -102,19 +177,33 @@ class TileFlats {
   /// Barnes 2014b's D8 over flats on the tile's undrained cells of shared flats: towards the
   /// neighbour of the same flat with the smallest mask, the first in neighbour order on ties;
   /// terminal when none is smaller, or when the flat has no low edge (`height(piece)` < 0).
-  template <class Height>
-  void direct(Raster<std::uint8_t>& d8, Height&& height) const {
-    for (int row = 0; row < d8.rows(); ++row)
-      for (int c = 0; c < d8.cols(); ++c) {
-        const std::size_t i = near_.index(c + 1, row + 1);
-        if (!undrained(i)) continue;
-        const std::int32_t h = height(piece_[i]);
+  template <class Height, class Halo>
+  void direct(Raster<std::uint8_t>& d8, Height&& height, Halo&& halo) const {
+    for (int row = 0; row < rows_; ++row)
+      for (int c = 0; c < cols_; ++c) {
+        const std::size_t i = index(c, row);
+        const std::uint32_t w = f_.word[i];
+        if (!undrained(w)) continue;
+        const std::int32_t h = height(w & kPieceBits);
         int best = -1;
-        std::int32_t best_mask = mask(i, h);
+        std::int32_t best_mask = mask(away_[i], towards_[i], h);
         for (int k = 0; k < 8 && h >= 0; ++k) {
-          const std::size_t n = std::size_t(std::ptrdiff_t(i) + off_[k]);
-          if (out_code(first_[n]) || near_[n] != near_[i]) continue;
-          if (const std::int32_t m = mask(n, h); m < best_mask) {
+          const int nc = c + dcol[k], nr = row + drow[k];
+          std::int32_t m = best_mask;
+          if (inside(nc, nr)) {
+            const std::size_t n = index(nc, nr);
+            const std::uint32_t wn = f_.word[n];
+            if (wn == kNoPiece || !same_piece(w, wn)) continue;
+            m = undrained(wn) ? mask(away_[n], towards_[n], h) : 2;
+          } else {
+            if (!same_flat_in_halo(c, row, nc, nr)) continue;
+            if (f_.halo_code[halo_.index(nc + 1, nr + 1)] != kNoFlow) {
+              m = 2;
+            } else if (const RingCell* hc = halo(nc, nr); hc != nullptr) {
+              m = mask(hc->away, hc->towards, h);
+            }
+          }
+          if (m < best_mask) {
             best_mask = m;
             best = k;
           }
@@ -124,59 +213,24 @@ class TileFlats {
   }
 
  private:
-  bool in_tile(int c, int row) const { return c > 0 && row > 0 && c + 1 < near_.cols() && row + 1 < near_.rows(); }
-  bool undrained(std::size_t i) const { return piece_[i] != kNoPiece && first_[i] == kNoFlow; }
-  bool next_to_undrained(std::size_t i) const {
-    const int c = int(i % std::size_t(near_.cols())), row = int(i / std::size_t(near_.cols()));
-    for (int k = 0; k < 8; ++k) {
-      const int nc = c + dcol[k], nr = row + drow[k];
-      if (near_.inside(nc, nr) && undrained(near_.index(nc, nr)) && near_(nc, nr) == near_[i]) return true;
-    }
-    return false;
+  static bool undrained(std::uint32_t w) { return w != kNoPiece && (w & kUndrained); }
+  static bool same_piece(std::uint32_t a, std::uint32_t b) { return (a & kPieceBits) == (b & kPieceBits); }
+  /// A low edge 2; an undrained cell from its distances (see the proof above).
+  static std::int32_t mask(std::int32_t away, std::int32_t towards, std::int32_t height) {
+    return away < kFar ? height + 1 - away + 2 * towards : 2 + 2 * towards;
   }
-  bool next_to_higher(std::size_t i) const {  // a tile cell: its neighbours all lie in `near`
-    for (int k = 0; k < 8; ++k) {
-      const std::size_t n = std::size_t(std::ptrdiff_t(i) + off_[k]);
-      if (!out_code(first_[n]) && near_[n] > near_[i]) return true;
-    }
-    return false;
-  }
-  std::int32_t mask(std::size_t i, std::int32_t height) const {
-    if (first_[i] != kNoFlow) return 2;  // a low edge
-    return away_[i] < kFar ? height + 1 - away_[i] + 2 * towards_[i] : 2 + 2 * towards_[i];
+  bool inside(int c, int row) const { return c >= 0 && row >= 0 && c < cols_ && row < rows_; }
+  std::size_t index(int c, int row) const { return std::size_t(row) * std::size_t(cols_) + std::size_t(c); }
+  /// Halo cell (nc, nr) next to the tile's ring cell (c, row) lies in its flat: one elevation, not outside.
+  bool same_flat_in_halo(int c, int row, int nc, int nr) const {
+    const std::size_t h = halo_.index(nc + 1, nr + 1);
+    return !out_code(f_.halo_code[h]) && f_.halo_z[h] == f_.ring_z[ring_.index(c, row)];
   }
 
-  /// The cells of shared flats in the tile, by piece (8-connected, one elevation, inside the tile).
-  void number_pieces(const std::vector<std::uint8_t>& member) {
-    std::vector<std::size_t> stack;
-    for (int row = 1; row + 1 < near_.rows(); ++row)
-      for (int c = 1; c + 1 < near_.cols(); ++c) {
-        const std::size_t s = near_.index(c, row);
-        if (!member[s] || piece_[s] != kNoPiece) continue;
-        const std::uint32_t id = std::uint32_t(pieces.size());
-        FlatPiece p{0, 0, 0};
-        piece_[s] = id;
-        stack.push_back(s);
-        while (!stack.empty()) {
-          const std::size_t i = stack.back();
-          stack.pop_back();
-          (first_[i] == kNoFlow ? p.undrained : p.draining) = 1;
-          const int ic = int(i % std::size_t(near_.cols())), ir = int(i / std::size_t(near_.cols()));
-          for (int k = 0; k < 8; ++k) {
-            const std::size_t n = std::size_t(std::ptrdiff_t(i) + off_[k]);
-            if (!in_tile(ic + dcol[k], ir + drow[k]) || piece_[n] != kNoPiece || !member[n] || near_[n] != near_[i]) continue;
-            piece_[n] = id;
-            stack.push_back(n);
-          }
-        }
-        pieces.push_back(p);
-      }
-  }
-
-  /// Breadth-first distances from `seeds` (distance, index in `near`), over the tile's undrained
-  /// cells of shared flats, one step between 8-neighbours of one elevation; a seed keeps its value.
+  /// Breadth-first distances from `seeds` (distance, tile cell), over the tile's undrained cells
+  /// of shared flats, one step between 8-neighbours of one piece; a seed keeps its value.
   std::vector<std::int32_t> distances(std::vector<std::pair<std::int32_t, std::uint32_t>> seeds) const {
-    std::vector<std::int32_t> d(near_.size(), kFar);
+    std::vector<std::int32_t> d(f_.word.size(), kFar);
     std::sort(seeds.begin(), seeds.end());
     std::vector<std::uint32_t> front, next;
     std::size_t s = 0;
@@ -191,22 +245,25 @@ class TileFlats {
           front.push_back(seeds[s].second);
         }
       next.clear();
-      for (const std::uint32_t i : front)
+      for (const std::uint32_t i : front) {
+        const int c = int(i % std::uint32_t(cols_)), row = int(i / std::uint32_t(cols_));
         for (int k = 0; k < 8; ++k) {
-          const std::size_t n = std::size_t(std::ptrdiff_t(i) + off_[k]);
-          if (n >= near_.size() || !undrained(n) || d[n] <= level + 1 || near_[n] != near_[i]) continue;
+          const int nc = c + dcol[k], nr = row + drow[k];
+          if (!inside(nc, nr)) continue;
+          const std::size_t n = index(nc, nr);
+          if (!undrained(f_.word[n]) || !same_piece(f_.word[n], f_.word[i]) || d[n] <= level + 1) continue;
           d[n] = level + 1;
           next.push_back(std::uint32_t(n));
         }
+      }
       std::swap(front, next);
     }
     return d;
   }
 
-  const Dem& near_;
-  const Raster<std::uint8_t>& first_;
-  std::ptrdiff_t off_[8];
-  std::vector<std::uint32_t> piece_;
+  const int cols_, rows_;
+  const Ring ring_, halo_;
+  const FlatCells& f_;
   std::vector<std::int32_t> away_, towards_;
 };
 
@@ -224,31 +281,54 @@ struct Sets {
   }
 };
 
-void write_window(const std::string& path, const Dem& near, const Raster<std::uint8_t>& first) {
+template <class T>
+void write_values(std::ofstream& out, const std::vector<T>& v) {
+  out.write(reinterpret_cast<const char*>(v.data()), std::streamsize(v.size() * sizeof(T)));
+}
+template <class T>
+void read_values(std::ifstream& in, std::vector<T>& v) {
+  in.read(reinterpret_cast<char*>(v.data()), std::streamsize(v.size() * sizeof(T)));
+}
+
+void write_flat_cells(const std::string& path, const FlatCells& f) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out.write(reinterpret_cast<const char*>(near.data()), std::streamsize(near.size() * sizeof(float)));
-  out.write(reinterpret_cast<const char*>(first.data()), std::streamsize(first.size()));
+  write_values(out, f.word);
+  write_values(out, f.ring_z);
+  write_values(out, f.halo_z);
+  write_values(out, f.halo_code);
   if (!out) throw bad_input(path + ": cannot write scratch data (disk full?)");
 }
 
-void read_window(const std::string& path, Dem& near, Raster<std::uint8_t>& first) {
+/// The FlatCells of tile `r` written by write_flat_cells; `pieces` as pass 2 found them.
+FlatCells read_flat_cells(const std::string& path, const TileRect& r, const std::vector<FlatPiece>& pieces) {
+  FlatCells f;
+  f.word.resize(std::size_t(r.cols) * std::size_t(r.rows));
+  f.ring_z.resize(Ring(r).size());
+  f.halo_z.resize(Ring(window_of(r)).size());
+  f.halo_code.resize(f.halo_z.size());
+  f.pieces = pieces;
   std::ifstream in(path, std::ios::binary);
-  in.read(reinterpret_cast<char*>(near.data()), std::streamsize(near.size() * sizeof(float)));
-  in.read(reinterpret_cast<char*>(first.data()), std::streamsize(first.size()));
+  read_values(in, f.word);
+  read_values(in, f.ring_z);
+  read_values(in, f.halo_z);
+  read_values(in, f.halo_code);
   if (!in) throw bad_input(path + ": cannot read scratch data back");
+  return f;
 }
 
 }  // namespace
 
 // Pass 2, for a tile with cells of flats that reach its halo: the pieces, the outer ring before any
-// wave, and the window (5 bytes a cell) kept on a scratch file for the rounds.
-void TiledRun::share_tile_flats(int t, const TileRect& r, const Dem& near, const Raster<std::uint8_t>& first) {
-  TileFlats f(near, first);
-  ring_[std::size_t(t)] = f.ring(r);
-  if (f.any_undrained()) {
+// wave, and the FlatCells kept on a scratch file for the rounds.
+void TiledRun::share_tile_flats(int t, const TileRect& r, const Dem& near, const Raster<std::uint8_t>& first,
+                                const std::vector<std::uint8_t>& member) {
+  FlatCells f = find_flat_cells(r, near, first, member);
+  const TileFlats flats(r, f);
+  ring_[std::size_t(t)] = flats.ring();
+  flat_cells_[std::size_t(t)] = flats.undrained_cells();
+  if (flat_cells_[std::size_t(t)] > 0) {
     flat_tile_[std::size_t(t)] = 1;
-    flat_cells_[std::size_t(t)] = f.undrained_cells();
-    write_window(flats_path(t), near, first);
+    write_flat_cells(flats_path(t), f);
   }
   pieces_[std::size_t(t)] = std::move(f.pieces);
 }
@@ -364,23 +444,20 @@ bool TiledRun::flat_round(std::vector<std::uint8_t>& solving) {
 }
 
 void TiledRun::solve_tile_flats(int t, const TileRect& r, std::vector<RingCell>& ring) {
-  Dem near(r.cols + 2, r.rows + 2, shifted(georef_, r.col0 - 1, r.row0 - 1));
-  Raster<std::uint8_t> first = near.like<std::uint8_t>(kNoData);
-  read_window(flats_path(t), near, first);
-  TileFlats f(near, first);
-  f.solve([&](int c, int row) { return ring_cell(r.col0 - 1 + c, r.row0 - 1 + row); });
-  ring = f.ring(r);
+  FlatCells f = read_flat_cells(flats_path(t), r, pieces_[std::size_t(t)]);
+  TileFlats flats(r, f);
+  flats.solve([&](int c, int row) { return ring_cell(r.col0 + c, r.row0 + row); }, f.pieces);
+  ring = flats.ring();
   pieces_[std::size_t(t)] = std::move(f.pieces);
 }
 
 // Pass 3's start: the tile's undrained cells of shared flats given their directions.
 void TiledRun::direct_tile_flats(int t, const TileRect& r, Raster<std::uint8_t>& d8) const {
-  Dem near(r.cols + 2, r.rows + 2, shifted(georef_, r.col0 - 1, r.row0 - 1));
-  Raster<std::uint8_t> first = near.like<std::uint8_t>(kNoData);
-  read_window(flats_path(t), near, first);
-  TileFlats f(near, first);
-  f.solve([&](int c, int row) { return ring_cell(r.col0 - 1 + c, r.row0 - 1 + row); });
-  f.direct(d8, [&](std::uint32_t piece) { return flat_height_[flat_of_[piece_base_[std::size_t(t)] + piece]]; });
+  FlatCells f = read_flat_cells(flats_path(t), r, pieces_[std::size_t(t)]);
+  TileFlats flats(r, f);
+  auto halo = [&](int c, int row) { return ring_cell(r.col0 + c, r.row0 + row); };
+  flats.solve(halo, f.pieces);
+  flats.direct(d8, [&](std::uint32_t piece) { return flat_height_[flat_of_[piece_base_[std::size_t(t)] + piece]]; }, halo);
 }
 
 }  // namespace terrapolis::hydro::tiled

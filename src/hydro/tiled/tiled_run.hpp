@@ -222,7 +222,8 @@ class TiledRun {
   Dem with_halo(const TileRect& r, const Dem& filled) const;
 
   // shared_flats.cpp: the flats that cross tile edges, drained by tiles.
-  void share_tile_flats(int t, const TileRect& r, const Dem& near, const Raster<std::uint8_t>& first);
+  void share_tile_flats(int t, const TileRect& r, const Dem& near, const Raster<std::uint8_t>& first,
+                        const std::vector<std::uint8_t>& member);
   const RingCell* ring_cell(int gc, int gr) const;
   void join_pieces();
   void solve_shared_flats();
