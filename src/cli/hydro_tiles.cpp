@@ -91,10 +91,10 @@ std::string tiles_of_this_process(const TiledHydroRequest& q, Context& context, 
     }
   char line[440];
   std::snprintf(line, sizeof line,
-                "tiles: %d of %d cells a side, %d at once; %llu spill labels, %llu edges; %llu cells of flats across tiles; "
+                "tiles: %d of %d cells a side, %d at once; %llu spill labels, %llu edges; %llu cells of flats across tiles (%llu rounds); "
                 "%llu links; %llu stream cells; state %.1f MB a tile + %.1f MB global; peak resident %.0f MB; %d process%s",
                 report.tiles, report.tile_size, report.concurrent_tiles, (unsigned long long)report.labels,
-                (unsigned long long)report.spill_edges, (unsigned long long)report.flat_cells_shared,
+                (unsigned long long)report.spill_edges, (unsigned long long)report.flat_cells_shared, (unsigned long long)report.flat_rounds,
                 (unsigned long long)report.links, (unsigned long long)report.stream_cells, report.tile_state_bytes / 1e6, report.global_state_bytes / 1e6,
                 peak_resident_mb(), driver.ranks(), driver.ranks() == 1 ? "" : "es");
   context.log.detail(line);

@@ -50,9 +50,11 @@ Whole whole_grid(const Dem& dem, std::optional<double> sea, AccumulationUnit uni
 }
 
 /// The tiled run's outputs put back together on the whole grid.
+/// With `memory_limit_mb` > 0 the engine sizes its tiles from it (`tile_size` ignored).
 Whole tiled(const Dem& dem, int tile_size, int concurrent, std::optional<double> sea, AccumulationUnit unit,
-            TiledReport* report = nullptr) {
+            TiledReport* report = nullptr, double memory_limit_mb = 0) {
   Whole w{dem.like<float>(-1.0f), dem.like<std::uint8_t>(77), dem.like<double>(-1.0), dem.like<std::uint32_t>(0xDEADu)};
+  if (memory_limit_mb > 0) tile_size = tile_size_for(dem.cols(), dem.rows(), memory_limit_mb, concurrent);
   const TileGrid grid(dem.cols(), dem.rows(), tile_size);
   std::mutex m;
   auto place = [&](auto& whole, int t, const auto& tile) {
@@ -72,7 +74,8 @@ Whole tiled(const Dem& dem, int tile_size, int concurrent, std::optional<double>
   sinks.accumulation = [&](int t, const Raster<double>& a) { place(w.accumulation, t, a); };
   sinks.basins = [&](int t, const Raster<std::uint32_t>& b) { place(w.basins, t, b); };
   TiledOptions o;
-  o.tile_size = tile_size;
+  o.tile_size = memory_limit_mb > 0 ? 0 : tile_size;
+  if (memory_limit_mb > 0) o.memory_limit_mb = memory_limit_mb;
   o.concurrent_tiles = concurrent;
   o.sea_level = sea;
   o.unit = unit;
@@ -147,6 +150,22 @@ Dem landscape() {
     }
   for (int r = 10; r < 14; ++r)
     for (int c = 70; c < 76; ++c) d(c, r) = NAN;
+  return d;
+}
+
+/// 256 x 256 cells of 1" sloping gently to the west, with a crater 80 m deep and 120 cells wide
+/// centred on the corner (128, 128) of four tiles of 128: filled, a lake of about 44 000 cells at
+/// one level, higher terrain all around it (the gradient away from it) and its spill point on the
+/// west (the gradient towards lower terrain), with integer noise outside the crater.
+Dem crater() {
+  Dem d(256, 256, geographic(9.0, 47.0, 1.0 / 3600), 0.0f);
+  std::mt19937_64 rng(5);
+  std::uniform_int_distribution<int> noise(0, 1);
+  for (int r = 0; r < 256; ++r)
+    for (int c = 0; c < 256; ++c) {
+      const double dc = std::hypot(c - 128.0, r - 128.0);
+      d(c, r) = dc < 120 ? float(1000 + 0.02 * c - 80 * (1 - dc / 120)) : float(1000 + 0.02 * c + noise(rng));
+    }
   return d;
 }
 
@@ -234,6 +253,59 @@ TEST(TiledHydro, RandomDemsWithTiesHolesAndSeaEqualTheWholeGrid) {
     const Whole whole = whole_grid(dem, sea, unit);
     const int size = 8 + int(rng() % 20);
     expect_same(whole, tiled(dem, size, 1 + int(seed % 2), sea, unit), "seed " + std::to_string(seed));
+  }
+}
+
+TEST(TiledHydro, FlatOnFourTilesDrainsWithinAMemoryLimitTheGatherWouldExceed) {
+  const Dem dem = crater();
+  const Whole whole = whole_grid(dem, std::nullopt, AccumulationUnit::area_m2);
+  const double limit_mb = 1.3;
+  ASSERT_EQ(TileGrid(256, 256, tile_size_for(256, 256, limit_mb, 1)).count(), 4) << "2 x 2 tiles of 128";
+  // The lake: one level, filled cells in the four tiles.
+  const TileGrid grid(256, 256, 128);
+  const float lake = whole.filled(128, 128);
+  std::set<int> lake_tiles;
+  std::size_t lake_cells = 0;
+  for (int r = 0; r < 256; ++r)
+    for (int c = 0; c < 256; ++c)
+      if (whole.filled(c, r) == lake && whole.filled(c, r) > dem(c, r)) {
+        lake_tiles.insert(grid.tile_of(c, r));
+        ++lake_cells;
+      }
+  EXPECT_EQ(lake_tiles.size(), 4u);
+  EXPECT_GT(lake_cells, 40000u);
+  TiledReport report;
+  expect_same(whole, tiled(dem, 0, 1, std::nullopt, AccumulationUnit::area_m2, &report, limit_mb), "within 1.3 MB");
+  EXPECT_EQ(report.tiles, 4);
+  // Gathered whole, the lake alone would take 48 bytes a cell: over the limit.
+  EXPECT_GE(report.flat_cells_shared, lake_cells);
+  EXPECT_GT(48.0 * double(report.flat_cells_shared), limit_mb * 1e6);
+  // By tiles: the tile processed at once plus the global state (frames, rings, pieces) fit.
+  EXPECT_LE(report.tile_state_bytes * report.concurrent_tiles + report.global_state_bytes, limit_mb * 1e6);
+  EXPECT_GE(report.flat_rounds, 2u) << "the tiles exchanged their rings";
+  // Smaller tiles: more rounds, the same bits.
+  for (int size : {40, 64, 100}) {
+    TiledReport small;
+    expect_same(whole, tiled(dem, size, 2, std::nullopt, AccumulationUnit::area_m2, &small), "tiles of " + std::to_string(size));
+    EXPECT_GT(small.flat_rounds, report.flat_rounds) << size;
+  }
+}
+
+TEST(TiledHydro, RandomWideFlatsOnRandomTileSizesEqualTheWholeGrid) {
+  for (std::uint64_t seed = 100; seed < 140; ++seed) {
+    std::mt19937_64 rng(seed);
+    // Some only 1 to 3 cells wide: tiles whose outer ring is the whole tile.
+    const int cols = seed % 8 == 0 ? 1 + int(rng() % 3) : 30 + int(rng() % 90), rows = 30 + int(rng() % 90);
+    Dem dem = test::random_dem(cols, rows, seed, seed % 3 == 0);
+    // Coarse steps: flats of hundreds of cells, joined and split by tile edges.
+    const float step = float(5 + rng() % 9);
+    for (auto& v : dem.values())
+      if (!std::isnan(v)) v = std::floor(v / step);
+    const std::optional<double> sea = seed % 4 == 1 ? std::optional<double>(0.0) : std::nullopt;
+    const Whole whole = whole_grid(dem, sea, AccumulationUnit::area_m2);
+    const int size = 8 + int(rng() % 24);
+    TiledReport report;
+    expect_same(whole, tiled(dem, size, 1 + int(seed % 2), sea, AccumulationUnit::area_m2, &report), "seed " + std::to_string(seed));
   }
 }
 

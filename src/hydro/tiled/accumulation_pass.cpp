@@ -1,5 +1,5 @@
-// Pass 3 of the tile engine (Barnes 2017): each tile's final directions (its own and the shared
-// flats' patches), the accumulation inside it, and the links by which its flow leaves it.
+// Pass 3 of the tile engine (Barnes 2017): each tile's final directions (its own and those of the
+// shared flats' cells in it), the accumulation inside it, and the links by which its flow leaves it.
 // SPDX-License-Identifier: MIT
 #include "hydro/exact_accumulation.hpp"
 #include "hydro/tiled/tile_bytes.hpp"
@@ -99,14 +99,15 @@ void TiledRun::accumulate_tiles() {
         edge_exit_[std::size_t(t)] = in.take<std::int32_t>();
         outlet_rows_[std::size_t(t)] = in.take<std::uint32_t>();
       });
+  ring_ = {};
+  pieces_ = {};
 }
 
 void TiledRun::accumulate_tile(int t, const TileRect& r) {
   Raster<std::uint8_t> d8 = tile_codes(r);
   d8.nodata = kNoData;
   read_codes(codes_path(t), d8);
-  for (const auto& [i, k] : patches_[std::size_t(t)]) d8[i] = k;
-  patches_[std::size_t(t)] = {};
+  if (flat_tile_[std::size_t(t)]) direct_tile_flats(t, r, d8);
   if (sinks_.d8) sinks_.d8(t, d8);
   write_codes(codes_path(t), d8);
   std::vector<std::int64_t> acc = own_units(d8, r);

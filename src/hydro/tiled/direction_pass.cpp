@@ -12,8 +12,9 @@ namespace {
 
 bool out_code(std::uint8_t v) { return v == kNoData || v == kTerminal; }  // drain_flats' "outside" cells
 
-/// Cells whose equal-elevation component (drain_flats' flats and the draining cells that join
-/// them) reaches the halo of `near`: their flat is not whole in this tile.
+}  // namespace
+
+// The equal-elevation components are drain_flats' flats and the draining cells that join them.
 std::vector<std::uint8_t> flats_reaching_halo(const Dem& near, const Raster<std::uint8_t>& first) {
   std::vector<std::uint8_t> member(near.size(), 0);
   std::vector<std::size_t> stack;
@@ -41,17 +42,29 @@ std::vector<std::uint8_t> flats_reaching_halo(const Dem& near, const Raster<std:
   return member;
 }
 
-}  // namespace
-
 // 2. Filled tiles (the flood again, each cell raised to its label's level), first-pass D8 on
 // the tile and a one-cell halo, flats inside the tile drained; cells of flats reaching the halo
-// handed on.
+// handed on: the pieces of them in the tile and its outer ring's cells in them.
 void TiledRun::direct_tiles() {
-  shared_.resize(static_cast<std::size_t>(tiles_));
+  ring_.resize(static_cast<std::size_t>(tiles_));
+  pieces_.resize(static_cast<std::size_t>(tiles_));
+  flat_tile_.assign(static_cast<std::size_t>(tiles_), 0);
+  flat_cells_.assign(static_cast<std::size_t>(tiles_), 0);
   std::exception_ptr failure = for_tiles("flow directions of tiles", [&](int t, const TileRect& r) { direct_tile(t, r); });
   exchange(
-      failure, [&](int t, std::vector<char>& out) { put(out, shared_[std::size_t(t)]); },
-      [&](int t, Unpack& in) { shared_[std::size_t(t)] = in.take<SharedEntry>(); });
+      failure,
+      [&](int t, std::vector<char>& out) {
+        put(out, ring_[std::size_t(t)]);
+        put(out, pieces_[std::size_t(t)]);
+        put(out, std::vector<std::uint64_t>{flat_cells_[std::size_t(t)]});
+      },
+      [&](int t, Unpack& in) {
+        ring_[std::size_t(t)] = in.take<RingCell>();
+        pieces_[std::size_t(t)] = in.take<FlatPiece>();
+        const std::vector<std::uint64_t> cells = in.take<std::uint64_t>();
+        flat_cells_[std::size_t(t)] = cells.empty() ? 0 : cells[0];
+        flat_tile_[std::size_t(t)] = flat_cells_[std::size_t(t)] > 0;
+      });
 }
 
 void TiledRun::direct_tile(int t, const TileRect& r) {
@@ -84,16 +97,14 @@ void TiledRun::direct_tile(int t, const TileRect& r) {
   const std::vector<std::uint8_t> member = flats_reaching_halo(near, first);
   Raster<std::uint8_t> d8 = tile_codes(r);
   d8.nodata = kNoData;
-  auto& out = shared_[std::size_t(t)];
+  bool any_member = false;
   for (int row = 0; row < r.rows; ++row)
     for (int c = 0; c < r.cols; ++c) {
       const std::size_t i = near.index(c + 1, row + 1);
-      bool next_to_member = member[i];
-      for (int k = 0; k < 8 && !next_to_member; ++k) next_to_member = member[near.index(c + 1 + dcol[k], row + 1 + drow[k])];
-      d8(c, row) = member[i] ? first[i] : drained[i];
-      if (next_to_member)
-        out.push_back({std::int64_t(r.row0 + row) * cols_ + (r.col0 + c), SharedCell{near[i], first[i], member[i] != 0}});
+      d8(c, row) = member[i] ? first[i] : drained[i];  // shared flats: drained by tiles later
+      any_member |= member[i] != 0;
     }
+  if (any_member) share_tile_flats(t, r, near, first, member);
   write_codes(codes_path(t), d8);
 }
 

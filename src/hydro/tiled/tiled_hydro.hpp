@@ -110,7 +110,8 @@ struct TiledOptions {
 struct TiledReport {
   int tile_size = 0, tiles = 0, concurrent_tiles = 0;
   std::uint64_t labels = 0, spill_edges = 0;   ///< Barnes 2016 spillover graph
-  std::uint64_t flat_cells_shared = 0;          ///< cells of flats that cross tile edges, solved globally
+  std::uint64_t flat_cells_shared = 0;          ///< undrained cells of flats that cross tile edges, drained by tiles
+  std::uint64_t flat_rounds = 0;                ///< rounds of tiles exchanging those flats' rings
   std::uint64_t links = 0;                      ///< Barnes 2017: flow paths leaving a tile
   std::uint64_t stream_cells = 0;               ///< cells of the stream network gathered (rank 0)
   double tile_state_bytes = 0;                  ///< per tile processed at once
@@ -129,8 +130,8 @@ int tile_size_for(int cols, int rows, double memory_limit_mb, int concurrent);
 int allowed_threads();
 
 /// Runs priority-flood filling (Barnes 2016), D8 with flat resolution (Barnes et al. 2014b, flats
-/// that cross tile edges gathered and solved whole) and D8 accumulation (Barnes 2017, fixed-point
-/// sums) on a `cols` x `rows` mosaic georeferenced by `georef`. The tiles handed to `sinks`,
+/// that cross tile edges solved by tiles that exchange their outer rings) and D8 accumulation
+/// (Barnes 2017, fixed-point sums) on a `cols` x `rows` mosaic georeferenced by `georef`. The tiles handed to `sinks`,
 /// put together, equal fill_depressions (priority_flood), d8_directions and accumulate (D8) on the
 /// whole grid bit for bit, for any tile size. Deterministic for any thread and process count.
 /// Collective over `driver`'s processes: each reads and hands out only the tiles it owns.

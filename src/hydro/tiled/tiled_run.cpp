@@ -48,14 +48,17 @@ TiledRun::TiledRun(int cols, int rows, const Georef& georef, const ReadWindow& r
 
 TiledRun::~TiledRun() {
   std::error_code ec;
-  for (int t = 0; t < tiles_; ++t) std::filesystem::remove(codes_path(t), ec);
+  for (int t = 0; t < tiles_; ++t) {
+    std::filesystem::remove(codes_path(t), ec);
+    std::filesystem::remove(flats_path(t), ec);
+  }
 }
 
 TiledReport TiledRun::run() {
   fill_tiles();
   solve_spill_graph();
   direct_tiles();
-  drain_shared_flats();
+  solve_shared_flats();
   accumulate_tiles();
   solve_link_graph();
   if (!final_accumulation()) return report_;

@@ -72,17 +72,52 @@ struct TileFill {
 /// nodata in a neighbouring tile, or on the mosaic's border, is a true outlet as in the whole grid.
 TileFill fill_tile(const Dem& window, const std::optional<double>& sea_level);  // fill_pass.cpp
 
-/// A cell given to the global flat resolution: its filled value and first-pass D8 code, and
-/// whether it belongs to a flat that reaches beyond its tile.
-struct SharedCell {
-  float z;
-  std::uint8_t code;
-  bool member;
+/// The outer ring of cells of a tile (every cell when it is under 3 cells wide or high), numbered:
+/// the north row, the south row, then the west and east cells of each row between.
+class Ring {
+ public:
+  explicit Ring(const TileRect& r) : cols_(r.cols), rows_(r.rows) {}
+  std::size_t size() const {
+    return whole() ? std::size_t(cols_) * std::size_t(rows_) : 2 * std::size_t(cols_) + 2 * std::size_t(rows_ - 2);
+  }
+  bool contains(int c, int r) const { return c == 0 || r == 0 || c == cols_ - 1 || r == rows_ - 1; }
+  std::size_t index(int c, int r) const {
+    if (whole()) return std::size_t(r) * std::size_t(cols_) + std::size_t(c);
+    if (r == 0) return std::size_t(c);
+    if (r == rows_ - 1) return std::size_t(cols_) + std::size_t(c);
+    return 2 * std::size_t(cols_) + 2 * std::size_t(r - 1) + (c == 0 ? 0 : 1);
+  }
+
+ private:
+  bool whole() const { return cols_ < 3 || rows_ < 3; }
+  int cols_ = 0, rows_ = 0;
 };
-struct SharedEntry {
-  std::int64_t cell;  // mosaic index
-  SharedCell value;
+
+inline constexpr std::int32_t kFar = std::numeric_limits<std::int32_t>::max() / 4;  // no wave reaches the cell
+inline constexpr std::uint32_t kNoPiece = 0xFFFFFFFFu;
+
+/// A cell of a tile's outer ring in a flat that crosses tile edges (Barnes et al. 2014b's flat:
+/// the 8-connected cells of one elevation, undrained and draining, non-terminal): the piece of the
+/// flat it belongs to in its tile (kNoPiece: none), and its distances in cell steps over the flat's
+/// undrained cells from the nearest high edge (`away`) and from the nearest low edge (`towards`),
+/// kFar where no path reaches. Draining cells: kFar and 0 (they are the low edges).
+struct RingCell {
+  std::uint32_t piece;
+  std::int32_t away, towards;
+  friend bool operator==(const RingCell&, const RingCell&) = default;
 };
+
+/// The cells of a flat crossing tile edges that lie in one tile and are connected inside it: whether
+/// they hold undrained and draining cells, and the largest away + 1 over their undrained cells (0:
+/// none reached), whose maximum over the flat is Barnes 2014b's flat height.
+struct FlatPiece {
+  std::uint8_t undrained, draining;
+  std::int32_t height;
+};
+
+/// Cells of `near` (a tile with a halo of one cell) whose equal-elevation component of non-terminal
+/// cells, by first-pass codes `first`, reaches the halo: their flat is not whole in the tile.
+std::vector<std::uint8_t> flats_reaching_halo(const Dem& near, const Raster<std::uint8_t>& first);
 
 /// A cell of the stream network, as a tile hands it on.
 struct StreamCell {
@@ -186,17 +221,16 @@ class TiledRun {
   void direct_tile(int t, const TileRect& r);
   Dem with_halo(const TileRect& r, const Dem& filled) const;
 
-  // shared_flats.cpp: the flats that cross tile edges, drained whole.
-  /// The cells handed on by the tiles, by mosaic index, and the flats that cross tile edges among them.
-  struct SharedFlats {
-    std::unordered_map<std::int64_t, std::uint32_t> slot;
-    std::vector<std::int64_t> cell_of;
-    std::vector<SharedCell> cells;
-  };
-  std::int64_t neighbour(std::int64_t g, int k) const;
-  std::unordered_map<std::uint32_t, std::vector<std::uint32_t>> flat_groups(const SharedFlats& s) const;
-  void drain_shared_flats();
-  void drain_shared_flat(const SharedFlats& s, const std::vector<std::uint32_t>& members);
+  // shared_flats.cpp: the flats that cross tile edges, drained by tiles.
+  void share_tile_flats(int t, const TileRect& r, const Dem& near, const Raster<std::uint8_t>& first,
+                        const std::vector<std::uint8_t>& member);
+  const RingCell* ring_cell(int gc, int gr) const;
+  void join_pieces();
+  void solve_shared_flats();
+  bool flat_round(std::vector<std::uint8_t>& solving);
+  void solve_tile_flats(int t, const TileRect& r, std::vector<RingCell>& ring);
+  void direct_tile_flats(int t, const TileRect& r, Raster<std::uint8_t>& d8) const;
+  std::string flats_path(int t) const { return (scratch_ / ("flats-" + std::to_string(t) + ".bin")).string(); }
 
   // accumulation_pass.cpp: pass 3, final directions, accumulation inside each tile, links (Barnes 2017).
   std::vector<std::int64_t> own_units(const Raster<std::uint8_t>& d8, const TileRect& r) const;
@@ -244,9 +278,14 @@ class TiledRun {
   std::vector<std::uint32_t> tile_labels_, base_;
   std::vector<float> level_;
   double frame_bytes_ = 0;
-  // Pass 2 and the shared flats: the cells handed on, then the codes of the flats solved whole.
-  std::vector<std::vector<SharedEntry>> shared_;
-  std::vector<std::vector<std::pair<std::uint32_t, std::uint8_t>>> patches_;
+  // Pass 2 and the shared flats: each tile's outer ring and pieces of them, the global flats.
+  std::vector<std::vector<RingCell>> ring_, fresh_ring_;  // by tile, Ring order; empty: no shared flat
+  std::vector<std::vector<FlatPiece>> pieces_;
+  std::vector<std::uint8_t> flat_tile_;   // the tile holds undrained cells of a shared flat (a scratch file)
+  std::vector<std::uint64_t> flat_cells_;  // by tile: those cells
+  std::vector<std::uint32_t> piece_base_;  // global piece = base + piece in its tile
+  std::vector<std::uint32_t> flat_of_;     // global piece -> its flat (the smallest global piece of it)
+  std::vector<std::int32_t> flat_height_;  // by flat: Barnes 2014b's flat height; -1: no low edge, undrainable
   // Pass 3 and the link graph.
   FixedPointUnits units_;
   std::vector<std::vector<Link>> links_;
