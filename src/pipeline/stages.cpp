@@ -616,7 +616,10 @@ void roads_summary(const json& figures, SummaryText& out) {
     for (const auto& [cls, km] : r["length_km"].items())
       out.line("           %-13s %9.1f %9.1f %9.1f km\n", cls.c_str(), km.get<double>(), r["new_km"].value(cls, 0.0), e["km"].value(cls, 0.0));
   } else {
-    for (const auto& [cls, km] : r["length_km"].items()) out.line("           %-13s %9.1f km\n", cls.c_str(), km.get<double>());
+    // By class as drawn once (a section at its highest class), so the classes add up to the
+    // network's km; run.json's length_km keeps the km summed per link.
+    const json& by_class = r.contains("new_km") ? r["new_km"] : r["length_km"];
+    for (const auto& [cls, km] : by_class.items()) out.line("           %-13s %9.1f km\n", cls.c_str(), km.get<double>());
   }
   if (r.contains("corridor")) {  // roads.corridor.enabled: the earthworks, of the new stretches only when roads are given
     const json& c = r["corridor"];
