@@ -97,8 +97,8 @@ class SitesCommand final : public Command {
       std::printf("sites: %lld settlements of the law (%lld people) found no place (raise --candidates)\n", static_cast<long long>(result.unplaced),
                   static_cast<long long>(result.unplaced_people));
     if (!existing_file.empty())
-      std::printf("sites: %zu existing places (%.0f people; %d moved to land, %d outside the DEM left out), %zu generated\n",
-                  existing.sites.size(), result.existing_population, existing.moved, existing.outside,
+      std::printf("sites: %zu existing places (%.0f people; %zu moved to land, %zu outside the DEM left out), %zu generated\n",
+                  existing.sites.size(), result.existing_population, existing.moved.size(), existing.outside.size(),
                   result.sites.size() - existing.sites.size());
     if (result.growth_people > 0)
       std::printf("sites: growth +%g%%: %lld new settled people, %lld to the existing places, %lld in new settlements\n",

@@ -135,8 +135,7 @@ ExistingPlaces read_existing_places(const std::string& path, const Raster<std::u
     }
     const auto [col, row] = std::isfinite(p.x) && std::isfinite(p.y) ? cell_of(buildable.georef(), p.x, p.y) : std::array<int, 2>{-1, -1};
     if (!buildable.inside(col, row)) {
-      ++out.outside;
-      out.outside_names.push_back(name);
+      out.outside.push_back(name);
       continue;
     }
     // Its cell, or the nearest free buildable one within two cells (a coastal town on a sea cell of
@@ -150,7 +149,7 @@ ExistingPlaces read_existing_places(const std::string& path, const Raster<std::u
       }
     if (best_c < 0)
       throw bad_input(path + ": " + name + ": lies on water, nodata or unbuildable land with no free buildable cell within two cells; move it or leave it out");
-    if (best_d > 0) ++out.moved, out.moved_names.push_back(name);
+    if (best_d > 0) out.moved.push_back(name);
     taken[buildable.index(best_c, best_r)] = 1;
     sites::Site s;
     s.col = best_c, s.row = best_r;
@@ -174,11 +173,11 @@ std::vector<std::string> existing_place_warnings(const ExistingPlaces& places) {
   };
   const auto count = [](std::size_t n) { return std::to_string(n) + (n == 1 ? " place " : " places "); };
   std::vector<std::string> out;
-  if (!places.outside_names.empty())
-    out.push_back("sites.existing: " + count(places.outside_names.size()) + "outside the DEM left out: " + listed(places.outside_names));
-  if (!places.moved_names.empty())
-    out.push_back("sites.existing: " + count(places.moved_names.size()) + "on water or unbuildable land moved to the nearest free buildable cell: " +
-                  listed(places.moved_names));
+  if (!places.outside.empty())
+    out.push_back("sites.existing: " + count(places.outside.size()) + "outside the DEM left out: " + listed(places.outside));
+  if (!places.moved.empty())
+    out.push_back("sites.existing: " + count(places.moved.size()) + "on water or unbuildable land moved to the nearest free buildable cell: " +
+                  listed(places.moved));
   return out;
 }
 

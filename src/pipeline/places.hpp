@@ -25,8 +25,8 @@ std::vector<density::Place> read_places(const std::string& path, const Dem& dem,
 /// left out, places without people (population 0 or none) likewise.
 struct ExistingPlaces {
   std::vector<sites::Site> sites;  ///< largest first, existing = true, name set
-  int outside = 0, without_people = 0, moved = 0;
-  std::vector<std::string> outside_names, moved_names;  ///< the places left out off the DEM, moved to land
+  int without_people = 0;
+  std::vector<std::string> outside, moved;  ///< the names of the places left out off the DEM, moved to land
 };
 
 /// The run's and the command's warnings about a places file: those outside the DEM (left out) and

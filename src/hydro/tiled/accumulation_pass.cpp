@@ -107,7 +107,7 @@ void TiledRun::accumulate_tile(int t, const TileRect& r) {
   Raster<std::uint8_t> d8 = tile_codes(r);
   d8.nodata = kNoData;
   read_codes(codes_path(t), d8);
-  if (flat_tile_[std::size_t(t)]) direct_tile_flats(t, r, d8);
+  if (flat_cells_[std::size_t(t)] > 0) direct_tile_flats(t, r, d8);
   if (sinks_.d8) sinks_.d8(t, d8);
   write_codes(codes_path(t), d8);
   std::vector<std::int64_t> acc = own_units(d8, r);

@@ -48,7 +48,6 @@ std::vector<std::uint8_t> flats_reaching_halo(const Dem& near, const Raster<std:
 void TiledRun::direct_tiles() {
   ring_.resize(static_cast<std::size_t>(tiles_));
   pieces_.resize(static_cast<std::size_t>(tiles_));
-  flat_tile_.assign(static_cast<std::size_t>(tiles_), 0);
   flat_cells_.assign(static_cast<std::size_t>(tiles_), 0);
   std::exception_ptr failure = for_tiles("flow directions of tiles", [&](int t, const TileRect& r) { direct_tile(t, r); });
   exchange(
@@ -63,7 +62,6 @@ void TiledRun::direct_tiles() {
         pieces_[std::size_t(t)] = in.take<FlatPiece>();
         const std::vector<std::uint64_t> cells = in.take<std::uint64_t>();
         flat_cells_[std::size_t(t)] = cells.empty() ? 0 : cells[0];
-        flat_tile_[std::size_t(t)] = flat_cells_[std::size_t(t)] > 0;
       });
 }
 

@@ -326,10 +326,7 @@ void TiledRun::share_tile_flats(int t, const TileRect& r, const Dem& near, const
   const TileFlats flats(r, f);
   ring_[std::size_t(t)] = flats.ring();
   flat_cells_[std::size_t(t)] = flats.undrained_cells();
-  if (flat_cells_[std::size_t(t)] > 0) {
-    flat_tile_[std::size_t(t)] = 1;
-    write_flat_cells(flats_path(t), f);
-  }
+  if (flat_cells_[std::size_t(t)] > 0) write_flat_cells(flats_path(t), f);
   pieces_[std::size_t(t)] = std::move(f.pieces);
 }
 
@@ -379,7 +376,8 @@ void TiledRun::join_pieces() {
 void TiledRun::solve_shared_flats() {
   join_pieces();
   fresh_ring_.assign(static_cast<std::size_t>(tiles_), {});
-  std::vector<std::uint8_t> solving = flat_tile_;
+  std::vector<std::uint8_t> solving(flat_cells_.size());
+  for (std::size_t t = 0; t < solving.size(); ++t) solving[t] = flat_cells_[t] > 0;
   double ring_bytes = 0;
   for (const auto& ring : ring_) ring_bytes += double(ring.size()) * sizeof(RingCell);
   do {
@@ -437,7 +435,7 @@ bool TiledRun::flat_round(std::vector<std::uint8_t>& solving) {
       const int ni = i + dcol[k], nj = j + drow[k];
       if (ni >= 0 && nj >= 0 && ni < grid_.across() && nj < grid_.down()) next_to_change |= changed[std::size_t(nj * grid_.across() + ni)] != 0;
     }
-    solving[std::size_t(t)] = flat_tile_[std::size_t(t)] && next_to_change;
+    solving[std::size_t(t)] = flat_cells_[std::size_t(t)] > 0 && next_to_change;
     any |= solving[std::size_t(t)] != 0;
   }
   return any;

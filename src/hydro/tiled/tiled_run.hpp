@@ -281,8 +281,7 @@ class TiledRun {
   // Pass 2 and the shared flats: each tile's outer ring and pieces of them, the global flats.
   std::vector<std::vector<RingCell>> ring_, fresh_ring_;  // by tile, Ring order; empty: no shared flat
   std::vector<std::vector<FlatPiece>> pieces_;
-  std::vector<std::uint8_t> flat_tile_;   // the tile holds undrained cells of a shared flat (a scratch file)
-  std::vector<std::uint64_t> flat_cells_;  // by tile: those cells
+  std::vector<std::uint64_t> flat_cells_;  // by tile: undrained cells of shared flats (> 0: a scratch file)
   std::vector<std::uint32_t> piece_base_;  // global piece = base + piece in its tile
   std::vector<std::uint32_t> flat_of_;     // global piece -> its flat (the smallest global piece of it)
   std::vector<std::int32_t> flat_height_;  // by flat: Barnes 2014b's flat height; -1: no low edge, undrainable
