@@ -325,8 +325,8 @@ void sites_run(RunState& s, Progress& progress, const Log& log) {
     summary["quotas"] = "belhadj2007";
   }
   if (!existing_file.empty()) {
-    summary["existing"] = {{"places", existing.sites.size()}, {"people", r.existing_population}, {"moved_to_land", existing.moved},
-                           {"outside_dem", existing.outside}, {"without_people", existing.without_people},
+    summary["existing"] = {{"places", existing.sites.size()}, {"people", r.existing_population}, {"moved_to_land", existing.moved.size()},
+                           {"outside_dem", existing.outside.size()}, {"without_people", existing.without_people},
                            {"generated", r.sites.size() - existing.sites.size()},
                            {"generated_people", population - std::llround(r.existing_population) - r.growth_to_existing}};
   }
@@ -520,16 +520,6 @@ json existing_figures(const roads::ExistingRoads& e, const roads::NetworkResult&
           {"on_existing_km", round_to(on_km, 0.01)}};
 }
 
-/// Land the roads serve, km²: cells with data that are not water (the sea, the inland water).
-double land_km2(const roads::TerrainField& terrain, const Dem& dem) {
-  const CellMetrics metrics = cell_metrics(dem.georef(), dem.cols(), dem.rows());
-  double m2 = 0;
-  for (int r = 0; r < dem.rows(); ++r)
-    for (int c = 0; c < dem.cols(); ++c)
-      if (!std::isnan(dem(c, r)) && !terrain.water(c, r)) m2 += metrics.area_m2[std::size_t(r)];
-  return m2 * 1e-6;
-}
-
 void roads_run(RunState& s, Progress& progress, const Log& log) {
   const RoadsSettings& settings = s.settings.roads;
   roads::TerrainField terrain = road_terrain(s);
@@ -564,7 +554,7 @@ void roads_run(RunState& s, Progress& progress, const Log& log) {
     water_m += road.stats.water_m;
   }
   for (const auto& section : r.layout.sections) network_km += section.length_m / 1000;
-  const double land = land_km2(terrain, s.dem);
+  const double land = s.summary["density"]["land_area_km2"].get<double>();  // the land the density stage measured, as sites reads it
   json per_class = json::object();
   for (const roads::RoadClassStyle& c : roads::kRoadClasses) per_class[std::string(c.name)] = round_to(km[std::string(c.name)], 0.01);
   s.summary["roads"] = {{"roads", r.roads.size()}, {"failed", r.failed.size()}, {"not_routed_budget", r.over_budget.size()},
