@@ -152,7 +152,7 @@ cells = n * per
 wall = end - start
 ranks = [list(map(float, open(f).read().split())) for f in sorted(glob.glob(f"{d}/time.*"))]
 cpu = [r[1] + r[2] for r in ranks]
-peak = [r[3] / 1024 for r in ranks]
+peak = [r[3] * 1024 / 1e6 for r in ranks]  # kB, as MB like --memory-limit
 print(f"  np {np_}: {cells:.3e} cells, wall {wall:.0f} s, CPU a rank {min(cpu):.0f}-{max(cpu):.0f} s, "
       f"{cells / np_ / wall / 1e6:.2f} M cells/s a rank (wall), {cells / sum(cpu) / 1e6:.2f} M cells/CPU s, "
       f"peak {min(peak):.0f}-{max(peak):.0f} MB a rank, written {written / 1e9:.2f} GB ({written / cells:.2f} B a cell)")

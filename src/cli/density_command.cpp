@@ -189,6 +189,7 @@ class DensityCommand final : public Command {
       throw bad_input("density on tiles: the hydrometry is not computed on tiles yet; give --hydrometry FILE (a raster or VRT in [0,1]), "
                       "or a hydrometry weight of 0 (--weights C,0,P,L) and no --river-bed-cap");
     context.log.detail("density tiles: the lakes the DEM flattens need the whole grid; on tiles only --water-mask is inland water (docs/scale.md)");
+    const double reserved_mb = reserve_reader_memory(tiles.limit_mb());
     const DemWindowReader reader(dem_.path, dem_.options());
     const RasterHeader& h = reader.header();
     const std::string water_mask = scenario.path("/water/water_mask");
@@ -213,7 +214,7 @@ class DensityCommand final : public Command {
         [&](int t, int across, const density::DensityResult& tile) {
           write_rasters(tile, options, terms(scenario), [&](const std::string& n) { return tile_file(dir.string(), n, t, across); });
         },
-        context.progress);
+        context.progress, reserved_mb);
     for (const char* l : layers)
       if (hydrometry || std::string(l) != "hydrometry") {
         std::vector<std::string> files;
@@ -221,12 +222,12 @@ class DensityCommand final : public Command {
         write_vrt((dir / (std::string(l) + ".vrt")).string(), files, false);
       }
     outputs.commit();
-    char line[300];
+    char line[360];
     std::snprintf(line, sizeof line,
-                  "density tiles: %d of %d cells a side, halo %d x %d cells (r_max + r_min); state %.1f MB a window + %.1f MB global; "
-                  "peak resident %.0f MB",
+                  "density tiles: %d of %d cells a side, halo %d x %d cells (r_max + r_min); state %.1f MB a window + %.1f MB global + "
+                  "%.0f MB reader and process; peak resident %.0f MB",
                   report.tiles, report.tile_size, report.halo_cols, report.halo_rows, report.window_bytes / 1e6,
-                  report.global_bytes / 1e6, peak_resident_mb());
+                  report.global_bytes / 1e6, reserved_mb, peak_resident_mb());
     context.log.detail(line);
     finish(context, report.stats);
   }

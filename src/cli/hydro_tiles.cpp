@@ -21,6 +21,7 @@ namespace fs = std::filesystem;
 TileDistribution* distribution = nullptr;
 
 std::string tiles_of_this_process(const TiledHydroRequest& q, Context& context, hydro::tiled::TileDriver& driver) {
+  const double reserved_mb = reserve_reader_memory(q.memory_limit_mb);
   const DemWindowReader reader(q.dem_path, q.read);
   const RasterHeader& h = reader.header();
   const fs::path out(q.out_dir);  // a fresh staging folder (OutputSet, rank 0's): no earlier tiles in it
@@ -35,6 +36,7 @@ std::string tiles_of_this_process(const TiledHydroRequest& q, Context& context, 
                            {"basins", q.basins, &q.basins_file}};
   hydro::tiled::TiledOptions o;
   o.memory_limit_mb = q.memory_limit_mb;
+  o.reserved_mb = reserved_mb;
   o.sea_level = q.sea_level;
   o.unit = q.unit;
   o.streams_threshold_m2 = q.streams_threshold_km2 * 1e6;
@@ -54,7 +56,7 @@ std::string tiles_of_this_process(const TiledHydroRequest& q, Context& context, 
     }
   } remove_scratch{scratch};
   o.scratch_dir = scratch.string();
-  o.tile_size = q.tile_size > 0 ? q.tile_size : hydro::tiled::tile_size_for(h.cols, h.rows, q.memory_limit_mb, threads);
+  o.tile_size = q.tile_size > 0 ? q.tile_size : hydro::tiled::tile_size_for(h.cols, h.rows, o.memory_limit_mb, threads, reserved_mb);
   const hydro::tiled::TileGrid grid(h.cols, h.rows, o.tile_size);
   auto tile_path = [&](const Layer& l, int t) { return tile_file(out.string(), l.name, t, grid.across()); };
   hydro::tiled::TileSinks sinks;
@@ -89,14 +91,16 @@ std::string tiles_of_this_process(const TiledHydroRequest& q, Context& context, 
       for (int t = 0; t < grid.count(); ++t) tiles.push_back(tile_path(l, t));
       write_vrt((out / (l.name + ".vrt")).string(), tiles, false);
     }
-  char line[440];
+  char line[560];
   std::snprintf(line, sizeof line,
                 "tiles: %d of %d cells a side, %d at once; %llu spill labels, %llu edges; %llu cells of flats across tiles (%llu rounds); "
-                "%llu links; %llu stream cells; state %.1f MB a tile + %.1f MB global; peak resident %.0f MB; %d process%s",
+                "%llu links; %llu stream cells; state %.1f MB a tile + %.1f MB global + %.0f MB reader and process; peak resident %.0f MB; %d process%s; "
+                "exchanged %.1f MB sent, %.1f MB received",
                 report.tiles, report.tile_size, report.concurrent_tiles, (unsigned long long)report.labels,
                 (unsigned long long)report.spill_edges, (unsigned long long)report.flat_cells_shared, (unsigned long long)report.flat_rounds,
                 (unsigned long long)report.links, (unsigned long long)report.stream_cells, report.tile_state_bytes / 1e6, report.global_state_bytes / 1e6,
-                peak_resident_mb(), driver.ranks(), driver.ranks() == 1 ? "" : "es");
+                reserved_mb, peak_resident_mb(), driver.ranks(), driver.ranks() == 1 ? "" : "es", double(report.bytes_sent) / 1e6,
+                double(report.bytes_received) / 1e6);
   context.log.detail(line);
   return "hydro: wrote " + q.out_name + " (" + std::to_string(report.tiles) + " tiles" +
          (q.streams ? ", " + std::to_string(reaches) + " stream reaches)" : ")");
@@ -108,7 +112,7 @@ double peak_resident_mb() {
   std::ifstream status("/proc/self/status");
   std::string line;
   while (std::getline(status, line))
-    if (line.rfind("VmHWM:", 0) == 0) return std::stod(line.substr(6)) / 1024.0;
+    if (line.rfind("VmHWM:", 0) == 0) return std::stod(line.substr(6)) * 1024 / 1e6;  // kB, as MB like the limits
   return 0;
 }
 

@@ -65,19 +65,19 @@ double plan_bytes(const DiscPlan& plan, int rows) {
 
 }  // namespace
 
-int density_tile_size_for(int cols, int rows, int halo_rows, int halo_cols, double global_bytes, double memory_limit_mb) {
-  const double limit = memory_limit_mb * 1e6 - global_bytes;
+int density_tile_size_for(int cols, int rows, int halo_rows, int halo_cols, double global_bytes, double memory_limit_mb, double reserved_mb) {
+  const double limit = (memory_limit_mb - reserved_mb) * 1e6 - global_bytes;
   for (int side = 1 << 15; side >= 64; side = side * 7 / 8) {
     const double window = kDensityBytesPerCell * double(std::min(side, rows) + 2 * halo_rows) * double(std::min(side, cols) + 2 * halo_cols);
     if (window <= limit) return side;
   }
-  throw bad_input("/input/memory_limit_mb: " + std::to_string(int(memory_limit_mb)) + " MB is too little for density tiles of 64 x 64 cells with a halo of " +
+  throw bad_input("/input/memory_limit_mb: " + std::to_string(int(memory_limit_mb)) + " MB" + (reserved_mb > 0 ? " (" + std::to_string(int(std::ceil(reserved_mb))) + " MB of it held by the process and the mosaic's reader)" : std::string()) + " is too little for density tiles of 64 x 64 cells with a halo of " +
                   std::to_string(halo_cols) + " x " + std::to_string(halo_rows) + " cells (r_max)");
 }
 
 TiledDensityReport run_tiled_density(int cols, int rows, const Georef& georef, const ReadWindowInputs& read,
                                      const DensityOptions& options, int tile_size, double memory_limit_mb,
-                                     const WriteDensityTile& write, Progress& progress) {
+                                     const WriteDensityTile& write, Progress& progress, double reserved_mb) {
   TiledDensityReport report;
   const CellMetrics metrics = cell_metrics(georef, cols, rows);
   const double r_min = raised_r_min(metrics, options);
@@ -92,7 +92,7 @@ TiledDensityReport run_tiled_density(int cols, int rows, const Georef& georef, c
   };
   const std::array<int, 2> widest = {outer.reach_rows() + inner.reach_rows(), outer.reach_cols() + inner.reach_cols()};
   report.tile_size = tile_size > 0 ? std::max(tile_size, 8)
-                                   : density_tile_size_for(cols, rows, widest[0], widest[1], report.global_bytes, memory_limit_mb);
+                                   : density_tile_size_for(cols, rows, widest[0], widest[1], report.global_bytes, memory_limit_mb, reserved_mb);
   const TileGrid grid(cols, rows, report.tile_size);
   report.tiles = grid.count();
   report.across = grid.across();

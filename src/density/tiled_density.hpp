@@ -70,14 +70,15 @@ inline constexpr double kDensityBytesPerCell = 64;
 
 /// The largest tile side (at least 64) whose window fits `memory_limit_mb` with the global state;
 /// throws bad_input when none does.
-int density_tile_size_for(int cols, int rows, int halo_rows, int halo_cols, double global_bytes, double memory_limit_mb);
+int density_tile_size_for(int cols, int rows, int halo_rows, int halo_cols, double global_bytes, double memory_limit_mb,
+                          double reserved_mb = 0);
 
 /// compute_density of a cols x rows mosaic georeferenced by `georef`, tile by tile on tiles of
-/// `tile_size` (0: from `memory_limit_mb`), one tile at a time (each computed in parallel):
+/// `tile_size` (0: from `memory_limit_mb` less `reserved_mb`), one tile at a time (each computed in parallel):
 /// three reads of each tile (altitude range, coast and plateau maxima, then the tile), two
 /// computations. `options` carries no raster (read gives each window's).
 TiledDensityReport run_tiled_density(int cols, int rows, const Georef& georef, const ReadWindowInputs& read,
                                      const DensityOptions& options, int tile_size, double memory_limit_mb,
-                                     const WriteDensityTile& write, Progress& progress);
+                                     const WriteDensityTile& write, Progress& progress, double reserved_mb = 0);
 
 }  // namespace terrapolis::density

@@ -14,10 +14,13 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <memory>
 #include <mutex>
+#include <string>
 #include <unistd.h>
 
 #include "core/error.hpp"
@@ -246,6 +249,48 @@ std::size_t to_metres(const std::string& path, GDALRasterBand* band, const Raste
   return valid;
 }
 
+/// The DEM at `path`: a raster GDAL reads (a GeoTIFF, a VRT mosaic, ...) or a folder of GeoTIFF
+/// tiles, joined into an in-memory VRT (tiles of one grid and CRS; where they overlap, the last in
+/// name order wins).
+DatasetPtr open_dem_source(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::is_directory(path, ec)) return open_raster(path);
+  std::vector<std::string> tiles;
+  for (const auto& entry : fs::directory_iterator(path, ec)) {
+    std::string ext = entry.path().extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+    if (entry.is_regular_file() && (ext == ".tif" || ext == ".tiff")) tiles.push_back(entry.path().string());
+  }
+  if (tiles.empty()) throw bad_input(path + ": folder holds no GeoTIFF tile (.tif)");
+  std::sort(tiles.begin(), tiles.end());  // a fixed order: where tiles overlap, the last one wins
+  // A VRT would leave out tiles of another CRS and resample those of another resolution: refuse them.
+  std::array<double, 6> first{};
+  OGRSpatialReference first_srs;
+  for (std::size_t i = 0; i < tiles.size(); ++i) {
+    auto tile = open_raster(tiles[i]);
+    std::array<double, 6> gt{};
+    if (tile->GetGeoTransform(gt.data()) != CE_None) throw bad_input(tiles[i] + ": has no geotransform (not georeferenced)");
+    const OGRSpatialReference* srs = tile->GetSpatialRef();
+    if (i == 0) {
+      first = gt;
+      if (srs) first_srs = *srs;
+    } else if (gt[1] != first[1] || gt[5] != first[5] || gt[2] != first[2] || gt[4] != first[4]) {
+      throw bad_input(tiles[i] + ": cell size differs from " + tiles[0] + "'s; the tiles of a mosaic share one grid");
+    } else if ((srs == nullptr) != first_srs.IsEmpty() || (srs && !srs->IsSame(&first_srs))) {
+      throw bad_input(tiles[i] + ": CRS differs from " + tiles[0] + "'s; the tiles of a mosaic share one CRS");
+    }
+  }
+  std::vector<const char*> names;
+  for (const auto& t : tiles) names.push_back(t.c_str());
+  init_gdal();
+  QuietGdal quiet;
+  int usage_error = 0;
+  GDALDatasetH vrt = GDALBuildVRT("", int(names.size()), nullptr, names.data(), nullptr, &usage_error);
+  if (!vrt) throw bad_input(path + ": cannot join its tiles (" + detail::last_gdal_error("unknown error") + ")");
+  return DatasetPtr(GDALDataset::FromHandle(vrt));
+}
+
 }  // namespace
 
 void check_grid_georeferencing(const std::string& what, const RasterHeader& header) {
@@ -264,6 +309,22 @@ void init_gdal() {
   });
 }
 
+double reserve_reader_memory(double limit_mb) {
+  init_gdal();
+  double cache_mb = std::min(64.0, limit_mb / 8);
+  if (!CPLGetConfigOption("GDAL_CACHEMAX", nullptr)) GDALSetCacheMax64(GIntBig(cache_mb * 1e6));
+  else cache_mb = double(GDALGetCacheMax64()) / 1e6;
+  constexpr int kPool = 16;  // GDAL's default is 100 open files, each with its own buffers
+  int pool = kPool;
+  if (const char* user = CPLGetConfigOption("GDAL_MAX_DATASET_POOL_SIZE", nullptr)) pool = std::max(2, std::atoi(user));
+  else CPLSetConfigOption("GDAL_MAX_DATASET_POOL_SIZE", std::to_string(kPool).c_str());
+  double resident_mb = 0;
+  std::ifstream status("/proc/self/status");
+  for (std::string line; std::getline(status, line);)
+    if (line.rfind("VmRSS:", 0) == 0) resident_mb = std::stod(line.substr(6)) * 1024 / 1e6;  // kB
+  return cache_mb + 0.8 * pool + resident_mb;
+}
+
 ReadOptions read_options(int band, const std::string& assume_crs) {
   ReadOptions o;
   if (band > 0) o.band = band;
@@ -272,14 +333,14 @@ ReadOptions read_options(int band, const std::string& assume_crs) {
 }
 
 RasterHeader read_header(const std::string& path, const ReadOptions& options) {
-  auto ds = open_raster(path);
+  auto ds = open_dem_source(path);
   GDALRasterBand* band = nullptr;
   double vfactor = 1.0;
   return header_of(path, *ds, options, band, vfactor);
 }
 
 Dem read_dem(const std::string& path, const ReadOptions& options) {
-  auto ds = open_raster(path);
+  auto ds = open_dem_source(path);
   GDALRasterBand* band = nullptr;
   double vfactor = 1.0;
   const RasterHeader h = header_of(path, *ds, options, band, vfactor);
@@ -440,45 +501,7 @@ struct DemWindowReader::Dataset {
 DemWindowReader::DemWindowReader(const std::string& path, ReadOptions options)
     : path_(path), dataset_(std::make_unique<Dataset>()) {
   options.windowed = true;
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  if (fs::is_directory(path, ec)) {
-    std::vector<std::string> tiles;
-    for (const auto& entry : fs::directory_iterator(path, ec)) {
-      std::string ext = entry.path().extension().string();
-      std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-      if (entry.is_regular_file() && (ext == ".tif" || ext == ".tiff")) tiles.push_back(entry.path().string());
-    }
-    if (tiles.empty()) throw bad_input(path + ": folder holds no GeoTIFF tile (.tif)");
-    std::sort(tiles.begin(), tiles.end());  // a fixed order: where tiles overlap, the last one wins
-    // A VRT would leave out tiles of another CRS and resample those of another resolution: refuse them.
-    std::array<double, 6> first{};
-    OGRSpatialReference first_srs;
-    for (std::size_t i = 0; i < tiles.size(); ++i) {
-      auto tile = open_raster(tiles[i]);
-      std::array<double, 6> gt{};
-      if (tile->GetGeoTransform(gt.data()) != CE_None) throw bad_input(tiles[i] + ": has no geotransform (not georeferenced)");
-      const OGRSpatialReference* srs = tile->GetSpatialRef();
-      if (i == 0) {
-        first = gt;
-        if (srs) first_srs = *srs;
-      } else if (gt[1] != first[1] || gt[5] != first[5] || gt[2] != first[2] || gt[4] != first[4]) {
-        throw bad_input(tiles[i] + ": cell size differs from " + tiles[0] + "'s; the tiles of a mosaic share one grid");
-      } else if ((srs == nullptr) != first_srs.IsEmpty() || (srs && !srs->IsSame(&first_srs))) {
-        throw bad_input(tiles[i] + ": CRS differs from " + tiles[0] + "'s; the tiles of a mosaic share one CRS");
-      }
-    }
-    std::vector<const char*> names;
-    for (const auto& t : tiles) names.push_back(t.c_str());
-    init_gdal();
-    QuietGdal quiet;
-    int usage_error = 0;
-    GDALDatasetH vrt = GDALBuildVRT("", int(names.size()), nullptr, names.data(), nullptr, &usage_error);
-    if (!vrt) throw bad_input(path + ": cannot join its tiles (" + detail::last_gdal_error("unknown error") + ")");
-    dataset_->dataset.reset(GDALDataset::FromHandle(vrt));
-  } else {
-    dataset_->dataset = open_raster(path);
-  }
+  dataset_->dataset = open_dem_source(path);
   header_ = header_of(path, *dataset_->dataset, options, dataset_->band, dataset_->vfactor);
 }
 

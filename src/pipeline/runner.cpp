@@ -184,7 +184,7 @@ json run_scenario(const Scenario& scenario, const RunOptions& options, Progress&
   // A rerun replaces its own run folder; the new run is built beside it and swapped in at the end.
   OutputSet run_folder("run", scenario_inputs(scenario), options.overwrite || rerun);
   const fs::path temp = run_folder.folder(output.string(), rerun);
-  const std::string dem_sha256 = file_sha256(dem_path);
+  const std::string dem_sha256 = input_sha256(dem_path);
   plugin::PluginSet plugins = plugin::load_plugins(nlohmann::json::parse(scenario.resolved["plugins"].dump()), log,
                                                    scenario.base_dir.string());
   const json files = input_files(scenario);
@@ -221,7 +221,7 @@ json run_scenario(const Scenario& scenario, const RunOptions& options, Progress&
     manifest["terrapolis"] = terrapolis::version;
     manifest["scenario"] = scenario.resolved;
     manifest["scenario_source"] = scenario.source;
-    manifest["input"] = {{"dem", dem_path}, {"sha256", state.dem_sha256}, {"bytes", fs::file_size(dem_path)},
+    manifest["input"] = {{"dem", dem_path}, {"sha256", state.dem_sha256}, {"bytes", input_bytes(dem_path)},
                          {"crs", state.dem.georef().crs.name},
                          {"epsg", state.dem.georef().crs.epsg ? json(*state.dem.georef().crs.epsg) : json(nullptr)}, {"files", files}};
     json libs = json::object();

@@ -99,8 +99,8 @@ void TiledRun::accumulate_tiles() {
         edge_exit_[std::size_t(t)] = in.take<std::int32_t>();
         outlet_rows_[std::size_t(t)] = in.take<std::uint32_t>();
       });
-  ring_ = {};
-  pieces_ = {};
+  release(ring_);
+  release(pieces_);
 }
 
 void TiledRun::accumulate_tile(int t, const TileRect& r) {

@@ -68,7 +68,7 @@ void TiledRun::direct_tiles() {
 void TiledRun::direct_tile(int t, const TileRect& r) {
   TileFill f = fill_tile(read_tile(r), options_.sea_level);
   for (std::size_t i = 0; i < f.z.size(); ++i) f.z[i] = final_z(f.z[i], global(t, f.label[i]));
-  f.label = {};
+  release(f.label);
   f.z.georef() = shifted(georef_, r.col0, r.row0);
   if (sinks_.filled) sinks_.filled(t, f.z);
   Dem wide = with_halo(r, f.z);

@@ -46,6 +46,7 @@ TileFill fill_tile(const Dem& window, const std::optional<double>& sea_level) {
     if (f.edges.size() > (std::size_t(1) << 20)) keep_lowest_edges(f.edges);
   }
   keep_lowest_edges(f.edges);
+  f.edges.shrink_to_fit();  // kept until the spill graph is solved: the lowest edges only, not the 2^20 before
   return f;
 }
 
@@ -98,7 +99,7 @@ void TiledRun::solve_spill_graph() {
   std::vector<SpillEdge> edges;
   for (int t = 0; t < tiles_; ++t) {
     for (SpillEdge e : tile_edges_[std::size_t(t)]) edges.push_back({global(t, e.a), global(t, e.b), e.spill});
-    tile_edges_[std::size_t(t)] = {};
+    release(tile_edges_[std::size_t(t)]);
     for (auto& l : frames_[std::size_t(t)].label) l = global(t, l);
   }
   add_edges_across_tiles(edges);

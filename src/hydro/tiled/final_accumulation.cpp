@@ -46,7 +46,7 @@ void TiledRun::finish_tile(int t, const TileRect& r) {
   if (!sinks_.accumulation && !sinks_.streams) return;
   std::vector<std::int64_t> acc = own_units(d8, r);
   for (const auto& [i, v] : inflow_[std::size_t(t)]) acc[i] += v;
-  inflow_[std::size_t(t)] = {};
+  release(inflow_[std::size_t(t)]);
   accumulate_d8_units(d8, acc);
   Raster<double> out = d8.like<double>(0.0);
   for (std::size_t i = 0; i < out.size(); ++i) out[i] = d8[i] == kNoData ? NAN : units_.value(acc[i]);
@@ -64,7 +64,7 @@ void TiledRun::gather_streams() {
   std::vector<StreamCell> network;
   for (auto& part : stream_cells_) {
     network.insert(network.end(), part.begin(), part.end());
-    part = {};
+    release(part);
   }
   std::sort(network.begin(), network.end(), [](const StreamCell& a, const StreamCell& b) { return a.index < b.index; });
   StreamCells streams{cols_, rows_, {}, {}, {}};
@@ -75,7 +75,7 @@ void TiledRun::gather_streams() {
   }
   report_.stream_cells = network.size();
   report_.global_state_bytes = std::max(report_.global_state_bytes, frame_bytes_ + double(network.size()) * 40);
-  network = {};
+  release(network);
   sinks_.streams(streams);
 }
 

@@ -36,7 +36,7 @@ void TiledRun::solve_link_graph() {
   all.reserve(link_count);
   for (auto& l : links_) {
     all.insert(all.end(), l.begin(), l.end());
-    l = {};
+    release(l);
   }
   std::vector<std::int64_t> next(link_count, -1);
   std::vector<std::uint32_t> indegree(link_count, 0);
@@ -50,7 +50,7 @@ void TiledRun::solve_link_graph() {
   }
   number_outlets();
   if (sinks_.basins) label_links(all, next);
-  edge_exit_ = {};
+  release(edge_exit_);
   std::vector<std::int64_t> total(link_count);
   for (std::uint32_t y = 0; y < link_count; ++y) total[y] = all[y].local;
   std::vector<std::uint32_t> ready;

@@ -383,7 +383,7 @@ void TiledRun::solve_shared_flats() {
   do {
     ++report_.flat_rounds;
   } while (flat_round(solving));
-  fresh_ring_ = {};
+  release(fresh_ring_);
   const std::size_t n = flat_of_.size();
   std::vector<std::uint8_t> undrained(n, 0), draining(n, 0);
   flat_height_.assign(n, 0);
@@ -425,7 +425,7 @@ bool TiledRun::flat_round(std::vector<std::uint8_t>& solving) {
     if (!solving[std::size_t(t)]) continue;
     changed[std::size_t(t)] = fresh_ring_[std::size_t(t)] != ring_[std::size_t(t)];
     ring_[std::size_t(t)].swap(fresh_ring_[std::size_t(t)]);
-    fresh_ring_[std::size_t(t)] = {};
+    release(fresh_ring_[std::size_t(t)]);
   }
   bool any = false;
   for (int t = 0; t < tiles_; ++t) {

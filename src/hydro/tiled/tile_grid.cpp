@@ -54,15 +54,15 @@ int allowed_threads() {
   return int(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
 }
 
-int tile_size_for(int cols, int rows, double memory_limit_mb, int concurrent) {
-  const double limit = memory_limit_mb * 1e6;
+int tile_size_for(int cols, int rows, double memory_limit_mb, int concurrent, double reserved_mb) {
+  const double limit = (memory_limit_mb - reserved_mb) * 1e6;
   for (int side = 1 << 15; side >= 64; side = side * 7 / 8) {
     const TileGrid grid(cols, rows, side);
     const double tile = kTileBytesPerCell * double(side + 4) * double(side + 4) * concurrent;
     const double global = kGlobalBytesPerTileSide * double(grid.count()) * double(side) + 40.0 * rows;
     if (tile + global <= limit) return side;
   }
-  throw bad_input("/input/memory_limit_mb: " + std::to_string(int(memory_limit_mb)) + " MB is too little for tiles of 64 x 64 cells on a " +
+  throw bad_input("/input/memory_limit_mb: " + std::to_string(int(memory_limit_mb)) + " MB" + (reserved_mb > 0 ? " (" + std::to_string(int(std::ceil(reserved_mb))) + " MB of it held by the process and the mosaic's reader)" : std::string()) + " is too little for tiles of 64 x 64 cells on a " +
                   std::to_string(cols) + " x " + std::to_string(rows) + " mosaic");
 }
 

@@ -94,8 +94,10 @@ struct TileSinks {
 struct TiledOptions {
   /// Tile side in cells; 0: the largest that keeps the state within memory_limit_mb.
   int tile_size = 0;
-  /// Memory for the engine's state (tiles being processed, the global graphs), MB.
+  /// Memory for the process, MB: the engine's state (tiles being processed, the global graphs) gets
+  /// all of it but reserved_mb, what the process and the mosaic's reader hold (reserve_reader_memory).
   double memory_limit_mb = 1024;
+  double reserved_mb = 0;
   /// Tiles processed at once by this process (each holds its state): 0 = as many as threads allowed.
   int concurrent_tiles = 0;
   std::optional<double> sea_level;
@@ -116,6 +118,7 @@ struct TiledReport {
   std::uint64_t stream_cells = 0;               ///< cells of the stream network gathered (rank 0)
   double tile_state_bytes = 0;                  ///< per tile processed at once
   double global_state_bytes = 0;                ///< at the largest: frames plus the spill graph, shared flats or links
+  std::uint64_t bytes_sent = 0, bytes_received = 0;  ///< by this process in the exchanges between passes (0 on one process)
 };
 
 /// Bytes of state per cell of a tile processed at once (the largest pass: the fill's labels and
@@ -123,8 +126,9 @@ struct TiledReport {
 inline constexpr double kTileBytesPerCell = 48;
 
 /// The tile side that keeps `concurrent` tiles and the global state of a cols x rows mosaic
-/// within `memory_limit_mb`; throws bad_input when not even 64-cell tiles fit.
-int tile_size_for(int cols, int rows, double memory_limit_mb, int concurrent);
+/// within `memory_limit_mb` less `reserved_mb` (what the process and the mosaic's reader hold:
+/// reserve_reader_memory); throws bad_input when not even 64-cell tiles fit.
+int tile_size_for(int cols, int rows, double memory_limit_mb, int concurrent, double reserved_mb = 0);
 
 /// The threads this process may use (--threads, or what terrapolis-mpi leaves to each rank).
 int allowed_threads();

@@ -28,7 +28,7 @@ TiledReport sized_report(int cols, int rows, const TiledOptions& options) {
   TiledReport report;
   report.concurrent_tiles = options.concurrent_tiles > 0 ? options.concurrent_tiles : allowed_threads();
   report.tile_size = options.tile_size > 0 ? std::max(options.tile_size, 8)
-                                           : tile_size_for(cols, rows, options.memory_limit_mb, report.concurrent_tiles);
+                                           : tile_size_for(cols, rows, options.memory_limit_mb, report.concurrent_tiles, options.reserved_mb);
   report.tile_state_bytes = kTileBytesPerCell * double(report.tile_size + 4) * double(report.tile_size + 4);
   return report;
 }

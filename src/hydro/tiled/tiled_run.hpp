@@ -179,12 +179,14 @@ class TiledRun {
     std::vector<std::vector<char>> bytes(static_cast<std::size_t>(tiles_));
     if (!failure)
       for (int t : own_) pack(t, bytes[std::size_t(t)]);
+    for (int t : own_) report_.bytes_sent += bytes[std::size_t(t)].size();
     driver_.share(bytes, failure);
     for (int t = 0; t < tiles_; ++t)
       if (!driver_.owns(t)) {
+        report_.bytes_received += bytes[std::size_t(t)].size();
         Unpack in(bytes[std::size_t(t)]);
         unpack(t, in);
-        bytes[std::size_t(t)] = {};
+        release(bytes[std::size_t(t)]);
       }
   }
 
