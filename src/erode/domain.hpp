@@ -5,10 +5,13 @@
 #include <tbb/parallel_for.h>
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <numeric>
+#include <string>
 #include <vector>
 
+#include "core/error.hpp"
 #include "core/geodesy.hpp"
 #include "core/neighbours.hpp"
 #include "erode/erosion.hpp"
@@ -123,6 +126,16 @@ class GlobalErosion {
   std::vector<double> eta_;  ///< erosion value of each cell's top rock voxel, 1: intact
   int reach_c_ = 0, reach_r_ = 0;
 };
+
+/// A thickness raster of a layered ground (m per cell: the loose layer, the rock broken off), checked
+/// for the setting `pointer`: on the domain's grid, then each value used finite and >= 0.
+inline void check_grid(const char* pointer, const Raster<float>& thickness, const Domain& d) {
+  if (thickness.cols() != d.cols || thickness.rows() != d.rows) throw bad_input(std::string(pointer) + ": not on the DEM's grid");
+}
+inline double checked_thickness(const char* pointer, double t) {
+  if (!(t >= 0 && std::isfinite(t))) throw bad_input(std::string(pointer) + ": thickness " + std::to_string(t) + " m is not a finite value >= 0");
+  return t;
+}
 
 /// Local erosion (Peytavie 2010 §2.3.3): breaks `rockfall_m` (m per cell, on the grid) of rock off
 /// into loose material inside the domain; returns the volume, m³. Throws bad_input on a value that is

@@ -54,13 +54,9 @@ Domain make_domain(const Dem& dem, const CellMetrics& metrics, const Raster<std:
 void add_loose_layer(Domain& d, const Raster<float>* loose_m) {
   d.loose.assign(d.height.size(), 0.0);
   if (!loose_m) return;
-  if (loose_m->cols() != d.cols || loose_m->rows() != d.rows) throw bad_input("/erode/loose: not on the DEM's grid");
-  for (std::size_t i = 0; i < d.loose.size(); ++i) {
-    const double t = (*loose_m)[i];
-    if (std::isnan(d.height[i]) || std::isnan(t)) continue;
-    if (!(t >= 0 && std::isfinite(t))) throw bad_input("/erode/loose: thickness " + std::to_string(t) + " m is not a finite value >= 0");
-    d.loose[i] = t;
-  }
+  check_grid("/erode/loose", *loose_m, d);
+  for (std::size_t i = 0; i < d.loose.size(); ++i)
+    if (!std::isnan(d.height[i]) && !std::isnan((*loose_m)[i])) d.loose[i] = checked_thickness("/erode/loose", (*loose_m)[i]);
 }
 
 /// The processes of one run over a domain, each present when the options ask for it.

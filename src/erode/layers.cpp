@@ -102,15 +102,14 @@ double GlobalErosion::step() {
 }
 
 double break_off(Domain& domain, const Raster<float>& rockfall_m) {
-  if (rockfall_m.cols() != domain.cols || rockfall_m.rows() != domain.rows) throw bad_input("/erode/rockfall: not on the DEM's grid");
+  check_grid("/erode/rockfall", rockfall_m, domain);
   double volume = 0;
   for (int r = 0; r < domain.rows; ++r) {
     double row = 0;
     for (int c = 0; c < domain.cols; ++c) {
       const std::size_t i = domain.index(c, r);
-      const double t = rockfall_m[i];
-      if (!domain.in[i] || std::isnan(t)) continue;
-      if (!(t >= 0 && std::isfinite(t))) throw bad_input("/erode/rockfall: thickness " + std::to_string(t) + " m is not a finite value >= 0");
+      if (!domain.in[i] || std::isnan(rockfall_m[i])) continue;
+      const double t = checked_thickness("/erode/rockfall", rockfall_m[i]);
       domain.loose[i] += t;  // the rock in the tool's region R turned into loose material, in place
       row += t;
     }
