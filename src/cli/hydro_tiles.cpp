@@ -95,7 +95,7 @@ std::string tiles_of_this_process(const TiledHydroRequest& q, Context& context, 
   std::snprintf(line, sizeof line,
                 "tiles: %d of %d cells a side, %d at once; %llu spill labels, %llu edges; %llu cells of flats across tiles (%llu rounds); "
                 "%llu links; %llu stream cells; state %.1f MB a tile + %.1f MB global + %.0f MB reader and process; peak resident %.0f MB; %d process%s; "
-                "exchanged %.1f MB sent, %.1f MB received",
+                "exchanged %.2f MB sent, %.2f MB received",
                 report.tiles, report.tile_size, report.concurrent_tiles, (unsigned long long)report.labels,
                 (unsigned long long)report.spill_edges, (unsigned long long)report.flat_cells_shared, (unsigned long long)report.flat_rounds,
                 (unsigned long long)report.links, (unsigned long long)report.stream_cells, report.tile_state_bytes / 1e6, report.global_state_bytes / 1e6,

@@ -58,6 +58,10 @@ for np in 1 2 4; do
     fail "np $np: $(cat "$work/np$np.log")"
   cmp -s "$work/whole/streams.geojson" "$work/np$np/streams.geojson" || fail "np $np: streams differ from the whole grid"
   grep -q "^tiles: 9 of 100.*; $np process" "$work/np$np.log" || fail "np $np: no tile report: $(cat "$work/np$np.log")"
+  # Bytes exchanged between passes: none on one rank, both ways on more.
+  read -r sent received < <(sed -n 's/^tiles: .*exchanged \([0-9.]*\) MB sent, \([0-9.]*\) MB received$/\1 \2/p' "$work/np$np.log")
+  awk -v np="$np" -v s="$sent" -v r="$received" 'BEGIN { exit !(s != "" && (np == 1 ? s + r == 0 : s > 0 && r > 0)) }' ||
+    fail "np $np: bytes exchanged: $(grep '^tiles' "$work/np$np.log")"
   for o in "${outputs[@]}"; do
     same_cells "$work/whole/$o.tif" "$work/np$np/$o.vrt" || fail "np $np: $o differs from the whole grid"
     cmp -s "$work/tiled/$o/tile_0001_0001.tif" "$work/np$np/$o/tile_0001_0001.tif" || fail "np $np: $o tile files differ from the tiled run's"
