@@ -71,7 +71,7 @@ int density_tile_size_for(int cols, int rows, int halo_rows, int halo_cols, doub
     const double window = kDensityBytesPerCell * double(std::min(side, rows) + 2 * halo_rows) * double(std::min(side, cols) + 2 * halo_cols);
     if (window <= limit) return side;
   }
-  throw bad_input("/input/memory_limit_mb: " + std::to_string(int(memory_limit_mb)) + " MB" + (reserved_mb > 0 ? " (" + std::to_string(int(std::ceil(reserved_mb))) + " MB of it held by the process and the mosaic's reader)" : std::string()) + " is too little for density tiles of 64 x 64 cells with a halo of " +
+  throw bad_input(hydro::tiled::too_little(memory_limit_mb, reserved_mb) + " for density tiles of 64 x 64 cells with a halo of " +
                   std::to_string(halo_cols) + " x " + std::to_string(halo_rows) + " cells (r_max)");
 }
 

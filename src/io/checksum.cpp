@@ -8,8 +8,6 @@
 #include <proj.h>
 #include <tbb/version.h>
 
-#include <algorithm>
-#include <cctype>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
@@ -17,6 +15,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "io/raster_io.hpp"
 
 namespace terrapolis {
 
@@ -56,20 +55,6 @@ class Sha256 {
   EVP_MD_CTX* ctx_;
 };
 
-/// The GeoTIFF tiles of a folder DEM, in name order (as the reader joins them).
-std::vector<std::filesystem::path> folder_tiles(const std::string& folder) {
-  std::vector<std::filesystem::path> tiles;
-  std::error_code ec;
-  for (const auto& entry : std::filesystem::directory_iterator(folder, ec)) {
-    std::string ext = entry.path().extension().string();
-    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
-    if (entry.is_regular_file() && (ext == ".tif" || ext == ".tiff")) tiles.push_back(entry.path());
-  }
-  if (ec) throw bad_input(folder + ": cannot be read (" + ec.message() + ")");
-  std::sort(tiles.begin(), tiles.end());
-  return tiles;
-}
-
 }  // namespace
 
 std::string file_sha256(const std::string& path) {
@@ -82,10 +67,10 @@ std::string input_sha256(const std::string& path) {
   std::error_code ec;
   if (!std::filesystem::is_directory(path, ec)) return file_sha256(path);
   Sha256 sha;
-  for (const auto& tile : folder_tiles(path)) {
-    const std::string name = tile.filename().string();
+  for (const std::string& tile : folder_tiles(path)) {
+    const std::string name = std::filesystem::path(tile).filename().string();
     sha.add(name.c_str(), name.size() + 1);  // the name and its end: renaming a tile changes the mosaic
-    sha.add_file(tile.string());
+    sha.add_file(tile);
   }
   return sha.hex();
 }
@@ -94,7 +79,7 @@ std::uintmax_t input_bytes(const std::string& path) {
   std::error_code ec;
   if (!std::filesystem::is_directory(path, ec)) return std::filesystem::file_size(path);
   std::uintmax_t bytes = 0;
-  for (const auto& tile : folder_tiles(path)) bytes += std::filesystem::file_size(tile);
+  for (const std::string& tile : folder_tiles(path)) bytes += std::filesystem::file_size(tile);
   return bytes;
 }
 

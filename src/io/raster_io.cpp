@@ -256,14 +256,8 @@ DatasetPtr open_dem_source(const std::string& path) {
   namespace fs = std::filesystem;
   std::error_code ec;
   if (!fs::is_directory(path, ec)) return open_raster(path);
-  std::vector<std::string> tiles;
-  for (const auto& entry : fs::directory_iterator(path, ec)) {
-    std::string ext = entry.path().extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-    if (entry.is_regular_file() && (ext == ".tif" || ext == ".tiff")) tiles.push_back(entry.path().string());
-  }
+  const std::vector<std::string> tiles = folder_tiles(path);
   if (tiles.empty()) throw bad_input(path + ": folder holds no GeoTIFF tile (.tif)");
-  std::sort(tiles.begin(), tiles.end());  // a fixed order: where tiles overlap, the last one wins
   // A VRT would leave out tiles of another CRS and resample those of another resolution: refuse them.
   std::array<double, 6> first{};
   OGRSpatialReference first_srs;
@@ -307,6 +301,19 @@ void init_gdal() {
     // failure is reported once, naming the input, from CPLGetLastErrorMsg (recorded before handlers run).
     CPLSetErrorHandler(CPLQuietErrorHandler);
   });
+}
+
+std::vector<std::string> folder_tiles(const std::string& folder) {
+  std::vector<std::string> tiles;
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(folder, ec)) {
+    std::string ext = entry.path().extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+    if (entry.is_regular_file() && (ext == ".tif" || ext == ".tiff")) tiles.push_back(entry.path().string());
+  }
+  if (ec) throw bad_input(folder + ": cannot be read (" + ec.message() + ")");
+  std::sort(tiles.begin(), tiles.end());  // a fixed order: where tiles overlap, the last one wins
+  return tiles;
 }
 
 double reserve_reader_memory(double limit_mb) {

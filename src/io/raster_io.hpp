@@ -74,6 +74,9 @@ void write_raster(const std::string& path, const Raster<T>& raster, const WriteO
 /// Reads windows of an elevation model too large to hold whole: a GeoTIFF (BigTIFF), a GDAL VRT
 /// mosaic, or a folder of GeoTIFF tiles (joined into an in-memory VRT, which refuses tiles of
 /// different CRSs or resolutions). Values as read_dem's: metres, NaN nodata.
+/// The GeoTIFF tiles (.tif, .tiff) of a folder DEM, in name order: the order they are joined in.
+std::vector<std::string> folder_tiles(const std::string& folder);
+
 /// Bounds what GDAL holds while a mosaic is read by windows under a memory limit: its block cache to
 /// min(64 MB, limit / 8) and its pool of open source files to 16 (about 0.8 MB each), unless the user
 /// set GDAL_CACHEMAX or GDAL_MAX_DATASET_POOL_SIZE. Returns the MB the tiles must leave free: those

@@ -3,6 +3,7 @@
 #include <tbb/global_control.h>
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 
 #include "core/error.hpp"
@@ -54,6 +55,12 @@ int allowed_threads() {
   return int(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
 }
 
+std::string too_little(double memory_limit_mb, double reserved_mb) {
+  std::string held;
+  if (reserved_mb > 0) held = " (" + std::to_string(int(std::ceil(reserved_mb))) + " MB of it held by the process and the mosaic's reader)";
+  return "/input/memory_limit_mb: " + std::to_string(int(memory_limit_mb)) + " MB" + held + " is too little";
+}
+
 int tile_size_for(int cols, int rows, double memory_limit_mb, int concurrent, double reserved_mb) {
   const double limit = (memory_limit_mb - reserved_mb) * 1e6;
   for (int side = 1 << 15; side >= 64; side = side * 7 / 8) {
@@ -62,7 +69,7 @@ int tile_size_for(int cols, int rows, double memory_limit_mb, int concurrent, do
     const double global = kGlobalBytesPerTileSide * double(grid.count()) * double(side) + 40.0 * rows;
     if (tile + global <= limit) return side;
   }
-  throw bad_input("/input/memory_limit_mb: " + std::to_string(int(memory_limit_mb)) + " MB" + (reserved_mb > 0 ? " (" + std::to_string(int(std::ceil(reserved_mb))) + " MB of it held by the process and the mosaic's reader)" : std::string()) + " is too little for tiles of 64 x 64 cells on a " +
+  throw bad_input(too_little(memory_limit_mb, reserved_mb) + " for tiles of 64 x 64 cells on a " +
                   std::to_string(cols) + " x " + std::to_string(rows) + " mosaic");
 }
 

@@ -129,6 +129,9 @@ inline constexpr double kTileBytesPerCell = 48;
 /// within `memory_limit_mb` less `reserved_mb` (what the process and the mosaic's reader hold:
 /// reserve_reader_memory); throws bad_input when not even 64-cell tiles fit.
 int tile_size_for(int cols, int rows, double memory_limit_mb, int concurrent, double reserved_mb = 0);
+/// The start of the error of a memory limit too small for any tiling ("/input/memory_limit_mb: L MB
+/// (R MB of it held by ...) is too little").
+std::string too_little(double memory_limit_mb, double reserved_mb);
 
 /// The threads this process may use (--threads, or what terrapolis-mpi leaves to each rank).
 int allowed_threads();
