@@ -30,33 +30,42 @@ namespace terrapolis::hydro::tiled {
 
 inline constexpr std::uint32_t kVoid = 0xFFFFFFFFu, kOpen = 0xFFFFFFFEu;  // labels: nodata, not reached yet
 
+/// The cells of a tile within `width` cells of its edges (every cell when it is under 2 x width
+/// cells wide or high), numbered: the north rows, the south rows, then the west and east cells of
+/// each row between.
+class Border {
+ public:
+  Border() = default;
+  Border(const TileRect& r, int width) : cols_(r.cols), rows_(r.rows), w_(width) {}
+  std::size_t size() const {
+    return whole() ? cells(cols_) * cells(rows_) : 2 * cells(w_) * (cells(cols_) + cells(rows_ - 2 * w_));
+  }
+  bool contains(int c, int r) const { return std::min({c, r, cols_ - 1 - c, rows_ - 1 - r}) < w_; }
+  std::size_t index(int c, int r) const {
+    if (whole() || r < w_) return cells(r) * cells(cols_) + cells(c);
+    if (r >= rows_ - w_) return cells(w_ + r - (rows_ - w_)) * cells(cols_) + cells(c);
+    return 2 * cells(w_) * cells(cols_) + cells(r - w_) * 2 * cells(w_) + cells(c < w_ ? c : w_ + c - (cols_ - w_));
+  }
+
+ private:
+  static std::size_t cells(int n) { return std::size_t(n); }
+  bool whole() const { return cols_ < 2 * w_ || rows_ < 2 * w_; }
+  int cols_ = 0, rows_ = 0, w_ = 1;
+};
+
 /// The cells of a tile within two of its edges (where neighbouring tiles look): filled values
 /// and global labels after the first pass.
-class Frame {
+class Frame : public Border {
  public:
   Frame() = default;
   /// The shape only, or with room for the values.
-  explicit Frame(const TileRect& r, bool with_values = true) : cols_(r.cols), rows_(r.rows) {
+  explicit Frame(const TileRect& r, bool with_values = true) : Border(r, 2) {
     if (!with_values) return;
     z.resize(size());
     label.resize(size());
   }
-  std::size_t size() const {
-    return whole() ? std::size_t(cols_) * std::size_t(rows_) : std::size_t(4) * (std::size_t(cols_) + std::size_t(rows_) - 4);
-  }
-  bool contains(int c, int r) const { return std::min({c, r, cols_ - 1 - c, rows_ - 1 - r}) < 2; }
-  std::size_t index(int c, int r) const {
-    if (whole()) return std::size_t(r) * std::size_t(cols_) + std::size_t(c);
-    if (r < 2) return std::size_t(r) * std::size_t(cols_) + std::size_t(c);
-    if (r >= rows_ - 2) return std::size_t(2 + r - (rows_ - 2)) * std::size_t(cols_) + std::size_t(c);
-    return std::size_t(4) * std::size_t(cols_) + std::size_t(r - 2) * 4 + std::size_t(c < 2 ? c : 2 + c - (cols_ - 2));
-  }
   std::vector<float> z;
   std::vector<std::uint32_t> label;  // global
-
- private:
-  bool whole() const { return cols_ < 4 || rows_ < 4; }
-  int cols_ = 0, rows_ = 0;
 };
 
 /// One tile filled with its edges as outlets (Barnes 2016, first stage): every cell labelled
@@ -72,25 +81,9 @@ struct TileFill {
 /// nodata in a neighbouring tile, or on the mosaic's border, is a true outlet as in the whole grid.
 TileFill fill_tile(const Dem& window, const std::optional<double>& sea_level);  // fill_pass.cpp
 
-/// The outer ring of cells of a tile (every cell when it is under 3 cells wide or high), numbered:
-/// the north row, the south row, then the west and east cells of each row between.
-class Ring {
- public:
-  explicit Ring(const TileRect& r) : cols_(r.cols), rows_(r.rows) {}
-  std::size_t size() const {
-    return whole() ? std::size_t(cols_) * std::size_t(rows_) : 2 * std::size_t(cols_) + 2 * std::size_t(rows_ - 2);
-  }
-  bool contains(int c, int r) const { return c == 0 || r == 0 || c == cols_ - 1 || r == rows_ - 1; }
-  std::size_t index(int c, int r) const {
-    if (whole()) return std::size_t(r) * std::size_t(cols_) + std::size_t(c);
-    if (r == 0) return std::size_t(c);
-    if (r == rows_ - 1) return std::size_t(cols_) + std::size_t(c);
-    return 2 * std::size_t(cols_) + 2 * std::size_t(r - 1) + (c == 0 ? 0 : 1);
-  }
-
- private:
-  bool whole() const { return cols_ < 3 || rows_ < 3; }
-  int cols_ = 0, rows_ = 0;
+/// The outer ring of cells of a tile (its border one cell wide).
+struct Ring : Border {
+  explicit Ring(const TileRect& r) : Border(r, 1) {}
 };
 
 inline constexpr std::int32_t kFar = std::numeric_limits<std::int32_t>::max() / 4;  // no wave reaches the cell
