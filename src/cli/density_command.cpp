@@ -14,6 +14,7 @@
 #include "cli/commands_list.hpp"
 #include "cli/dem_input.hpp"
 #include "cli/hydro_tiles.hpp"
+#include "core/memory.hpp"
 #include "cli/plugin_options.hpp"
 #include "cli/schema_options.hpp"
 #include "core/error.hpp"

@@ -8,9 +8,9 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 
 #include "core/error.hpp"
+#include "core/memory.hpp"
 #include "io/vector_io.hpp"
 
 namespace terrapolis::cli {
@@ -107,14 +107,6 @@ std::string tiles_of_this_process(const TiledHydroRequest& q, Context& context, 
 }
 
 }  // namespace
-
-double peak_resident_mb() {
-  std::ifstream status("/proc/self/status");
-  std::string line;
-  while (std::getline(status, line))
-    if (line.rfind("VmHWM:", 0) == 0) return std::stod(line.substr(6)) * 1024 / 1e6;  // kB, as MB like the limits
-  return 0;
-}
 
 std::string tile_file(const std::string& out_dir, const std::string& layer, int tile, int across) {
   char name[64];

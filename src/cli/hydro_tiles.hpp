@@ -34,8 +34,6 @@ struct TiledHydroRequest {
 /// OUTDIR/LAYER/tile_RRRR_CCCC.tif: the file of tile `tile` of a mosaic `across` tiles wide.
 std::string tile_file(const std::string& out_dir, const std::string& layer, int tile, int across);
 
-/// Peak resident memory of this process (Linux VmHWM), MB (10^6 bytes, as the limits); 0 elsewhere.
-double peak_resident_mb();
 
 /// Writes OUTDIR/filled.vrt, flowdir.vrt, accumulation.vrt (basins.vrt) over one GeoTIFF a tile in
 /// OUTDIR/filled/, flowdir/, accumulation/ (tile_RRRR_CCCC.tif); the same cells as the whole-grid

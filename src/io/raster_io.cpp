@@ -16,7 +16,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <memory>
 #include <mutex>
@@ -25,6 +24,7 @@
 
 #include "core/error.hpp"
 #include "core/interrupt.hpp"
+#include "core/memory.hpp"
 #include "io/gdal_util.hpp"
 
 namespace terrapolis {
@@ -325,11 +325,7 @@ double reserve_reader_memory(double limit_mb) {
   int pool = kPool;
   if (const char* user = CPLGetConfigOption("GDAL_MAX_DATASET_POOL_SIZE", nullptr)) pool = std::max(2, std::atoi(user));
   else CPLSetConfigOption("GDAL_MAX_DATASET_POOL_SIZE", std::to_string(kPool).c_str());
-  double resident_mb = 0;
-  std::ifstream status("/proc/self/status");
-  for (std::string line; std::getline(status, line);)
-    if (line.rfind("VmRSS:", 0) == 0) resident_mb = std::stod(line.substr(6)) * 1024 / 1e6;  // kB
-  return cache_mb + 0.8 * pool + resident_mb;
+  return cache_mb + 0.8 * pool + resident_mb();
 }
 
 ReadOptions read_options(int band, const std::string& assume_crs) {

@@ -2,7 +2,6 @@
 // SPDX-License-Identifier: MIT
 #include "pipeline/runner.hpp"
 
-#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -10,6 +9,7 @@
 #include <functional>
 
 #include "core/error.hpp"
+#include "core/memory.hpp"
 #include "io/checksum.hpp"
 #include "io/output_set.hpp"
 #include "io/text_io.hpp"
@@ -26,11 +26,6 @@ namespace {
 
 using json = nlohmann::ordered_json;
 
-long peak_rss_kb() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return usage.ru_maxrss;
-}
 
 
 /// What a run does with each stage.
@@ -212,7 +207,7 @@ json run_scenario(const Scenario& scenario, const RunOptions& options, Progress&
       const auto start = std::chrono::steady_clock::now();
       stage.run(state, progress, stage_log);
       const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      timings.push_back({{"stage", stage.name}, {"seconds", seconds}, {"peak_memory_mb", double(peak_rss_kb()) / 1024.0}});
+      timings.push_back({{"stage", stage.name}, {"seconds", seconds}, {"peak_memory_mb", peak_resident_mb()}});
       ran.push_back(stage.name);
       stage_log.detail("done in " + std::to_string(seconds) + " s");
     }

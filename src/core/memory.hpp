@@ -1,0 +1,12 @@
+// This process's resident memory, for memory limits and the run's timings.
+// SPDX-License-Identifier: MIT
+#pragma once
+
+namespace terrapolis {
+
+/// Resident memory of this process now (Linux VmRSS), MB (10^6 bytes, as the memory limits); 0 elsewhere.
+double resident_mb();
+/// Peak resident memory of this process so far (getrusage's ru_maxrss, kB on Linux), MB (10^6 bytes).
+double peak_resident_mb();
+
+}  // namespace terrapolis
