@@ -64,6 +64,16 @@ CellMetrics projected_metrics(const Georef& g, int rows) {
 
 }  // namespace
 
+CellMetrics metric_rows(const CellMetrics& m, int row0, int rows) {
+  auto part = [&](const std::vector<double>& v, int n) { return std::vector<double>(v.begin() + row0, v.begin() + row0 + n); };
+  CellMetrics out;
+  out.width_m = part(m.width_m, rows);
+  out.area_m2 = part(m.area_m2, rows);
+  out.height_m = part(m.height_m, rows + 1);
+  out.diagonal_m = part(m.diagonal_m, rows + 1);
+  return out;
+}
+
 double CellMetrics::total_area_m2(int cols) const {
   double s = 0;
   for (double a : area_m2) s += a;

@@ -42,6 +42,11 @@ struct CellMetrics {
 /// Computes the metrics of a `cols` x `rows` grid. Throws bad_input for a rotated geographic grid.
 CellMetrics cell_metrics(const Georef& georef, int cols, int rows);
 
+/// The rows [row0, row0 + rows) of a grid's metrics (height_m and diagonal_m: one more), for a
+/// window that must step and weigh its cells exactly as the whole grid does (a window's own
+/// cell_metrics may differ in the last bit: its origin is computed, not read).
+CellMetrics metric_rows(const CellMetrics& metrics, int row0, int rows);
+
 /// Geodesic distance in metres between two points given in degrees, on `ellipsoid`.
 double geodesic_distance_m(const Ellipsoid& ellipsoid, double lon1, double lat1, double lon2, double lat2);
 

@@ -15,19 +15,6 @@ namespace {
 using hydro::tiled::TileGrid;
 using hydro::tiled::TileRect;
 
-/// The rows [row0, row0 + rows) of the whole grid's metrics (height_m and diagonal_m: one more).
-CellMetrics metric_rows(const CellMetrics& m, int row0, int rows) {
-  auto part = [&](const std::vector<double>& v, int n) {
-    return std::vector<double>(v.begin() + row0, v.begin() + row0 + n);
-  };
-  CellMetrics out;
-  out.width_m = part(m.width_m, rows);
-  out.area_m2 = part(m.area_m2, rows);
-  out.height_m = part(m.height_m, rows + 1);
-  out.diagonal_m = part(m.diagonal_m, rows + 1);
-  return out;
-}
-
 /// Reach of the discs of `plan` around the cells of rows [row0, row0 + rows): rows and columns.
 /// On a geographic grid the columns follow the latitude (a disc is wider in columns poleward).
 std::array<int, 2> reach_of_rows(const DiscPlan& plan, int row0, int rows) {

@@ -17,16 +17,23 @@ namespace {
 constexpr int kSafetyCap = 160;  // |F| <= ~8^t: |F|^2 stays below DBL_MAX up to t ~ 170
 }  // namespace
 
-BelhadjModel::BelhadjModel(const Dem& dem, const CellMetrics& metrics, VerticalScale vertical,
-                           std::optional<double> sea_level, BelhadjShare share)
-    : cols_(dem.cols()), rows_(dem.rows()), stride_(dem.cols() + 2), share_(share) {
-  const std::size_t padded = std::size_t(stride_) * std::size_t(rows_ + 2);
+std::array<double, 2> belhadj_land_range(const Dem& dem, std::optional<double> sea_level) {
   double lo = INFINITY, hi = -INFINITY;
   for (float v : dem.values())
     if (!std::isnan(v) && !is_sea(v, sea_level)) {
       lo = std::min(lo, double(v));
       hi = std::max(hi, double(v));
     }
+  return {lo, hi};
+}
+
+int belhadj_iteration_limit(const BelhadjOptions& options) { return options.max_iterations > 0 ? options.max_iterations : kSafetyCap; }
+
+BelhadjModel::BelhadjModel(const Dem& dem, const CellMetrics& metrics, VerticalScale vertical,
+                           std::optional<double> sea_level, BelhadjShare share, std::optional<std::array<double, 2>> land_range)
+    : cols_(dem.cols()), rows_(dem.rows()), stride_(dem.cols() + 2), share_(share) {
+  const std::size_t padded = std::size_t(stride_) * std::size_t(rows_ + 2);
+  const auto [lo, hi] = land_range ? *land_range : belhadj_land_range(dem, sea_level);
   if (!(lo <= hi)) throw bad_input("hydrometry: the DEM has no land cell (all nodata or below sea level)");
   z_out_ = vertical == VerticalScale::normalised16 ? -1.0 : lo - std::max(hi - lo, 1.0);
   if (vertical == VerticalScale::normalised16 && lo / 65535.0 <= z_out_)  // valid cells must lie above it
@@ -257,12 +264,12 @@ BelhadjRun belhadj_hydrometry(const Dem& dem, const CellMetrics& metrics, const 
   ProgressStep step(progress, "hydrometry (Belhadj)");
   BelhadjModel model(dem, metrics, options.vertical, options.sea_level, options.share);
   BelhadjRun run;
-  const int limit = options.max_iterations > 0 ? options.max_iterations : kSafetyCap;
+  const int limit = belhadj_iteration_limit(options);
   const double log_target = std::log(options.threshold);
   for (;;) {
     run.final_mean = model.step();
     ++run.iterations;
-    if (run.final_mean < options.threshold || run.iterations >= limit) break;
+    if (belhadj_stops(options, run.iterations, run.final_mean)) break;
     const double by_mean = run.final_mean > 0 ? std::log(run.final_mean) / log_target : 1.0;
     step.update(std::clamp(std::max(by_mean, double(run.iterations) / limit), 0.0, 1.0));
   }
@@ -274,10 +281,9 @@ BelhadjRun belhadj_hydrometry(const Dem& dem, const CellMetrics& metrics, const 
         lo = std::min(lo, model.acc(c, r));
         hi = std::max(hi, model.acc(c, r));
       }
-  const double span = hi > lo ? hi - lo : 1.0;
   for (int r = 0; r < dem.rows(); ++r)
     for (int c = 0; c < dem.cols(); ++c) {
-      if (model.valid(c, r)) run.hydrometry(c, r) = float((model.acc(c, r) - lo) / span);
+      if (model.valid(c, r)) run.hydrometry(c, r) = belhadj_rescale(model.acc(c, r), lo, hi);
       else if (!std::isnan(dem(c, r))) run.hydrometry(c, r) = 0.0f;  // sea
     }
   return run;

@@ -1,6 +1,7 @@
 // Belhadj's iterative rain-diffusion hydrometry (thesis, Paris 8, 2007, §4.2.2, Algorithm 12).
 // SPDX-License-Identifier: MIT
 #pragma once
+#include <array>
 #include <optional>
 #include <vector>
 
@@ -37,8 +38,10 @@ enum class BelhadjShare {
 class BelhadjModel {
  public:
   /// Initial state: F = (0, 0, -1) (a falling drop: straight down), Q = 1, Acc = 0 on every valid cell.
+  /// `land_range`: the lowest and highest land altitude of the whole grid when `dem` is a window of
+  /// it (the outside altitude follows them); unset, `dem`'s own.
   BelhadjModel(const Dem& dem, const CellMetrics& metrics, VerticalScale vertical, std::optional<double> sea_level,
-               BelhadjShare share = BelhadjShare::all_neighbours);
+               BelhadjShare share = BelhadjShare::all_neighbours, std::optional<std::array<double, 2>> land_range = std::nullopt);
   BelhadjModel(const BelhadjModel&) = delete;  // the array pointers point into the model's own block
   BelhadjModel& operator=(const BelhadjModel&) = delete;
 
@@ -98,6 +101,17 @@ struct BelhadjRun {
   int iterations = 0;        ///< iterations done
   double final_mean = 0;     ///< mean quantity at the last iteration
 };
+
+/// The iterations the diffusion may run: max_iterations, or the safety cap of 160.
+int belhadj_iteration_limit(const BelhadjOptions& options);
+/// Whether the diffusion stops after iteration `iteration` (1-based), whose step began at this mean quantity.
+inline bool belhadj_stops(const BelhadjOptions& options, int iteration, double mean) {
+  return mean < options.threshold || iteration >= belhadj_iteration_limit(options);
+}
+/// Lowest and highest land altitude (not nodata, above the sea level) of `dem`: +inf, -inf without land.
+std::array<double, 2> belhadj_land_range(const Dem& dem, std::optional<double> sea_level);
+/// The hydrometry of a cell from its Acc, rescaled by the lowest and highest Acc of the grid's valid cells.
+inline float belhadj_rescale(double acc, double lo, double hi) { return float((acc - lo) / (hi > lo ? hi - lo : 1.0)); }
 
 /// Runs the diffusion until the mean quantity drops below `threshold` or `max_iterations`.
 /// The cap of 160 iterations keeps the flow vectors finite (|F| can grow 8-fold per iteration on a

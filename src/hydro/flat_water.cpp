@@ -9,32 +9,15 @@
 
 namespace terrapolis::hydro {
 
-/// Largest share of the cells around a flat surface that may lie below it (its outlet, noise on the
-/// shore). On N47E009, 0.1 lost the eastern Obersee of Lake Constance, 0.4 kept a 12 km² stretch of
-/// the Alpine Rhine valley floor.
-constexpr double kMaxLowerShare = 0.25;
-
 FlatWater detect_flat_water(const Dem& dem, const FlatWaterOptions& options) {
   const int cols = dem.cols(), rows = dem.rows();
   FlatWater out{dem.like<std::uint8_t>(0), 0, 0.0};
   if (options.min_area_km2 <= 0 || cols < 3 || rows < 3) return out;
   const std::size_t n = dem.size();
-  auto land = [&](std::size_t i) { return !dem.is_nodata(i) && double(dem[i]) > options.sea_level_m; };
   // Seeds: land cells level with all their neighbours (grid edges count as level).
   std::vector<std::uint8_t> seed(n, 0);
   for (int r = 0; r < rows; ++r)
-    for (int c = 0; c < cols; ++c) {
-      const std::size_t i = dem.index(c, r);
-      if (!land(i)) continue;
-      bool level = true;
-      for (int dr = -1; dr <= 1 && level; ++dr)
-        for (int dc = -1; dc <= 1 && level; ++dc) {
-          if ((dr == 0 && dc == 0) || c + dc < 0 || r + dr < 0 || c + dc >= cols || r + dr >= rows) continue;
-          const std::size_t j = dem.index(c + dc, r + dr);
-          level = land(j) && std::fabs(double(dem[j]) - double(dem[i])) <= options.tolerance_m;
-        }
-      seed[i] = level;
-    }
+    for (int c = 0; c < cols; ++c) seed[dem.index(c, r)] = flat_water_seed(dem, c, r, options);
   // Components of seeds (8-connected), scan order: deterministic. Kept ones are marked with their
   // one-cell fringe (the shore cells at the water level that seeded them).
   const CellMetrics metrics = cell_metrics(dem.georef(), cols, rows);
@@ -91,7 +74,7 @@ FlatWater detect_flat_water(const Dem& dem, const FlatWaterOptions& options) {
           if (dem.is_nodata(j) || double(dem[j]) < level - options.tolerance_m) ++lower;
         }
     }
-    if (double(lower) > kMaxLowerShare * double(outside)) continue;
+    if (!flat_water_in_basin(lower, outside)) continue;
     ++out.lakes;
     for (const std::size_t i : region) out.mask[i] = 1;
   }

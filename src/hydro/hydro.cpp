@@ -29,8 +29,7 @@ HydroResult run_hydro(const Dem& dem, const HydroOptions& options, Progress& pro
   }
   const Raster<double>& d8_area = plain_area ? out.accumulation : area;
   if (options.with_hydrometry) {
-    HydrometryOptions h = options.hydrometry;
-    if (options.sea_level) h.sea_level = options.sea_level;
+    const HydrometryOptions h = hydrometry_options(options);
     if (h.method == HydrometryMethod::accumulation) {
       out.hydrometry = hydrometry_from_accumulation(d8_area, dem, h.sea_level);
     } else {

@@ -42,4 +42,11 @@ struct HydroResult {
 /// Runs the stage on `dem` (metres, NaN nodata). Throws bad_input on invalid options.
 HydroResult run_hydro(const Dem& dem, const HydroOptions& options, Progress& progress);
 
+/// The hydrometry's options as run_hydro uses them: the stage's sea level (when set) for theirs.
+inline HydrometryOptions hydrometry_options(const HydroOptions& options) {
+  HydrometryOptions h = options.hydrometry;
+  if (options.sea_level) h.sea_level = options.sea_level;
+  return h;
+}
+
 }  // namespace terrapolis::hydro
