@@ -15,6 +15,7 @@
 # terrapolis-mpi on WEAK_RANKS (default "1 2"), one thread a rank: cells/s a rank, CPU, peak
 # resident memory of each rank (GNU time), the engine's reported state, disk written. WEAK_DIR:
 # where the mosaic and outputs go (default a temporary folder; removed at the end).
+# RUN=1: a run to the density stage on such a continent, whole grid vs input.memory_limit_mb (RUN_COPIES, RUN_MEMORY).
 # DENSITY=1: the density stage instead, whole grid vs tile by tile (DENSITY_OPTIONS, ";"-separated).
 # SPDX-License-Identifier: MIT
 set -euo pipefail
@@ -80,13 +81,9 @@ same_cells() {  # raw copies compared byte for byte
   if cmp -s "$work/a.bin" "$work/b.bin"; then echo "    $(basename "$2"): same cells"; else echo "    $(basename "$2"): DIFFERENT"; fi
 }
 
-# Weak scaling on a synthetic continent (WEAK=1).
-weak() {
-  local copies=${WEAK_COPIES:-360} memory=${WEAK_MEMORY:-400} dem=${WEAK_DEM:-../shared/dems/N47E009.hgt} dir
-  dir=$(mktemp -d "${WEAK_DIR:-$work}/continent.XXXXXX")
-  trap "rm -rf '$work' '$dir'" EXIT  # expanded now: dir is local
-  # The four mirror images of the DEM, once (Int16).
-  /usr/bin/python3 - "$dem" "$dir" <<'PY'
+# The four mirror images of DEM in DIR, once (Int16), for mosaic.
+mirror_images() {
+  /usr/bin/python3 - "$1" "$2" <<'PY'
 import sys
 import numpy as np
 from osgeo import gdal
@@ -101,9 +98,12 @@ for name, a in (("id", z), ("lr", z[:, ::-1]), ("ud", z[::-1, :]), ("both", z[::
     band.SetNoDataValue(-32768)
     band.WriteArray(a)
 PY
-  # mosaic N: N copies about as many across as down, each mirrored where it meets its neighbours.
-  mosaic() {
-    /usr/bin/python3 - "$1" "$dir" <<'PY'
+}
+
+# mosaic N DIR: DIR/continent-N.vrt, N copies about as many across as down, each mirrored where it
+# meets its neighbours (seamless edges).
+mosaic() {
+  /usr/bin/python3 - "$1" "$2" <<'PY'
 import math, sys
 from osgeo import gdal
 n, d = int(sys.argv[1]), sys.argv[2]
@@ -121,7 +121,14 @@ open(f"{d}/continent-{n}.vrt", "w").write(f"""<VRTDataset rasterXSize="{side * a
 <VRTRasterBand dataType="Int16" band="1"><NoDataValue>-32768</NoDataValue>{sources}</VRTRasterBand></VRTDataset>
 """)
 PY
-  }
+}
+
+# Weak scaling on a synthetic continent (WEAK=1).
+weak() {
+  local copies=${WEAK_COPIES:-360} memory=${WEAK_MEMORY:-400} dem=${WEAK_DEM:-../shared/dems/N47E009.hgt} dir
+  dir=$(mktemp -d "${WEAK_DIR:-$work}/continent.XXXXXX")
+  trap "rm -rf '$work' '$dir'" EXIT  # expanded now: dir is local
+  mirror_images "$dem" "$dir"
   local side cells_a_copy
   side=$(gdalinfo "$dir/id.tif" | sed -n 's/^Size is \([0-9]*\),.*/\1/p')
   cells_a_copy=$(( side * side ))
@@ -129,7 +136,7 @@ PY
   local np
   for np in ${WEAK_RANKS:-1 2}; do
     local n=$(( copies * np )) out=$dir/out
-    mosaic "$n"
+    mosaic "$n" "$dir"
     rm -rf "$out"
     local cmd=("$bin" -v --threads 1 hydro "$dir/continent-$n.vrt" "$out" --outputs $outputs --memory-limit "$memory")
     local start end
@@ -163,6 +170,41 @@ PY
 }
 if [[ ${WEAK:-0} == 1 ]]; then
   weak
+  exit
+fi
+
+# A run by tiles (RUN=1): `terrapolis run --until density` (density.preset belhadj2007) on the
+# mirror-tiled continent of RUN_COPIES copies of WEAK_DEM (default 36: 5.2e7 cells), on the whole
+# grid and with input.memory_limit_mb RUN_MEMORY (default 400): wall, CPU, peak resident memory,
+# each stage's time and peak, and the tiled rasters checked against the whole grid's.
+run_bench() {
+  local copies=${RUN_COPIES:-36} memory=${RUN_MEMORY:-400} dem=${WEAK_DEM:-../shared/dems/N47E009.hgt} dir
+  dir=$(mktemp -d "${WEAK_DIR:-$work}/continent.XXXXXX")
+  trap "rm -rf '$work' '$dir'" EXIT
+  mirror_images "$dem" "$dir"
+  mosaic "$copies" "$dir"
+  local set=(--set dem="$dir/continent-$copies.vrt" --set density.preset=belhadj2007 --set outputs.preview=false --until density)
+  echo "run by tiles: $copies copies of $(basename "$dem"), $(gdalinfo "$dir/continent-$copies.vrt" | sed -n 's/^Size is //p') cells, $(nproc) cores"
+  local label out
+  for label in whole tiled; do
+    out=$dir/$label
+    local extra=()
+    [[ $label == tiled ]] && extra=(--set input.memory_limit_mb="$memory")
+    /usr/bin/time -f "%e %U %S %M" -o "$dir/time" "$bin" -q run "${set[@]}" "${extra[@]}" -o "$out" >/dev/null 2>"$dir/log" ||
+      { cat "$dir/log"; return 1; }
+    /usr/bin/python3 - "$label" "$dir/time" "$out/run.json" "$memory" <<'PY'
+import json, sys
+wall, user, sys_, kb = map(float, open(sys.argv[2]).read().split())
+timings = json.load(open(sys.argv[3]))["timings"]
+stages = ", ".join(f"{t['stage']} {t['seconds']:.0f} s (peak {t['peak_memory_mb']:.0f} MB)" for t in timings)
+limit = f" (limit {sys.argv[4]} MB)" if sys.argv[1] == "tiled" else ""
+print(f"  {sys.argv[1]:<6} wall {wall:6.0f} s  cpu {user + sys_:6.0f} s  peak {kb * 1024 / 1e6:6.0f} MB{limit}: {stages}")
+PY
+  done
+  for r in elevation filled accumulation hydrometry inland_water buildable density; do same_cells "$dir/whole/$r.tif" "$dir/tiled/$r.vrt"; done
+}
+if [[ ${RUN:-0} == 1 ]]; then
+  run_bench
   exit
 fi
 

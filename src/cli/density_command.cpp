@@ -22,9 +22,7 @@
 #include "core/text.hpp"
 #include "density/density.hpp"
 #include "density/tiled_density.hpp"
-#include "hydro/hydro.hpp"
-#include "hydro/tiled/tiled_belhadj.hpp"
-#include "hydro/tiled/tiled_flat_water.hpp"
+#include "pipeline/by_tiles.hpp"
 #include "pipeline/descriptions.hpp"
 #include "pipeline/stages.hpp"
 #include "io/output_set.hpp"
@@ -190,79 +188,33 @@ class DensityCommand final : public Command {
       throw bad_input("--layer: user layers are rescaled by their range over the grid, not computed on tiles yet");
     if (!plugins_.specs.empty()) throw bad_input("--plugin: plugins are not run on tiles yet");
     const bool hydrometry = hydrometry_used(options);
-    const hydro::HydrometryOptions belhadj = hydro::hydrometry_options(pipeline::hydro_options(scenario));
-    if (hydrometry && hydrometry_path_.empty() && belhadj.method != hydro::HydrometryMethod::belhadj)
-      throw bad_input("density on tiles: the accumulation hydrometry (hydro.hydrometry) is not computed on tiles yet, Belhadj's is; "
-                      "give --hydrometry FILE (a raster or VRT in [0,1]) or a hydrometry weight of 0 (--weights C,0,P,L)");
-    const pipeline::InlandWaterSettings water = pipeline::inland_water_settings(scenario);
-    if (!water.reservoirs.empty()) throw bad_input("/water/reservoirs: not flooded on tiles yet");
     const double reserved_mb = reserve_reader_memory(tiles.limit_mb());
     const DemWindowReader reader(dem_.path, dem_.options());
     const RasterHeader& h = reader.header();
-    const auto read_dem = [&](int c0, int r0, int cols, int rows) { return reader.read(c0, r0, cols, rows); };
-    // What the whole-grid command computes on the whole DEM, computed by tiles into the staging
-    // folder first, then read by windows as given files are: the lakes the DEM flattens, Belhadj's hydrometry.
-    const fs::path computed = dir / ".computed";
-    std::string flat_water;
-    if (water.flat_water.min_area_km2 > 0) {
-      const int side = tiles.tile_size > 0 ? tiles.tile_size : hydro::tiled::flat_water_tile_size_for(h.cols, h.rows, tiles.limit_mb(), reserved_mb);
-      fs::create_directories(computed / "flat_water");
-      const hydro::tiled::TiledFlatWaterReport f = hydro::tiled::run_tiled_flat_water(
-          h.cols, h.rows, h.georef, read_dem, water.flat_water, side,
-          [&](int t, int across, const Raster<std::uint8_t>& tile) {
-            write_raster(tile_file(computed.string(), "flat_water", t, across), tile, WriteOptions{});
-          },
-          context.progress);
-      std::vector<std::string> files;
-      for (int t = 0; t < f.tiles; ++t) files.push_back(tile_file(computed.string(), "flat_water", t, f.across));
-      flat_water = (computed / "flat_water.vrt").string();
-      write_vrt(flat_water, files, false);
-      context.log.detail("flat water tiles: " + std::to_string(f.tiles) + " of " + std::to_string(side) + " cells a side, " +
-                         std::to_string(f.lakes) + " lakes the DEM flattens, " + format(f.area_km2, 2) + " km2 (" +
-                         std::to_string(f.surfaces) + " level surfaces on tile edges or large enough, joined across tiles)");
-    }
-    // The inland water of a window: the flattened lakes and --water-mask, as pipeline::inland_water.
-    auto read_water = [&](density::DensityOptions& o, const Georef& grid, int cols, int rows) {
-      if (!water.water_mask.empty()) o.water_mask = read_mask(water.water_mask, grid, cols, rows);
-      if (flat_water.empty()) return;
-      Raster<std::uint8_t> lakes = read_mask(flat_water, grid, cols, rows);
-      if (o.water_mask.size() > 0)
-        for (std::size_t i = 0; i < lakes.size(); ++i)
-          if (o.water_mask[i]) lakes[i] = 1;
-      o.water_mask = std::move(lakes);
-    };
-    std::optional<DemWindowReader> hydrometry_reader;
+    // What the whole-grid command computes on the whole DEM (pipeline::hydro_for_density), computed
+    // by tiles into the staging folder first, then read by windows: the inland water, Belhadj's hydrometry.
+    const MosaicFiles water{(dir / ".computed").string(), "inland_water"}, belhadj{water.dir, "hydrometry"};
+    water.create();
+    const pipeline::InlandWaterTiles w = pipeline::inland_water_by_tiles(
+        reader, pipeline::inland_water_settings(scenario), tiles, reserved_mb,
+        [&](int t, int across, const Raster<std::uint8_t>& tile) { write_raster(water.tile(t, across), tile, WriteOptions{}); }, context.progress);
+    water.finish(w.tiles, w.across);
+    context.log.detail(pipeline::describe(w));
+    std::optional<DemWindowReader> computed;
     if (hydrometry && hydrometry_path_.empty()) {
-      fs::create_directories(computed / "tiles");
-      const hydro::tiled::TiledBelhadjReport b = hydro::tiled::run_tiled_belhadj(
-          h.cols, h.rows, h.georef, read_dem,
-          hydro::belhadj_options(belhadj), tiles.tile_size, tiles.limit_mb(), (computed / "scratch").string(),
-          [&](int t, int across, const Raster<float>& tile) { write_raster(tile_file(computed.string(), "tiles", t, across), tile, WriteOptions{}); },
-          context.progress, reserved_mb);
-      std::vector<std::string> files;
-      for (int t = 0; t < b.tiles; ++t) files.push_back(tile_file(computed.string(), "tiles", t, b.across));
-      write_vrt((computed / "hydrometry.vrt").string(), files, false);
-      hydrometry_reader.emplace((computed / "hydrometry.vrt").string(), ReadOptions{});
-      char line[300];
-      std::snprintf(line, sizeof line,
-                    "hydrometry tiles: %d of %d cells a side, %d Belhadj iterations (mean %.3g) found in %d pass%s, halo %d cells; "
-                    "state %.1f MB a window",
-                    b.tiles, b.tile_size, b.iterations, b.final_mean, b.searches, b.searches > 1 ? "es" : "", b.halo, b.window_bytes / 1e6);
-      context.log.detail(line);
+      belhadj.create();
+      const hydro::tiled::TiledBelhadjReport b = pipeline::hydrometry_by_tiles(
+          reader, pipeline::hydro_options(scenario), tiles, reserved_mb, water.dir + "/scratch",
+          [&](int t, int across, const Raster<float>& tile) { write_raster(belhadj.tile(t, across), tile, WriteOptions{}); }, context.progress);
+      belhadj.finish(b.tiles, b.across);
+      computed.emplace(belhadj.vrt(), ReadOptions{});
+      context.log.detail(pipeline::describe(b));
     }
-    auto read = [&](int c0, int r0, int cols, int rows, bool dem_only) {
-      density::WindowInputs in;
-      in.dem = reader.read(c0, r0, cols, rows);
-      in.options = options;
-      const Georef& grid = in.dem.georef();
-      read_water(in.options, grid, cols, rows);
-      if (dem_only) return in;
-      pipeline::read_density_files(scenario, grid, cols, rows, "", in.options);
-      in.hydrometry = !hydrometry            ? in.dem.like<float>(0.0f)
-                      : hydrometry_reader ? hydrometry_reader->read(c0, r0, cols, rows)
-                                          : read_hydrometry(hydrometry_path_, grid, cols, rows);
-      return in;
-    };
+    pipeline::ReadHydrometry read_hydro;
+    if (computed) read_hydro = [&](const Dem& window, int c0, int r0) { return computed->read(c0, r0, window.cols(), window.rows()); };
+    else if (hydrometry)
+      read_hydro = [&](const Dem& window, int, int) { return read_hydrometry(hydrometry_path_, window.georef(), window.cols(), window.rows()); };
+    const density::ReadWindowInputs read = pipeline::density_windows(reader, scenario, options, water.vrt(), read_hydro);
     const char* layers[] = {"coast", "plateau", "plain", "hydrometry", "buildable", "density"};
     for (const char* l : layers)
       if (hydrometry || std::string(l) != "hydrometry") fs::create_directory(dir / l);
@@ -278,8 +230,8 @@ class DensityCommand final : public Command {
         for (int t = 0; t < report.tiles; ++t) files.push_back(tile_file(dir.string(), l, t, report.across));
         write_vrt((dir / (std::string(l) + ".vrt")).string(), files, false);
       }
-    hydrometry_reader.reset();
-    fs::remove_all(computed);
+    computed.reset();
+    fs::remove_all(water.dir);
     outputs.commit();
     char line[360];
     std::snprintf(line, sizeof line,

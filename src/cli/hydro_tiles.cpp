@@ -109,9 +109,7 @@ std::string tiles_of_this_process(const TiledHydroRequest& q, Context& context, 
 }  // namespace
 
 std::string tile_file(const std::string& out_dir, const std::string& layer, int tile, int across) {
-  char name[64];
-  std::snprintf(name, sizeof name, "tile_%04d_%04d.tif", tile / across, tile % across);
-  return (fs::path(out_dir) / layer / name).string();
+  return MosaicFiles{out_dir, layer}.tile(tile, across);
 }
 
 void set_tile_distribution(TileDistribution* d) { distribution = d; }

@@ -115,7 +115,7 @@ class SitesCommand final : public Command {
     pipeline::StageSettings settings;
     for (const char* stage : {"hydro", "density"})
       schema_.settings([&] {
-        pipeline::stage(stage).prepare(scenario, dem, settings);
+        pipeline::stage(stage).prepare(scenario, grid_of(dem), settings);
         return 0;
       });
     density::DensityResult model = pipeline::run_density(scenario, settings, dem, context.progress, context.log);

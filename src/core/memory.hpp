@@ -8,5 +8,8 @@ namespace terrapolis {
 double resident_mb();
 /// Peak resident memory of this process so far (getrusage's ru_maxrss, kB on Linux), MB (10^6 bytes).
 double peak_resident_mb();
+/// Hands the heap's free pages back to the system (glibc keeps them resident after a stage frees
+/// its state), so that the next stage's memory limit counts only what is in use.
+void release_free_memory();
 
 }  // namespace terrapolis

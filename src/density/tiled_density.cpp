@@ -24,15 +24,6 @@ std::array<int, 2> reach_of_rows(const DiscPlan& plan, int row0, int rows) {
   return reach;
 }
 
-template <class T>
-Raster<T> crop(const Raster<T>& r, const Window& w) {
-  if (r.size() == 0) return r;  // a term not computed
-  Raster<T> out(w.cols, w.rows, hydro::tiled::shifted(r.georef(), w.x0, w.y0));
-  out.nodata = r.nodata;
-  for (int y = 0; y < w.rows; ++y) std::copy_n(&r(w.x0, w.y0 + y), w.cols, &out(0, y));
-  return out;
-}
-
 /// Adds a tile's figures to the mosaic's (counts exactly; areas and the density sum in tile order).
 void add_stats(DensityStats& total, const DensityStats& tile) {
   total.cells += tile.cells;
@@ -122,12 +113,12 @@ TiledDensityReport run_tiled_density(int cols, int rows, const Georef& georef, c
   DensityStats& stats = report.stats;
   pass("density by tiles", maxima, [&](int t, const DensityResult& d, const Window& core) {
     DensityResult tile;
-    tile.coast = crop(d.coast, core);
-    tile.plateau = crop(d.plateau, core);
-    tile.plain = crop(d.plain, core);
-    tile.hydrometry = crop(d.hydrometry, core);
-    tile.density = crop(d.density, core);
-    tile.buildable = crop(d.buildable, core);
+    tile.coast = hydro::tiled::crop(d.coast, core.x0, core.y0, core.cols, core.rows);
+    tile.plateau = hydro::tiled::crop(d.plateau, core.x0, core.y0, core.cols, core.rows);
+    tile.plain = hydro::tiled::crop(d.plain, core.x0, core.y0, core.cols, core.rows);
+    tile.hydrometry = hydro::tiled::crop(d.hydrometry, core.x0, core.y0, core.cols, core.rows);
+    tile.density = hydro::tiled::crop(d.density, core.x0, core.y0, core.cols, core.rows);
+    tile.buildable = hydro::tiled::crop(d.buildable, core.x0, core.y0, core.cols, core.rows);
     tile.stats = d.stats;
     add_stats(stats, d.stats);
     write(t, grid.across(), tile);

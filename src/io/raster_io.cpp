@@ -552,4 +552,21 @@ void write_vrt(const std::string& path, const std::vector<std::string>& tiles, b
   detail::commit_file(tmp, path);
 }
 
+std::string MosaicFiles::tile(int t, int across) const {
+  char file[64];
+  std::snprintf(file, sizeof file, "tile_%04d_%04d.tif", t / across, t % across);
+  return dir + "/" + name + "/" + file;
+}
+
+void MosaicFiles::create() const {
+  std::filesystem::remove_all(dir + "/" + name);  // a rerun's tiles may be cut otherwise
+  std::filesystem::create_directories(dir + "/" + name);
+}
+
+void MosaicFiles::finish(int tiles, int across) const {
+  std::vector<std::string> files;
+  for (int t = 0; t < tiles; ++t) files.push_back(tile(t, across));
+  write_vrt(vrt(), files, true);
+}
+
 }  // namespace terrapolis

@@ -40,6 +40,16 @@ void check_grid_georeferencing(const std::string& what, const RasterHeader& head
 
 /// Reads the header of `path`, applying the same checks as read_dem except for reading pixels.
 RasterHeader read_header(const std::string& path, const ReadOptions& options = {});
+/// The grid of a raster in memory: size, georeferencing, nodata.
+template <class T>
+RasterHeader grid_of(const Raster<T>& raster) {
+  RasterHeader h;
+  h.cols = raster.cols();
+  h.rows = raster.rows();
+  h.bands = 1;
+  h.georef = raster.georef();
+  return h;
+}
 
 /// Reads an elevation model as metres in float32, NaN where there is no data.
 /// Honours the nodata value (including NaN, and 65535 in UInt16), the mask band, scale/offset, and
@@ -104,5 +114,17 @@ class DemWindowReader {
 /// Writes a GDAL VRT mosaic of `tiles` (paths stored relative to the VRT's folder) under a
 /// temporary name, then renames it.
 void write_vrt(const std::string& path, const std::vector<std::string>& tiles, bool overwrite);
+
+/// A raster written tile by tile: tile t of a mosaic `across` tiles wide as
+/// DIR/NAME/tile_RRRR_CCCC.tif, then DIR/NAME.vrt over them all.
+struct MosaicFiles {
+  std::string dir, name;
+  std::string tile(int t, int across) const;
+  std::string vrt() const { return dir + "/" + name + ".vrt"; }
+  /// Creates DIR/NAME/ for the tiles, empty (DIR is a folder being written: a staging or run folder).
+  void create() const;
+  /// Writes the VRT over tiles 0 .. tiles - 1, replacing the one there.
+  void finish(int tiles, int across) const;
+};
 
 }  // namespace terrapolis

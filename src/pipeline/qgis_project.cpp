@@ -273,7 +273,7 @@ void write_geopackage(const RunState& state, const std::string& path) {
   std::vector<LayerStyle> styles;
   for (const OutputFile& o : state.outputs) {
     if (o.raster) continue;
-    layers.push_back(read_vector((state.folder / o.name).string(), state.dem.georef().crs));
+    layers.push_back(read_vector((state.folder / o.name).string(), state.grid.georef.crs));
     layers.back().name = stem(o.name);
     styles.push_back({stem(o.name), qgis_style(o, state), o.description});
   }
@@ -283,7 +283,7 @@ void write_geopackage(const RunState& state, const std::string& path) {
 }
 
 void write_qgis_styles_and_project(const RunState& state) {
-  const std::string srs = spatialrefsys(crs_definition(state.dem.georef().crs));
+  const std::string srs = spatialrefsys(crs_definition(state.grid.georef.crs));
   const std::string srs_lonlat = spatialrefsys(crs_definition(wgs84()));
 
   std::vector<const OutputFile*> layers;

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 
+#include "core/memory.hpp"
 #include "terrapolis/version.hpp"
 
 namespace terrapolis::pipeline {
@@ -31,10 +32,13 @@ Style style_from_name(const std::string& name) {
   return Style::unit_ramp;
 }
 
-template <class T>
-void RunState::write(const std::string& stage, const std::string& name, const Raster<T>& raster,
-                     Style style, const std::vector<std::pair<std::string, std::string>>& metadata) {
-  const std::string description = describe_output(name, terms);
+void TiledInput::reserve() {
+  release_free_memory();
+  reserved_mb = reserve_reader_memory(tiles.limit_mb());
+}
+
+WriteOptions RunState::file_options(const std::string& stage, const std::string& name,
+                                    const std::vector<std::pair<std::string, std::string>>& metadata) const {
   // The output folder is where, not what: it stays out of the provenance so runs compare byte for byte.
   nlohmann::ordered_json parameters = scenario.resolved;
   parameters.erase("output");
@@ -43,7 +47,7 @@ void RunState::write(const std::string& stage, const std::string& name, const Ra
   parameters["input"].erase("memory_limit_mb");
   WriteOptions options;
   options.cog = scenario.resolved["outputs"]["cog"].get<bool>();
-  options.description = description;
+  options.description = describe_output(name, terms);
   // Provenance without timestamps, so the same scenario gives the same bytes.
   options.metadata = {{"TERRAPOLIS_VERSION", terrapolis::version},
                       {"TERRAPOLIS_STAGE", stage},
@@ -52,8 +56,26 @@ void RunState::write(const std::string& stage, const std::string& name, const Ra
                       {"TERRAPOLIS_SCENARIO", parameters.dump()}};
   options.metadata.insert(options.metadata.end(), metadata.begin(), metadata.end());
   options.overwrite = true;  // the run folder is this run's own (a rerun starts from a copy)
+  return options;
+}
+
+template <class T>
+void RunState::write(const std::string& stage, const std::string& name, const Raster<T>& raster,
+                     Style style, const std::vector<std::pair<std::string, std::string>>& metadata) {
+  const WriteOptions options = file_options(stage, name, metadata);
   write_raster((folder / name).string(), raster, options);
-  outputs.push_back({name, stage, description, style, true, 0});
+  outputs.push_back({name, stage, options.description, style, true, 0});
+}
+
+template <class T>
+void RunState::write_tile(const std::string& stage, const MosaicFiles& mosaic, int t, int across, const Raster<T>& raster,
+                          const std::vector<std::pair<std::string, std::string>>& metadata) const {
+  write_raster(mosaic.tile(t, across), raster, file_options(stage, mosaic.name + ".tif", metadata));
+}
+
+void RunState::write_mosaic(const std::string& stage, const MosaicFiles& mosaic, int tiles, int across, Style style) {
+  mosaic.finish(tiles, across);
+  outputs.push_back({mosaic.name + ".vrt", stage, describe_output(mosaic.name + ".tif", terms), style, true, 0});
 }
 
 template void RunState::write(const std::string&, const std::string&, const Raster<float>&, Style,
@@ -64,6 +86,10 @@ template void RunState::write(const std::string&, const std::string&, const Rast
                               const std::vector<std::pair<std::string, std::string>>&);
 template void RunState::write(const std::string&, const std::string&, const Raster<std::uint32_t>&, Style,
                               const std::vector<std::pair<std::string, std::string>>&);
+template void RunState::write_tile(const std::string&, const MosaicFiles&, int, int, const Raster<float>&,
+                                   const std::vector<std::pair<std::string, std::string>>&) const;
+template void RunState::write_tile(const std::string&, const MosaicFiles&, int, int, const Raster<std::uint8_t>&,
+                                   const std::vector<std::pair<std::string, std::string>>&) const;
 
 void RunState::write(const std::string& stage, const std::string& name, const VectorLayer& layer, Style style) {
   const std::string description = describe_output(name, terms);

@@ -39,15 +39,28 @@ struct OutputFile {
   std::size_t features = 0;  ///< vector layers: number of features
 };
 
+/// How a run reads its DEM when it works tile by tile (input.tile_size, input.memory_limit_mb).
+struct TiledInput {
+  std::string dem_path;
+  ReadOptions read;
+  TileSettings tiles;
+  double reserved_mb = 0;  ///< what the process and the mosaic's reader hold of the memory limit
+  /// At the start of a stage: what the process holds now (the earlier stages' free heap handed back).
+  void reserve();
+};
+
 struct RunState {
-  RunState(const Scenario& s, std::filesystem::path run_folder, std::string sha256, Dem elevation)
-      : scenario(s), folder(std::move(run_folder)), dem_sha256(std::move(sha256)), dem(std::move(elevation)), terms(description_terms(s)) {}
+  RunState(const Scenario& s, std::filesystem::path run_folder, std::string sha256, Dem elevation, RasterHeader dem_grid)
+      : scenario(s), folder(std::move(run_folder)), dem_sha256(std::move(sha256)), dem(std::move(elevation)), grid(std::move(dem_grid)),
+        terms(description_terms(s)) {}
 
   const Scenario& scenario;
   StageSettings settings;  ///< every stage's settings, prepared before the first stage runs
   std::filesystem::path folder;  ///< the run folder being written (a temporary name until the end)
   std::string dem_sha256;
-  Dem dem;
+  Dem dem;            ///< the whole DEM; empty when the run works tile by tile
+  RasterHeader grid;  ///< the DEM's grid and georeferencing
+  std::optional<TiledInput> by_tiles;  ///< set: the stages read the DEM by windows and write their rasters by tiles
   plugin::PluginSet plugins;  ///< the scenario's plugins, loaded and checked before any work
   // Typed results of the stages, filled in data-flow order.
   std::optional<Raster<float>> hydrometry;        ///< hydro: [0,1]
@@ -66,8 +79,22 @@ struct RunState {
   template <class T>
   void write(const std::string& stage, const std::string& name, const Raster<T>& raster, Style style,
              const std::vector<std::pair<std::string, std::string>>& metadata = {});
+  /// Writes tile t of a raster of the run written by tiles (`mosaic.name` the file's name without
+  /// .tif), with the provenance and description write() gives the whole file.
+  template <class T>
+  void write_tile(const std::string& stage, const MosaicFiles& mosaic, int t, int across, const Raster<T>& raster,
+                  const std::vector<std::pair<std::string, std::string>>& metadata = {}) const;
+  /// Writes the VRT over a raster's tiles and records it (NAME.vrt).
+  void write_mosaic(const std::string& stage, const MosaicFiles& mosaic, int tiles, int across, Style style);
+  /// Where the run writes raster NAME by tiles.
+  MosaicFiles mosaic(const std::string& name) const { return {folder.string(), name}; }
   /// Writes a vector layer of the run and records it with its description.
   void write(const std::string& stage, const std::string& name, const VectorLayer& layer, Style style);
+
+ private:
+  /// The file options of a raster of the run: provenance without timestamps, its description.
+  WriteOptions file_options(const std::string& stage, const std::string& name,
+                            const std::vector<std::pair<std::string, std::string>>& metadata) const;
 };
 
 }  // namespace terrapolis::pipeline

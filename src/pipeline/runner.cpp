@@ -96,7 +96,7 @@ void reuse_saved(RunState& state, const json& saved, const std::string& stage, j
     if (o["stage"] != stage) continue;
     OutputFile file{o["file"].get<std::string>(), stage, o["description"].get<std::string>(), style_from_name(o.value("style", "")),
                     o["kind"] == "raster", o.value("features", std::size_t(0))};
-    if (!file.raster) state.vectors.emplace_back(file.style, read_vector((state.folder / file.name).string(), state.dem.georef().crs));
+    if (!file.raster) state.vectors.emplace_back(file.style, read_vector((state.folder / file.name).string(), state.grid.georef.crs));
     state.outputs.push_back(file);
   }
   if (saved["summary"].contains(stage)) state.summary[stage] = saved["summary"][stage];
@@ -163,12 +163,27 @@ json run_scenario(const Scenario& scenario, const RunOptions& options, Progress&
   const std::vector<Action> plan = plan_stages(options);
   const std::string dem_path = scenario.path("dem");
   const ReadOptions read = read_options(scenario.resolved["input"]["band"].get<int>(), scenario.resolved["input"]["assume_crs"].get<std::string>());
-  Dem dem = read_dem(dem_path, read);  // before creating anything: bad input leaves no folder
+  // Before creating anything, so that bad input leaves no folder: the whole DEM, or its grid when
+  // the stages read it by windows (docs/scale.md).
+  const TileSettings tiles = tile_settings(scenario);
+  Dem dem;
+  RasterHeader grid;
+  if (tiles.given()) {
+    grid = DemWindowReader(dem_path, read).header();
+  } else {
+    dem = read_dem(dem_path, read);
+    grid = grid_of(dem);
+  }
+  const std::size_t last = options.until.empty() ? stages().size() - 1 : stage_index("--until", options.until);
+  if (tiles.given() && last > stage_index("--until", kLastTiledStage))
+    throw bad_input(scenario.source + std::string(tiles.tile_size > 0 ? ": /input/tile_size" : ": /input/memory_limit_mb") +
+                    ": a run works tile by tile up to the density stage yet (sites, network, roads and access read the whole grid): "
+                    "add --until density");
   // Every stage's settings and checks before the first stage runs, and before anything is created.
   StageSettings settings;
   for (const StageDef& stage : stages()) {
     try {
-      stage.prepare(scenario, dem, settings);
+      stage.prepare(scenario, grid, settings);
     } catch (const Error& e) {
       throw Error(e.kind(), scenario.source + ": " + e.what());
     }
@@ -185,13 +200,17 @@ json run_scenario(const Scenario& scenario, const RunOptions& options, Progress&
   const json files = input_files(scenario);
   if (rerun) check_reusable(output, saved, scenario, dem_sha256, files, plan);
   {
-    RunState state(scenario, temp, dem_sha256, std::move(dem));
+    RunState state(scenario, temp, dem_sha256, std::move(dem), grid);
+    if (tiles.given()) state.by_tiles = TiledInput{dem_path, read, tiles, 0};
     state.plugins = std::move(plugins);
     state.settings = std::move(settings);
     json timings = json::array();
     json ran = json::array(), reused = json::array(), stale = json::array();
-    const std::size_t last = options.until.empty() ? stages().size() - 1 : stage_index("--until", options.until);
-    if (rerun && last + 1 < stages().size()) throw bad_input("--until: only for a new run (not with --from or --only)");
+    // A rerun may stop where its saved run stopped (a run by tiles, made --until density), never
+    // before a stage it made: that stage's files would stay without their entry in run.json.
+    for (std::size_t i = last + 1; rerun && i < stages().size(); ++i)
+      if (saved["summary"].contains(stages()[i].name))
+        throw bad_input(std::string("--until: the run made the ") + stages()[i].name + " stage: a rerun goes on to its last stage");
     for (std::size_t i = 0; i <= last; ++i) {
       const StageDef& stage = stages()[i];
       const Log stage_log = log.stage(stage.name);
@@ -217,8 +236,8 @@ json run_scenario(const Scenario& scenario, const RunOptions& options, Progress&
     manifest["scenario"] = scenario.resolved;
     manifest["scenario_source"] = scenario.source;
     manifest["input"] = {{"dem", dem_path}, {"sha256", state.dem_sha256}, {"bytes", input_bytes(dem_path)},
-                         {"crs", state.dem.georef().crs.name},
-                         {"epsg", state.dem.georef().crs.epsg ? json(*state.dem.georef().crs.epsg) : json(nullptr)}, {"files", files}};
+                         {"crs", state.grid.georef.crs.name},
+                         {"epsg", state.grid.georef.crs.epsg ? json(*state.grid.georef.crs.epsg) : json(nullptr)}, {"files", files}};
     json libs = json::object();
     for (const auto& [name, version] : io_library_versions()) libs[name] = version;
     manifest["libraries"] = libs;

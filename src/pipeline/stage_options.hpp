@@ -29,6 +29,8 @@ struct TileSettings {
   double memory_limit_mb = 0;  ///< 0: none given
   /// Tile by tile: a tile size or a memory limit given, or the DEM is a folder of tiles.
   bool tiled(const std::string& dem_path) const;
+  /// A tile size or a memory limit given (a run works tile by tile only then).
+  bool given() const { return tile_size > 0 || memory_limit_mb > 0; }
   /// The limit the tiles are sized to: the one given, or 1 GB.
   double limit_mb() const { return memory_limit_mb > 0 ? memory_limit_mb : 1024; }
 };

@@ -5,11 +5,14 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <mutex>
 #include <optional>
 
 #include "core/error.hpp"
 #include "core/geodesy.hpp"
 #include "density/tiled_density.hpp"
+#include "hydro/tiled/tiled_hydro.hpp"
+#include "pipeline/by_tiles.hpp"
 #include "io/mask_io.hpp"
 #include "io/raster_io.hpp"
 #include "network/layers.hpp"
@@ -47,29 +50,68 @@ void named(const std::string& pointer, Check&& check) {
 
 // ---- terrain -------------------------------------------------------------------------------
 
-void terrain_run(RunState& s, Progress&, const Log&) {
-  s.write("terrain", "elevation.tif", s.dem, Style::elevation);
-  s.write("terrain", "hillshade.tif", hillshade(s.dem), Style::hillshade);
+/// The altitudes' range and cells with data, gathered over the DEM or its tiles.
+struct AltitudeRange {
   double lo = 1e300, hi = -1e300;
   std::size_t valid = 0;
-  for (float v : s.dem.values()) {
-    if (std::isnan(v)) continue;
-    lo = std::min(lo, double(v));
-    hi = std::max(hi, double(v));
-    ++valid;
+  void add(const Dem& dem) {
+    for (float v : dem.values()) {
+      if (std::isnan(v)) continue;
+      lo = std::min(lo, double(v));
+      hi = std::max(hi, double(v));
+      ++valid;
+    }
   }
-  s.summary["terrain"] = {{"cols", s.dem.cols()}, {"rows", s.dem.rows()}, {"min_m", lo}, {"max_m", hi},
-                          {"nodata_share", 1.0 - double(valid) / double(s.dem.size())}};
+  json figures(const RasterHeader& g) const {
+    return {{"cols", g.cols}, {"rows", g.rows}, {"min_m", lo}, {"max_m", hi}, {"nodata_share", 1.0 - double(valid) / (double(g.cols) * double(g.rows))}};
+  }
+};
+
+/// The tiles a stage of a run by tiles writes, sized to the memory limit for `bytes_per_cell` of state.
+hydro::tiled::TileGrid run_tiles(const RunState& s, int halo) {
+  const TiledInput& in = *s.by_tiles;
+  const int side = in.tiles.tile_size > 0 ? in.tiles.tile_size
+                                          : density::density_tile_size_for(s.grid.cols, s.grid.rows, halo, halo, 0, in.tiles.limit_mb(), in.reserved_mb);
+  return hydro::tiled::TileGrid(s.grid.cols, s.grid.rows, side);
+}
+
+/// The terrain by tiles: each tile read with a one-cell halo for its hillshade.
+void terrain_run_tiles(RunState& s, Progress& progress) {
+  s.by_tiles->reserve();
+  const DemWindowReader reader(s.by_tiles->dem_path, s.by_tiles->read);
+  const hydro::tiled::TileGrid grid = run_tiles(s, 1);
+  const MosaicFiles elevation = s.mosaic("elevation"), shade = s.mosaic("hillshade");
+  elevation.create();
+  shade.create();
+  AltitudeRange range;
+  ProgressStep step(progress, "terrain by tiles");
+  for (int t = 0; t < grid.count(); ++t) {
+    const hydro::tiled::TileRect r = grid.rect(t);
+    const int c0 = std::max(0, r.col0 - 1), r0 = std::max(0, r.row0 - 1);
+    const Dem window = reader.read(c0, r0, std::min(s.grid.cols, r.col0 + r.cols + 1) - c0, std::min(s.grid.rows, r.row0 + r.rows + 1) - r0);
+    const Dem z = hydro::tiled::crop(window, r.col0 - c0, r.row0 - r0, r.cols, r.rows);
+    s.write_tile("terrain", elevation, t, grid.across(), z);
+    s.write_tile("terrain", shade, t, grid.across(), hydro::tiled::crop(hillshade(window), r.col0 - c0, r.row0 - r0, r.cols, r.rows));
+    range.add(z);
+    step.update(double(t + 1) / grid.count());
+  }
+  s.write_mosaic("terrain", elevation, grid.count(), grid.across(), Style::elevation);
+  s.write_mosaic("terrain", shade, grid.count(), grid.across(), Style::hillshade);
+  s.summary["terrain"] = range.figures(s.grid);
+}
+
+void terrain_run(RunState& s, Progress& progress, const Log&) {
+  if (s.by_tiles) return terrain_run_tiles(s, progress);
+  s.write("terrain", "elevation.tif", s.dem, Style::elevation);
+  s.write("terrain", "hillshade.tif", hillshade(s.dem), Style::hillshade);
+  AltitudeRange range;
+  range.add(s.dem);
+  s.summary["terrain"] = range.figures(s.grid);
 }
 
 void terrain_load(RunState&) {}  // the DEM is always read from the input
 
-void terrain_prepare(const Scenario& scenario, const Dem&, Settings&) {
-  // Only the hydro and density commands work tile by tile yet (docs/scale.md): a run refuses it.
-  if (const TileSettings t = tile_settings(scenario); t.tile_size > 0 || t.memory_limit_mb > 0)
-    throw bad_input(std::string(t.tile_size > 0 ? "/input/tile_size" : "/input/memory_limit_mb") +
-                    ": a run does not work tile by tile yet (only the hydro and density commands do)");
-}
+void terrain_prepare(const Scenario& scenario, const RasterHeader&, Settings&) { tile_settings(scenario); }
 
 void terrain_summary(const json& figures, SummaryText& out) {
   const json& t = figures["terrain"];
@@ -81,48 +123,130 @@ void terrain_summary(const json& figures, SummaryText& out) {
 
 constexpr const char* kInlandWater = "inland_water.tif";
 
+void inland_water_figures(RunState& s, std::size_t flat_lakes, double flat_lake_km2);
+
 /// The inland water (pipeline::inland_water) as inland_water.tif, which the density, the roads and
 /// the access stages read back.
 void write_inland_water(RunState& s, Progress& progress, const Log& log) {
   InlandWater water = inland_water(s.dem, s.settings.water, progress, log);
   s.write("hydro", kInlandWater, water.mask, Style::water);
-  s.summary["hydro"]["flat_lakes"] = water.flat_lakes;
-  s.summary["hydro"]["flat_lake_km2"] = round_to(water.flat_lake_km2, 0.01);
+  inland_water_figures(s, water.flat_lakes, water.flat_lake_km2);
   if (!water.reservoirs.empty()) s.summary["hydro"]["reservoirs"] = std::move(water.reservoirs);
 }
 
 // ---- hydro (Belhadj 2007 §4.2.2; Barnes et al. 2014; docs/hydro.md) ----------------------
 
-void hydro_run(RunState& s, Progress& progress, const Log& log) {
-  const hydro::HydroOptions& options = s.settings.hydro;
-  hydro::HydroResult r = hydro::run_hydro(s.dem, options, progress);
-  if (const auto& types = s.settings.river_types) hydro::classify_streams(r.streams, r.filled, options.sea_level, *types);
-  const json& h = s.scenario.resolved["hydro"];
-  const hydro::D8Codes codes = s.settings.d8_codes;
-  s.write("hydro", "filled.tif", r.filled, Style::elevation);
-  s.write("hydro", "flowdir.tif", hydro::encode_d8(r.d8, codes), Style::flow_direction,
-          {{"D8_CODES", h["d8_codes"].get<std::string>()}, {"D8_CODES_DESCRIPTION", hydro::describe(codes)}});
-  Raster<float> area = r.filled.like<float>(NAN);
-  double largest_km2 = 0;
+/// The flow directions' metadata: their code convention.
+std::vector<std::pair<std::string, std::string>> d8_metadata(const RunState& s) {
+  return {{"D8_CODES", s.scenario.resolved["hydro"]["d8_codes"].get<std::string>()}, {"D8_CODES_DESCRIPTION", hydro::describe(s.settings.d8_codes)}};
+}
+
+/// The upstream area in km2 as accumulation.tif holds it (from m2), and its largest value.
+Raster<float> area_km2(const Raster<double>& accumulation_m2, double& largest_km2) {
+  Raster<float> area = accumulation_m2.like<float>(NAN);
   for (std::size_t i = 0; i < area.size(); ++i) {
-    area[i] = float(r.accumulation[i] * 1e-6);
+    area[i] = float(accumulation_m2[i] * 1e-6);
     if (!std::isnan(area[i])) largest_km2 = std::max(largest_km2, double(area[i]));
   }
-  s.write("hydro", "accumulation.tif", area, Style::accumulation, {{"UNIT", "km2"}});
-  s.write("hydro", "hydrometry.tif", r.hydrometry, Style::unit_ramp);
-  s.write("hydro", "streams.geojson", r.streams, Style::streams);
-  const int f_order = r.streams.field_index("strahler"), f_length = r.streams.field_index("length_m");
+  return area;
+}
+
+json hydro_figures(const VectorLayer& streams, double largest_km2, int belhadj_iterations) {
+  const int f_order = streams.field_index("strahler"), f_length = streams.field_index("length_m");
   std::int64_t max_order = 0;
   double length_m = 0;
-  for (const auto& f : r.streams.features) {
+  for (const auto& f : streams.features) {
     max_order = std::max(max_order, std::get<std::int64_t>(f.values[std::size_t(f_order)]));
     length_m += std::get<double>(f.values[std::size_t(f_length)]);
   }
-  s.summary["hydro"] = {{"stream_reaches", r.streams.features.size()},
-                        {"stream_length_km", round_to(length_m / 1000, 0.01)},
-                        {"max_strahler", max_order},
-                        {"largest_catchment_km2", round_to(largest_km2, 0.01)},
-                        {"belhadj_iterations", r.hydrometry_iterations}};
+  return {{"stream_reaches", streams.features.size()},
+          {"stream_length_km", round_to(length_m / 1000, 0.01)},
+          {"max_strahler", max_order},
+          {"largest_catchment_km2", round_to(largest_km2, 0.01)},
+          {"belhadj_iterations", belhadj_iterations}};
+}
+
+void inland_water_figures(RunState& s, std::size_t flat_lakes, double flat_lake_km2) {
+  s.summary["hydro"]["flat_lakes"] = flat_lakes;
+  s.summary["hydro"]["flat_lake_km2"] = round_to(flat_lake_km2, 0.01);
+}
+
+/// The hydro stage by tiles (docs/scale.md): the tile engine's fill, directions, accumulation and
+/// streams, then Belhadj's hydrometry and the inland water by tiles.
+void hydro_run_tiles(RunState& s, Progress& progress, const Log& log) {
+  s.by_tiles->reserve();
+  const TiledInput& in = *s.by_tiles;
+  const hydro::HydroOptions& options = s.settings.hydro;
+  const DemWindowReader reader(in.dem_path, in.read);
+  const RasterHeader& g = s.grid;
+  const std::filesystem::path scratch = s.folder / ".scratch";
+  std::filesystem::create_directories(scratch);
+  hydro::tiled::TiledOptions o;
+  o.memory_limit_mb = in.tiles.limit_mb();
+  o.reserved_mb = in.reserved_mb;
+  o.sea_level = options.sea_level;
+  o.streams_threshold_m2 = options.streams.threshold_km2 * 1e6;
+  o.concurrent_tiles = hydro::tiled::allowed_threads();
+  o.scratch_dir = scratch.string();
+  o.tile_size = in.tiles.tile_size > 0 ? in.tiles.tile_size
+                                       : hydro::tiled::tile_size_for(g.cols, g.rows, o.memory_limit_mb, o.concurrent_tiles, in.reserved_mb);
+  const int across = hydro::tiled::TileGrid(g.cols, g.rows, o.tile_size).across();
+  const MosaicFiles filled = s.mosaic("filled"), flowdir = s.mosaic("flowdir"), accumulation = s.mosaic("accumulation");
+  for (const MosaicFiles* m : {&filled, &flowdir, &accumulation}) m->create();
+  std::mutex largest_lock;
+  double largest_km2 = 0;
+  VectorLayer streams;
+  hydro::tiled::TileSinks sinks;
+  sinks.filled = [&](int t, const Dem& z) { s.write_tile("hydro", filled, t, across, z); };
+  sinks.d8 = [&](int t, const Raster<std::uint8_t>& d8) { s.write_tile("hydro", flowdir, t, across, hydro::encode_d8(d8, s.settings.d8_codes), d8_metadata(s)); };
+  sinks.accumulation = [&](int t, const Raster<double>& m2) {
+    double largest = 0;
+    s.write_tile("hydro", accumulation, t, across, area_km2(m2, largest), {{"UNIT", "km2"}});
+    const std::lock_guard<std::mutex> lock(largest_lock);
+    largest_km2 = std::max(largest_km2, largest);
+  };
+  sinks.streams = [&](hydro::StreamCells& cells) {
+    streams = hydro::streams_of_cells(cells, g.georef, cell_metrics(g.georef, g.cols, g.rows), progress);
+    cells = {};
+  };
+  hydro::tiled::LocalTiles here;
+  const hydro::tiled::TiledReport report = hydro::tiled::run_tiled_hydro(
+      g.cols, g.rows, g.georef, [&](int c0, int r0, int cols, int rows) { return reader.read(c0, r0, cols, rows); }, o, sinks, progress, here);
+  s.write_mosaic("hydro", filled, report.tiles, across, Style::elevation);
+  s.write_mosaic("hydro", flowdir, report.tiles, across, Style::flow_direction);
+  s.write_mosaic("hydro", accumulation, report.tiles, across, Style::accumulation);
+  const MosaicFiles hydrometry = s.mosaic("hydrometry");
+  hydrometry.create();
+  const hydro::tiled::TiledBelhadjReport b = hydrometry_by_tiles(
+      reader, options, in.tiles, in.reserved_mb, scratch.string(),
+      [&](int t, int n, const Raster<float>& tile) { s.write_tile("hydro", hydrometry, t, n, tile); }, progress);
+  s.write_mosaic("hydro", hydrometry, b.tiles, b.across, Style::unit_ramp);
+  s.write("hydro", "streams.geojson", streams, Style::streams);
+  s.summary["hydro"] = hydro_figures(streams, largest_km2, b.iterations);
+  log.detail("hydro tiles: " + std::to_string(report.tiles) + " of " + std::to_string(report.tile_size) + " cells a side; " + describe(b));
+  const MosaicFiles water = s.mosaic(std::filesystem::path(kInlandWater).stem().string());
+  water.create();
+  const InlandWaterTiles w = inland_water_by_tiles(
+      reader, s.settings.water, in.tiles, in.reserved_mb,
+      [&](int t, int n, const Raster<std::uint8_t>& tile) { s.write_tile("hydro", water, t, n, tile); }, progress);
+  s.write_mosaic("hydro", water, w.tiles, w.across, Style::water);
+  inland_water_figures(s, w.flat_lakes, w.flat_lake_km2);
+  log.detail(describe(w));
+  std::filesystem::remove_all(scratch);
+}
+
+void hydro_run(RunState& s, Progress& progress, const Log& log) {
+  if (s.by_tiles) return hydro_run_tiles(s, progress, log);
+  const hydro::HydroOptions& options = s.settings.hydro;
+  hydro::HydroResult r = hydro::run_hydro(s.dem, options, progress);
+  if (const auto& types = s.settings.river_types) hydro::classify_streams(r.streams, r.filled, options.sea_level, *types);
+  s.write("hydro", "filled.tif", r.filled, Style::elevation);
+  s.write("hydro", "flowdir.tif", hydro::encode_d8(r.d8, s.settings.d8_codes), Style::flow_direction, d8_metadata(s));
+  double largest_km2 = 0;
+  s.write("hydro", "accumulation.tif", area_km2(r.accumulation, largest_km2), Style::accumulation, {{"UNIT", "km2"}});
+  s.write("hydro", "hydrometry.tif", r.hydrometry, Style::unit_ramp);
+  s.write("hydro", "streams.geojson", r.streams, Style::streams);
+  s.summary["hydro"] = hydro_figures(r.streams, largest_km2, r.hydrometry_iterations);
   if (r.hydrometry_iterations > 0) log.detail("belhadj: " + std::to_string(r.hydrometry_iterations) + " iterations");
   s.hydrometry = std::move(r.hydrometry);
   write_inland_water(s, progress, log);
@@ -130,6 +254,7 @@ void hydro_run(RunState& s, Progress& progress, const Log& log) {
 }
 
 void hydro_load(RunState& s) {
+  if (s.by_tiles) return;  // the density stage reads the hydrometry and the inland water by windows
   s.hydrometry = read_resampled(saved(s, "hydrometry.tif"), s.dem.georef(), s.dem.cols(), s.dem.rows(), Resampling::nearest);
   const Raster<float> km2 = read_resampled(saved(s, "accumulation.tif"), s.dem.georef(), s.dem.cols(), s.dem.rows(), Resampling::nearest);
   Raster<double> m2 = s.dem.like<double>(NAN);
@@ -137,12 +262,21 @@ void hydro_load(RunState& s) {
   s.rivers = river_cells(m2, s.scenario);
 }
 
-void hydro_prepare(const Scenario& scenario, const Dem&, Settings& s) {
+void hydro_prepare(const Scenario& scenario, const RasterHeader&, Settings& s) {
   s.water = inland_water_settings(scenario);
   s.hydro = hydro_options(scenario);
   s.river_types = river_type_options(scenario);
   s.d8_codes = d8_codes(scenario);
   check_file("/water/water_mask", s.water.water_mask);
+  if (!tile_settings(scenario).given()) return;
+  // What the tile engine computes (docs/scale.md): Priority-Flood, D8, Belhadj's hydrometry, the flattened lakes.
+  const json& h = scenario.resolved["hydro"];
+  const auto refuse = [](const std::string& what) { throw bad_input(what + ": not computed on tiles yet (input.tile_size, input.memory_limit_mb)"); };
+  if (s.hydro.fill != hydro::FillMethod::priority_flood) refuse("/hydro/fill " + h["fill"].get<std::string>());
+  if (s.hydro.flow != hydro::FlowMethod::d8) refuse("/hydro/flow " + h["flow"].get<std::string>());
+  if (s.hydro.hydrometry.method != hydro::HydrometryMethod::belhadj) refuse("/hydro/hydrometry " + h["hydrometry"].get<std::string>());
+  if (s.river_types) refuse("/hydro/classify");
+  if (!s.water.reservoirs.empty()) refuse("/water/reservoirs");
 }
 
 void hydro_summary(const json& figures, SummaryText& out) {
@@ -169,27 +303,60 @@ density::DensityOptions density_inputs(const RunState& s) {
   return density_inputs(s.scenario, s.settings, s.dem, read_mask(saved(s, kInlandWater), s.dem.georef(), s.dem.cols(), s.dem.rows()), s.rivers);
 }
 
+json density_figures(const RunState& s, const density::DensityStats& st) {
+  const std::size_t land = st.known_cells - st.water_cells;
+  return {{"buildable_land_share", land ? round_to(double(st.buildable_cells) / double(land), 1e-4) : 0.0},
+          {"water_share", st.known_cells ? round_to(double(st.water_cells) / double(st.known_cells), 1e-4) : 0.0},
+          {"mean_density", round_to(st.mean_density, 1e-4)},
+          {"land_area_km2", land_area_figure(st)},
+          {"preset", s.scenario.resolved["density"]["preset"]}};
+}
+
+/// The density's rasters: the three characteristics, the buildable mask, the density.
+constexpr std::pair<const char*, Style> kDensityRasters[] = {
+    {"coast", Style::unit_ramp}, {"plateau", Style::unit_ramp}, {"plain", Style::unit_ramp}, {"buildable", Style::mask}, {"density", Style::density}};
+
+/// The density stage by tiles (density::run_tiled_density), reading the hydro stage's hydrometry
+/// and inland water by windows.
+void density_run_tiles(RunState& s, Progress& progress, const Log& log) {
+  s.by_tiles->reserve();
+  const TiledInput& in = *s.by_tiles;
+  const DemWindowReader reader(in.dem_path, in.read), hydrometry(saved(s, "hydrometry.vrt"));
+  const density::DensityOptions& options = s.settings.density;
+  const density::ReadWindowInputs read = density_windows(reader, s.scenario, options, saved(s, "inland_water.vrt"),
+                                                         [&](const Dem& w, int c0, int r0) { return hydrometry.read(c0, r0, w.cols(), w.rows()); });
+  for (const auto& [name, style] : kDensityRasters) s.mosaic(name).create();
+  const density::TiledDensityReport report = density::run_tiled_density(
+      s.grid.cols, s.grid.rows, s.grid.georef, read, options, in.tiles.tile_size, in.tiles.limit_mb(),
+      [&](int t, int across, const density::DensityResult& d) {
+        const Raster<float>* floats[] = {&d.coast, &d.plateau, &d.plain};
+        for (int k = 0; k < 3; ++k) s.write_tile("density", s.mosaic(kDensityRasters[k].first), t, across, *floats[k]);
+        s.write_tile("density", s.mosaic("buildable"), t, across, d.buildable);
+        s.write_tile("density", s.mosaic("density"), t, across, d.density);
+      },
+      progress, in.reserved_mb);
+  for (const auto& [name, style] : kDensityRasters) s.write_mosaic("density", s.mosaic(name), report.tiles, report.across, style);
+  s.summary["density"] = density_figures(s, report.stats);
+  log.detail("density tiles: " + std::to_string(report.tiles) + " of " + std::to_string(report.tile_size) + " cells a side, halo " +
+             std::to_string(report.halo_cols) + " x " + std::to_string(report.halo_rows) + " cells");
+}
+
 void density_run(RunState& s, Progress& progress, const Log& log) {
+  if (s.by_tiles) return density_run_tiles(s, progress, log);
   density::DensityOptions options = density_inputs(s);
   plugin::add_to_density(plugin::density_factors(s.plugins, s.dem, progress, log), options);
   density::DensityResult r = density::compute_density(s.dem, *s.hydrometry, options, progress);
-  const std::pair<const char*, const Raster<float>*> characteristics[] = {{"coast", &r.coast}, {"plateau", &r.plateau}, {"plain", &r.plain}};
-  for (const auto& [name, raster] : characteristics)
-    s.write("density", std::string(name) + ".tif", *raster, Style::unit_ramp);
+  const Raster<float>* floats[] = {&r.coast, &r.plateau, &r.plain};
+  for (int k = 0; k < 3; ++k) s.write("density", std::string(kDensityRasters[k].first) + ".tif", *floats[k], kDensityRasters[k].second);
   s.write("density", "buildable.tif", r.buildable, Style::mask);
   s.write("density", "density.tif", r.density, Style::density);
-  const auto& st = r.stats;
-  const std::size_t land = st.known_cells - st.water_cells;
-  s.summary["density"] = {{"buildable_land_share", land ? round_to(double(st.buildable_cells) / double(land), 1e-4) : 0.0},
-                          {"water_share", st.known_cells ? round_to(double(st.water_cells) / double(st.known_cells), 1e-4) : 0.0},
-                          {"mean_density", round_to(st.mean_density, 1e-4)},
-                          {"land_area_km2", land_area_figure(st)},
-                          {"preset", s.scenario.resolved["density"]["preset"]}};
+  s.summary["density"] = density_figures(s, r.stats);
   s.density = std::move(r.density);
   s.buildable = std::move(r.buildable);
 }
 
 void density_load(RunState& s) {
+  if (s.by_tiles) return;  // no later stage runs on tiles yet
   DensityFolder saved_outputs = read_density_folder(s.folder.string());
   if (saved_outputs.density.cols() != s.dem.cols() || saved_outputs.density.rows() != s.dem.rows())
     throw bad_input(saved(s, "density.tif") + ": not on the DEM's grid");
@@ -197,14 +364,23 @@ void density_load(RunState& s) {
   s.buildable = std::move(saved_outputs.buildable);
 }
 
-void density_prepare(const Scenario& scenario, const Dem& dem, Settings& s) {
+void density_prepare(const Scenario& scenario, const RasterHeader& grid, Settings& s) {
   s.density = density_options(scenario);
   const json& density = scenario.resolved["density"];
   for (std::size_t i = 0; i < density["layers"].size(); ++i)
     check_file("/density/layers/" + std::to_string(i) + "/file", scenario.file(density["layers"][i]["file"].get<std::string>()));
   for (std::size_t i = 0; i < density["exclusions"].size(); ++i)
     check_file("/density/exclusions/" + std::to_string(i), scenario.file(density["exclusions"][i].get<std::string>()));
-  density::raised_r_min(cell_metrics(dem.georef(), dem.cols(), dem.rows()), s.density);  // r_max against r_min raised to this grid's cells
+  density::raised_r_min(cell_metrics(grid.georef, grid.cols, grid.rows), s.density);  // r_max against r_min raised to this grid's cells
+  if (!tile_settings(scenario).given()) return;
+  // The terrain terms rank and measure distances over the whole grid; layers are rescaled by their whole range.
+  for (std::size_t t = 0; t < density::kTerrainCount; ++t)
+    if (s.density.terrain_weights[t] != 0)
+      throw bad_input(std::string("/density/weights/") + density::kTerrainTerms[t] + ": the terrain terms are not computed on tiles yet "
+                      "(they rank the whole grid): give density.preset belhadj2007 or weight 0");
+  if (!density["layers"].empty()) throw bad_input("/density/layers: not computed on tiles yet");
+  if (!density["model"].get<std::string>().empty()) throw bad_input("/density/model: not computed on tiles yet");
+  if (!scenario.resolved["plugins"].empty()) throw bad_input("/plugins: not run on tiles yet");
 }
 
 void density_summary(const json& figures, SummaryText& out) {
@@ -347,13 +523,13 @@ void sites_load(RunState& s) {
   sites::snap_to_cells(s.sites, s.dem.georef(), s.dem.cols(), s.dem.rows());  // the network a full run builds
 }
 
-void sites_prepare(const Scenario& scenario, const Dem& dem, Settings& s) {
+void sites_prepare(const Scenario& scenario, const RasterHeader& grid, Settings& s) {
   s.sites = sites_options(scenario);
   check_file("/sites/reference", scenario.path("/sites/reference"));
   if (const std::string existing = scenario.path("/sites/existing"); !existing.empty()) {
     check_file("/sites/existing", existing);
     // Its format and figures now (whether each place finds land needs the density).
-    named("/sites/existing", [&] { check_existing_places(existing, dem.georef().crs); });
+    named("/sites/existing", [&] { check_existing_places(existing, grid.georef.crs); });
   }
 }
 
@@ -441,7 +617,7 @@ void network_run(RunState& s, Progress& progress, const Log&) {
 
 void network_load(RunState& s) { s.network = read_vector(saved(s, "network.geojson"), s.dem.georef().crs); }
 
-void network_prepare(const Scenario& scenario, const Dem&, Settings& s) { s.network = network_options(scenario); }
+void network_prepare(const Scenario& scenario, const RasterHeader&, Settings& s) { s.network = network_options(scenario); }
 
 void network_summary(const json& figures, SummaryText& out) {
   const json& n = figures["network"];
@@ -572,7 +748,7 @@ void roads_run(RunState& s, Progress& progress, const Log& log) {
 
 void roads_load(RunState&) {}  // the access stage reads the saved layers
 
-void roads_prepare(const Scenario& scenario, const Dem& dem, Settings& s) {
+void roads_prepare(const Scenario& scenario, const RasterHeader& grid, Settings& s) {
   s.roads = roads_settings(scenario);
   s.corridor = corridor_settings(scenario);
   check_file("/roads/corridor/side_angles", s.corridor.side_angles);
@@ -580,7 +756,7 @@ void roads_prepare(const Scenario& scenario, const Dem& dem, Settings& s) {
   if (const std::string& lines = s.roads.existing; !lines.empty()) {
     check_file("/roads/existing", lines);
     // Its CRS and geometry now (which roads lie on the DEM needs its grid).
-    named("/roads/existing", [&] { roads::check_existing_roads(lines, dem.georef().crs); });
+    named("/roads/existing", [&] { roads::check_existing_roads(lines, grid.georef.crs); });
   }
 }
 
@@ -682,7 +858,7 @@ void access_run(RunState& s, Progress& progress, const Log& log) {
 
 void access_load(RunState&) {}  // nothing downstream
 
-void access_prepare(const Scenario& scenario, const Dem&, Settings& s) { s.access = access_settings(scenario); }
+void access_prepare(const Scenario& scenario, const RasterHeader&, Settings& s) { s.access = access_settings(scenario); }
 
 void access_summary(const json& figures, SummaryText& out) {
   const json& a = figures["access"];

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/progress.hpp"
+#include "io/raster_io.hpp"
 #include "pipeline/run_state.hpp"
 
 namespace terrapolis::pipeline {
@@ -38,7 +39,7 @@ struct StageDef {
   /// Builds the stage's settings into `settings` and makes every check that needs no earlier
   /// stage's result (the settings against each other and the DEM's grid, the files the stage reads).
   /// Throws bad_input naming the setting's JSON pointer ("/sites/u_max: must be >= /sites/u_min").
-  void (*prepare)(const Scenario&, const Dem&, StageSettings& settings);
+  void (*prepare)(const Scenario&, const RasterHeader& grid, StageSettings& settings);
   /// Computes the stage from the state and writes its files into state.folder.
   void (*run)(RunState&, Progress&, const Log&);
   /// Reads the stage's typed results back from its saved files in state.folder (reruns).
@@ -47,6 +48,9 @@ struct StageDef {
   /// holds this stage's entry).
   void (*summary)(const nlohmann::ordered_json& figures, SummaryText&);
 };
+
+/// The last stage a run works tile by tile (input.tile_size, input.memory_limit_mb): the later ones read the whole grid.
+inline constexpr const char* kLastTiledStage = "density";
 
 /// The stages, in data-flow order: the one list the runner, --help and the docs read.
 const std::vector<StageDef>& stages();

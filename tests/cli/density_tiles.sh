@@ -54,7 +54,7 @@ nz=$samples/spDataLarge_nz_elev.tif
 for o in coast plateau hydrometry buildable density; do
   same_cells "$work/nz_whole/$o.tif" "$work/nz_tiled/$o.vrt" || fail "nz: tiled $o differs (lakes by tiles)"
 done
-grep -q "^flat water tiles: 20 of 300 cells a side, 10 lakes the DEM flattens, 133.00 km2" "$work/nz.log" ||
+grep -q "^inland water tiles: 20 of 300 cells a side, 10 lakes the DEM flattens, 133.00 km2" "$work/nz.log" ||
   fail "no flat water tile report: $(grep tiles "$work/nz.log")"
 
 # North Corsica (GEBCO 15", sea below 0) through a VRT, hydrometry neutral, on one thread: coasts
@@ -92,5 +92,5 @@ expect_refused "$work/r2" "--layer: .*not computed on tiles" "$bin" density "$zi
 expect_refused "$work/r3" "--tile-size: must be at least 8" "$bin" density "$zion" "$work/r3" --tile-size 3
 expect_refused "$work/r4" "--memory-limit: .*too little" "$bin" density "$zion" "$work/r4" --weights 1,0,1.5,0 --memory-limit 1
 echo "density tiles: ok"
-expect_fail 2 "/input/tile_size: a run does not work tile by tile yet" "$bin" run -o "$work/r5" --set input.tile_size=100
+expect_fail 2 "/input/tile_size: a run works tile by tile up to the density stage yet" "$bin" run -o "$work/r5" --set input.tile_size=100
 [[ ! -e $work/r5 ]] || fail "a refused run left its folder"

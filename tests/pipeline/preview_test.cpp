@@ -21,7 +21,9 @@ TEST(Preview, SmallWidthsOnEverySampleDem) {
   for (const char* name : {"spDataLarge_dem_mongon.tif", "spDataLarge_nz_elev.tif", "spDataLarge_srtm_zion.tif",
                            "stars_olinda_dem_utm25s.tif", "terra_elev_luxembourg.tif", "whiteboxR_DEM_vermont.tif",
                            "gebco2022_15s_north_corsica_capcorse.asc"}) {
-    RunState state(scenario, dir, "", read_dem(std::string(TERRAPOLIS_SAMPLES) + "/" + name));
+    Dem dem = read_dem(std::string(TERRAPOLIS_SAMPLES) + "/" + name);
+    const RasterHeader grid = grid_of(dem);
+    RunState state(scenario, dir, "", std::move(dem), grid);
     state.density = state.dem.like<float>(0.5f);
     for (int width : {64, 65, 66, 80, 99, 100, 127, 128, 200}) {
       const std::string png = (dir / (std::string(name) + "-" + std::to_string(width) + ".png")).string();

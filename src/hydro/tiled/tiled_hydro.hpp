@@ -2,6 +2,7 @@
 // and written tile by tile, in bounded memory, bit-identical to the whole-grid computation.
 // SPDX-License-Identifier: MIT
 #pragma once
+#include <algorithm>
 #include <cstdint>
 #include <exception>
 #include <functional>
@@ -41,6 +42,16 @@ class TileGrid {
 
 /// The georeferencing of the window of `g`'s grid whose first cell is (col0, row0).
 Georef shifted(const Georef& g, int col0, int row0);
+
+/// The cells [x0, x0 + cols) x [y0, y0 + rows) of `r` as a raster of their own (empty stays empty).
+template <class T>
+Raster<T> crop(const Raster<T>& r, int x0, int y0, int cols, int rows) {
+  if (r.size() == 0) return r;
+  Raster<T> out(cols, rows, shifted(r.georef(), x0, y0));
+  out.nodata = r.nodata;
+  for (int y = 0; y < rows; ++y) std::copy_n(&r(x0, y0 + y), cols, &out(0, y));
+  return out;
+}
 
 /// Who processes which tiles, and how what a pass learnt about its tiles (their frames, spill
 /// edges, shared flat cells, links: perimeters and global graphs, never whole tiles) reaches every

@@ -1,0 +1,79 @@
+// The inland water and the hydrometry by tiles (see by_tiles.hpp).
+// SPDX-License-Identifier: MIT
+#include "pipeline/by_tiles.hpp"
+
+#include <cstdio>
+
+#include "core/error.hpp"
+#include "hydro/tiled/tiled_flat_water.hpp"
+#include "io/mask_io.hpp"
+
+namespace terrapolis::pipeline {
+
+InlandWaterTiles inland_water_by_tiles(const DemWindowReader& dem, const InlandWaterSettings& water, const TileSettings& tiles,
+                                       double reserved_mb, const WriteTile<std::uint8_t>& write, Progress& progress) {
+  if (!water.reservoirs.empty()) throw bad_input("/water/reservoirs: not flooded on tiles yet");
+  const RasterHeader& h = dem.header();
+  InlandWaterTiles out;
+  out.tile_size = tiles.tile_size > 0 ? tiles.tile_size : hydro::tiled::flat_water_tile_size_for(h.cols, h.rows, tiles.limit_mb(), reserved_mb);
+  const hydro::tiled::TiledFlatWaterReport f = hydro::tiled::run_tiled_flat_water(
+      h.cols, h.rows, h.georef, [&](int c0, int r0, int cols, int rows) { return dem.read(c0, r0, cols, rows); }, water.flat_water,
+      out.tile_size,
+      [&](int t, int across, const Raster<std::uint8_t>& lakes) {
+        if (water.water_mask.empty()) return write(t, across, lakes);
+        Raster<std::uint8_t> mask = read_mask(water.water_mask, lakes.georef(), lakes.cols(), lakes.rows());
+        for (std::size_t i = 0; i < mask.size(); ++i) mask[i] = mask[i] || lakes[i];  // as inland_water: 1 water, 0 not
+        write(t, across, mask);
+      },
+      progress);
+  out.tiles = f.tiles;
+  out.across = f.across;
+  out.flat_lakes = f.lakes;
+  out.flat_lake_km2 = f.area_km2;
+  out.surfaces = f.surfaces;
+  return out;
+}
+
+std::string describe(const InlandWaterTiles& r) {
+  char line[300];
+  std::snprintf(line, sizeof line, "inland water tiles: %d of %d cells a side, %zu lakes the DEM flattens, %.2f km2 (%zu level surfaces on tile edges "
+                "or large enough, joined across tiles)", r.tiles, r.tile_size, r.flat_lakes, r.flat_lake_km2, r.surfaces);
+  return line;
+}
+
+hydro::tiled::TiledBelhadjReport hydrometry_by_tiles(const DemWindowReader& dem, const hydro::HydroOptions& hydro, const TileSettings& tiles,
+                                                     double reserved_mb, const std::string& scratch_dir, const WriteTile<float>& write,
+                                                     Progress& progress) {
+  const hydro::HydrometryOptions h = hydro::hydrometry_options(hydro);
+  if (h.method != hydro::HydrometryMethod::belhadj)
+    throw bad_input("/hydro/hydrometry: the accumulation hydrometry is not computed on tiles yet (Belhadj's is)");
+  const RasterHeader& g = dem.header();
+  return hydro::tiled::run_tiled_belhadj(
+      g.cols, g.rows, g.georef, [&](int c0, int r0, int cols, int rows) { return dem.read(c0, r0, cols, rows); }, hydro::belhadj_options(h),
+      tiles.tile_size, tiles.limit_mb(), scratch_dir, write, progress, reserved_mb);
+}
+
+std::string describe(const hydro::tiled::TiledBelhadjReport& b) {
+  char line[300];
+  std::snprintf(line, sizeof line,
+                "hydrometry tiles: %d of %d cells a side, %d Belhadj iterations (mean %.3g) found in %d pass%s, halo %d cells; state %.1f MB a window",
+                b.tiles, b.tile_size, b.iterations, b.final_mean, b.searches, b.searches > 1 ? "es" : "", b.halo, b.window_bytes / 1e6);
+  return line;
+}
+
+density::ReadWindowInputs density_windows(const DemWindowReader& dem, const Scenario& scenario, const density::DensityOptions& options,
+                                          const std::string& inland_water, const ReadHydrometry& hydrometry) {
+  return [&dem, &scenario, &options, inland_water, hydrometry](int c0, int r0, int cols, int rows, bool dem_only) {
+    density::WindowInputs in;
+    in.dem = dem.read(c0, r0, cols, rows);
+    in.options = options;
+    const Georef& grid = in.dem.georef();
+    in.options.water_mask = read_mask(inland_water, grid, cols, rows);
+    if (dem_only) return in;
+    read_density_files(scenario, grid, cols, rows, "", in.options);
+    in.hydrometry = hydrometry ? hydrometry(in.dem, c0, r0) : in.dem.like<float>(0.0f);
+    return in;
+  };
+}
+
+}  // namespace terrapolis::pipeline

@@ -1,0 +1,53 @@
+// What the hydro stage hands the density stage, computed by tiles (the run's stages and the density
+// command on a mosaic share it): the inland water and Belhadj's hydrometry, the whole grid's cells.
+// SPDX-License-Identifier: MIT
+#pragma once
+#include <cstdint>
+#include <functional>
+#include <string>
+
+#include "core/progress.hpp"
+#include "core/raster.hpp"
+#include "density/tiled_density.hpp"
+#include "hydro/hydro.hpp"
+#include "hydro/tiled/tiled_belhadj.hpp"
+#include "io/raster_io.hpp"
+#include "pipeline/scenario.hpp"
+#include "pipeline/stage_options.hpp"
+
+namespace terrapolis::pipeline {
+
+template <class T>
+using WriteTile = std::function<void(int tile, int across, const Raster<T>& raster)>;
+
+struct InlandWaterTiles {
+  int tiles = 0, across = 0, tile_size = 0;
+  std::size_t flat_lakes = 0;  ///< as InlandWater::flat_lakes
+  double flat_lake_km2 = 0;
+  std::size_t surfaces = 0;    ///< level surfaces joined across tiles or large enough
+};
+
+/// pipeline::inland_water by tiles: the lakes the DEM flattens (hydro::tiled::run_tiled_flat_water)
+/// and water.water_mask, 1 water, 0 not. Reservoirs are refused (bad_input).
+InlandWaterTiles inland_water_by_tiles(const DemWindowReader& dem, const InlandWaterSettings& water, const TileSettings& tiles,
+                                       double reserved_mb, const WriteTile<std::uint8_t>& write, Progress& progress);
+/// The log line of inland_water_by_tiles.
+std::string describe(const InlandWaterTiles& report);
+
+/// The hydrometry of run_hydro by tiles: Belhadj's (the accumulation method is refused, bad_input),
+/// keeping its Acc in `scratch_dir` meanwhile.
+hydro::tiled::TiledBelhadjReport hydrometry_by_tiles(const DemWindowReader& dem, const hydro::HydroOptions& hydro, const TileSettings& tiles,
+                                                     double reserved_mb, const std::string& scratch_dir, const WriteTile<float>& write,
+                                                     Progress& progress);
+/// The log line of hydrometry_by_tiles.
+std::string describe(const hydro::tiled::TiledBelhadjReport& report);
+
+/// The hydrometry of a window of the DEM (its cells [c0, c0 + window.cols()) x ...).
+using ReadHydrometry = std::function<Raster<float>(const Dem& window, int c0, int r0)>;
+/// The density model's inputs by windows (density::run_tiled_density): the DEM, the inland water
+/// (the VRT of inland_water_by_tiles), the scenario's exclusions and `hydrometry`'s (empty: zeros).
+/// Holds references to `dem`, `scenario` and `options`.
+density::ReadWindowInputs density_windows(const DemWindowReader& dem, const Scenario& scenario, const density::DensityOptions& options,
+                                          const std::string& inland_water, const ReadHydrometry& hydrometry);
+
+}  // namespace terrapolis::pipeline

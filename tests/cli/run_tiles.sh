@@ -1,0 +1,68 @@
+#!/usr/bin/env bash
+# `terrapolis run` tile by tile (input.tile_size, input.memory_limit_mb; docs/scale.md): the
+# terrain, hydro and density stages read the DEM by windows and write one GeoTIFF a tile and a VRT
+# per raster, the same cells as the run on the whole grid, the same streams and figures; memory
+# bounded by the limit; what is not computed on tiles yet refused before any stage.
+# SPDX-License-Identifier: MIT
+source "$(dirname "$0")/lib.sh" "$@"
+cd "$WORK"
+rasters=(elevation hillshade filled flowdir accumulation hydrometry inland_water coast plateau plain buildable density)
+tiled=(--set density.preset=belhadj2007 --until density)
+
+# The bundled DEM (GEBCO 15", sea below 0) on 3 x 3 tiles of 64 cells.
+"$TP" -q run "${tiled[@]}" -o whole
+"$TP" -v run "${tiled[@]}" --set input.tile_size=64 -o tiles 2> tiles.log
+for r in "${rasters[@]}"; do
+  same_cells "whole/$r.tif" "tiles/$r.vrt" || fail "$r differs from the whole grid's run"
+  [[ $(ls tiles/$r/tile_*.tif | wc -l) -eq 9 ]] || fail "expected 9 tiles of $r"
+done
+cmp -s whole/streams.geojson tiles/streams.geojson || fail "streams.geojson differs from the whole grid's run"
+same_summary() {
+  /usr/bin/python3 -c 'import json, sys; a, b = (json.load(open(f + "/run.json"))["summary"] for f in sys.argv[1:]); sys.exit(a != b)' "$1" "$2"
+}
+same_summary whole tiles || fail "the run's figures differ from the whole grid's"
+grep -q "TERRAPOLIS_STAGE=density" <(gdalinfo tiles/density/tile_0001_0002.tif) || fail "a tile without its provenance"
+grep -q 'density.vrt' tiles/project.qgs || fail "the QGIS project does not show the tiled rasters"
+grep -q "no preview.png: the run worked tile by tile" tiles.log || fail "no word of the preview left out"
+
+# A rerun from the density stage reads the hydro stage's tiles back.
+"$TP" -q run "${tiled[@]}" --set input.tile_size=64 --set density.r_max_m=4000 --from density -o tiles
+"$TP" -q run --set density.preset=belhadj2007 --set density.r_max_m=4000 --until density -o whole4
+same_cells whole4/density.tif tiles/density.vrt || fail "--from density on tiles differs from the whole grid's run"
+expect_fail 2 "--until: the run made the density stage: a rerun goes on to its last stage" "$TP" run --set sites.population=1000 --until hydro --from hydro -o "$(
+  "$TP" -q run --until roads -o full > /dev/null && echo full)"
+
+# New Zealand at 1 km (float metres, ten lakes the DEM flattens, nodata sea) within a memory limit;
+# every raster but the plain (a float DEM's plain sums may round otherwise on tiles).
+nz=(--set dem="$SAMPLES/spDataLarge_nz_elev.tif" --set water.nodata_is_sea=true "${tiled[@]}")
+"$TP" -q run "${nz[@]}" -o nz_whole
+limit=170  # the run on the whole grid peaks at about 270 MB
+[[ -n ${ASAN_OPTIONS:-} ]] && limit=600  # AddressSanitizer's shadow memory
+"$TP" -q run "${nz[@]}" --set input.memory_limit_mb=$limit -o nz_tiles
+for r in "${rasters[@]}"; do
+  [[ $r == plain ]] && continue
+  same_cells "nz_whole/$r.tif" "nz_tiles/$r.vrt" || fail "nz: $r differs from the whole grid's run"
+done
+cmp -s nz_whole/streams.geojson nz_tiles/streams.geojson || fail "nz: streams.geojson differs"
+/usr/bin/python3 - "$limit" <<'PY' || fail "nz: figures or memory"
+import json, sys
+w, t = (json.load(open(f + "/run.json")) for f in ("nz_whole", "nz_tiles"))
+assert w["summary"]["hydro"] == t["summary"]["hydro"], (w["summary"]["hydro"], t["summary"]["hydro"])
+assert t["summary"]["hydro"]["flat_lakes"] >= 8, t["summary"]["hydro"]
+peak = max(s["peak_memory_mb"] for s in t["timings"])
+whole = max(s["peak_memory_mb"] for s in w["timings"])
+print(f"nz: peak {peak:.0f} MB by tiles (limit {sys.argv[1]} MB), {whole:.0f} MB on the whole grid")
+import os
+assert os.environ.get("ASAN_OPTIONS") or peak <= float(sys.argv[1]) < whole, (peak, whole)
+PY
+no_leftovers "$WORK"
+[[ -z $(find . -name '.scratch*') ]] || fail "a scratch folder was left behind"
+
+# Refused before any stage, exit 2, no folder: the later stages, and what the tiles do not compute yet.
+expect_refused r1 "/input/tile_size: a run works tile by tile up to the density stage yet .*--until density" \
+  "$TP" run --set input.tile_size=64 -o r1
+expect_refused r2 "/density/weights/altitude: the terrain terms are not computed on tiles yet" \
+  "$TP" run --set input.memory_limit_mb=500 --until density -o r2
+expect_refused r3 "/hydro/classify: not computed on tiles yet" "$TP" run "${tiled[@]}" --set input.tile_size=64 --set hydro.classify=true -o r3
+expect_refused r4 "/hydro/flow mfd: not computed on tiles yet" "$TP" run "${tiled[@]}" --set input.tile_size=64 --set hydro.flow=mfd -o r4
+echo "run by tiles: ok"
