@@ -14,6 +14,7 @@
 #include "cli/commands_list.hpp"
 #include "cli/dem_input.hpp"
 #include "cli/hydro_tiles.hpp"
+#include "pipeline/by_tiles.hpp"
 #include "cli/schema_options.hpp"
 #include "core/error.hpp"
 #include "hydro/catchment.hpp"
@@ -127,6 +128,7 @@ class HydroCommand final : public Command {
       q.accumulation_file = opts(acc_description, {{"UNIT", acc_unit}});
       q.basins_file = opts(basins_description);
       const std::string done = run_tiled_hydro_command(q, context);
+      if (wanted[3]) tiled_hydrometry(context, o, tiles, dir, opts(pipeline::describe_output("hydrometry.tif", terms)));
       outputs.commit();
       context.log.info(done);
       return;
@@ -189,14 +191,30 @@ class HydroCommand final : public Command {
     return wanted;
   }
 
+  /// Belhadj's hydrometry by tiles into DIR/hydrometry.vrt, after the engine (it has the memory to itself).
+  void tiled_hydrometry(Context& context, const HydroOptions& o, const pipeline::TileSettings& tiles, const fs::path& dir,
+                        const WriteOptions& file) const {
+    if (o.hydrometry.method != HydrometryMethod::belhadj)
+      return context.log.detail("hydrometry.tif left out: the accumulation hydrometry is not computed on tiles yet (Belhadj's is)");
+    const MosaicFiles m{dir.string(), "hydrometry"};
+    m.create();
+    const fs::path scratch = dir / ".scratch-hydrometry";
+    const hydro::tiled::TiledBelhadjReport b = pipeline::hydrometry_by_tiles(
+        DemWindowReader(dem_.path, dem_.options()), o, tiles, reserve_reader_memory(tiles.limit_mb()), scratch.string(),
+        [&](int t, int across, const Raster<float>& tile) { write_raster(m.tile(t, across), tile, file); }, context.progress);
+    m.finish(b.tiles, b.across);
+    fs::remove_all(scratch);
+    context.log.detail(pipeline::describe(b));
+  }
+
   /// What the tile engine does not compute (yet), refused by name.
   void check_tiled(const HydroOptions& o, const std::array<bool, 6>& wanted, bool classify) const {
     if (o.fill != FillMethod::priority_flood || o.flow != FlowMethod::d8 || !weights_.empty())
       throw bad_input("tiled hydro (--tile-size, --memory-limit, a folder of tiles): only --fill priority-flood, --flow d8, no --weights");
-    // The default outputs on tiles: all but the hydrometry, and the streams when the accumulation is an area.
+    // The default outputs on tiles: the hydrometry when it is Belhadj's, and the streams when the accumulation is an area.
     const bool explicit_outputs = outputs_ != kDefaultOutputs;
-    if (explicit_outputs && wanted[3])
-      throw bad_input("--outputs: the hydrometry is not computed on tiles yet; ask for filled,flowdir,accumulation,streams,basins");
+    if (explicit_outputs && wanted[3] && o.hydrometry.method != HydrometryMethod::belhadj)
+      throw bad_input("--outputs: the accumulation hydrometry is not computed on tiles yet (Belhadj's is)");
     if (explicit_outputs && wanted[4] && o.unit == AccumulationUnit::cells)
       throw bad_input("--outputs: streams on tiles need --area-units m2 or km2");
     if (classify) throw bad_input("--classify: river types are not computed on tiles yet");

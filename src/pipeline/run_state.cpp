@@ -4,7 +4,6 @@
 
 #include <cstdint>
 
-#include "core/memory.hpp"
 #include "terrapolis/version.hpp"
 
 namespace terrapolis::pipeline {
@@ -32,10 +31,7 @@ Style style_from_name(const std::string& name) {
   return Style::unit_ramp;
 }
 
-void TiledInput::reserve() {
-  release_free_memory();
-  reserved_mb = reserve_reader_memory(tiles.limit_mb());
-}
+void TiledInput::reserve() { reserved_mb = reserve_reader_memory(tiles.limit_mb()); }
 
 WriteOptions RunState::file_options(const std::string& stage, const std::string& name,
                                     const std::vector<std::pair<std::string, std::string>>& metadata) const {

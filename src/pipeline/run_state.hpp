@@ -45,7 +45,7 @@ struct TiledInput {
   ReadOptions read;
   TileSettings tiles;
   double reserved_mb = 0;  ///< what the process and the mosaic's reader hold of the memory limit
-  /// At the start of a stage: what the process holds now (the earlier stages' free heap handed back).
+  /// At the start of a stage: what the process holds now (reserve_reader_memory).
   void reserve();
 };
 

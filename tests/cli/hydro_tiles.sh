@@ -48,10 +48,12 @@ grep -q 'ID\["EPSG",4326\]' <(gdalinfo "$work/zion_tiled/filled.vrt") || fail "V
 
 # Corsica (sea level, coast) through a VRT with km2 and TauDEM codes, on one thread.
 gdalbuildvrt -q "$work/corsica.vrt" "$samples/gebco2022_15s_north_corsica_capcorse.asc"
+# The default outputs: Belhadj's hydrometry too, by tiles (each run t steps with a halo of t + 2).
 "$bin" -q hydro "$samples/gebco2022_15s_north_corsica_capcorse.asc" "$work/cor_whole" --sea-level 0 --area-units km2 \
-  --d8-codes taudem --outputs filled,flowdir,accumulation
+  --d8-codes taudem --outputs filled,flowdir,accumulation,hydrometry
 "$bin" -q hydro "$work/corsica.vrt" "$work/cor_tiled" --sea-level 0 --area-units km2 --d8-codes taudem --tile-size 40 --threads 1
-for o in "${outputs[@]}"; do same_cells "$work/cor_whole/$o.tif" "$work/cor_tiled/$o.vrt" || fail "corsica: tiled $o differs"; done
+for o in "${outputs[@]}" hydrometry; do same_cells "$work/cor_whole/$o.tif" "$work/cor_tiled/$o.vrt" || fail "corsica: tiled $o differs"; done
+grep -q "HYDROMETRY=belhadj" <(gdalinfo "$work/cor_tiled/hydrometry/tile_0001_0002.tif") || fail "hydrometry tile without its provenance"
 
 # NZ (NaN nodata) at twice its resolution: 6.5 M cells, 26 MB as float, within a memory limit of
 # 100 MB for the whole process (the engine's state, GDAL's bounded cache and open files, the process
@@ -62,7 +64,7 @@ gdal_translate -q -outsize 200% 200% -r bilinear "$samples/spDataLarge_nz_elev.t
 # Under AddressSanitizer the process holds about 280 MB more from the start (its shadow memory).
 limit=100 min_tiles=8  # the share left to tiles moves with the process's own memory (20-30 tiles here)
 [[ -n ${ASAN_OPTIONS:-} ]] && limit=500 min_tiles=2
-"$bin" -v hydro "$nz" "$work/nz_tiled" --memory-limit $limit --area-units cells --threads 1 2>"$work/nz.log"
+"$bin" -v hydro "$nz" "$work/nz_tiled" --memory-limit $limit --area-units cells --threads 1 --outputs filled,flowdir,accumulation 2>"$work/nz.log"
 for o in "${outputs[@]}"; do same_cells "$work/nz_whole/$o.tif" "$work/nz_tiled/$o.vrt" || fail "nz: tiled $o differs"; done
 line=$(grep "^tiles: " "$work/nz.log") || fail "no tile report: $(cat "$work/nz.log")"
 [[ $line =~ ^tiles:\ ([0-9]+)\ of\ [0-9]+\ cells\ a\ side,\ ([0-9]+)\ at\ once.*state\ ([0-9.]+)\ MB\ a\ tile\ \+\ ([0-9.]+)\ MB\ global\ \+\ ([0-9.]+)\ MB\ reader\ and\ process\;\ peak\ resident\ ([0-9.]+)\ MB ]] ||
@@ -76,7 +78,8 @@ no_leftovers "$work"
 
 # Refusals: exit 2, nothing written.
 expect_refused "$work/r1" "only --fill priority-flood" "$bin" hydro "$zion" "$work/r1" --tile-size 64 --fill breach
-expect_refused "$work/r2" "not computed on tiles" "$bin" hydro "$zion" "$work/r2" --tile-size 64 --outputs filled,hydrometry
+expect_refused "$work/r2" "accumulation hydrometry is not computed on tiles" "$bin" hydro "$zion" "$work/r2" --tile-size 64 --outputs filled,hydrometry \
+  --hydrometry accumulation
 expect_refused "$work/r7" "need --area-units" "$bin" hydro "$zion" "$work/r7" --tile-size 64 --outputs streams --area-units cells
 expect_refused "$work/r3" "at least 8" "$bin" hydro "$zion" "$work/r3" --tile-size 3
 expect_refused "$work/r4" "too little" "$bin" hydro "$nz" "$work/r4" --memory-limit 1
