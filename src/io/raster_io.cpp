@@ -534,6 +534,18 @@ Dem DemWindowReader::read(int col0, int row0, int cols, int rows) const {
   return window;
 }
 
+void DemWindowReader::check_cells() const {
+  const int strip = std::max(1, int(std::min<std::int64_t>(header_.rows, (1 << 22) / std::max(1, header_.cols))));  // ~16 MB a strip
+  for (int r0 = 0; r0 < header_.rows; r0 += strip) {
+    const Dem part = read(0, r0, header_.cols, std::min(strip, header_.rows - r0));
+    if (std::any_of(part.values().begin(), part.values().end(), [](float v) { return !std::isnan(v); })) {
+      for (int r1 = r0 + strip; r1 < header_.rows; r1 += strip) read(0, r1, header_.cols, std::min(strip, header_.rows - r1));
+      return;
+    }
+  }
+  throw bad_input(path_ + ": holds no data (every cell is nodata)");
+}
+
 void write_vrt(const std::string& path, const std::vector<std::string>& tiles, bool overwrite) {
   init_gdal();
   detail::check_output(path, overwrite);

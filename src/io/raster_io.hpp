@@ -103,6 +103,9 @@ class DemWindowReader {
   /// The cells [col0, col0 + cols) x [row0, row0 + rows); those outside the raster are NaN. The
   /// georeferencing is the window's. Serialised: one reader may be shared between threads.
   Dem read(int col0, int row0, int cols, int rows) const;
+  /// Reads every cell once, by strips of rows, as read_dem would check them: throws bad_input for a
+  /// file that cannot be read through or holds no data (before a tiled run's first stage).
+  void check_cells() const;
 
  private:
   struct Dataset;

@@ -169,7 +169,9 @@ json run_scenario(const Scenario& scenario, const RunOptions& options, Progress&
   Dem dem;
   RasterHeader grid;
   if (tiles.given()) {
-    grid = DemWindowReader(dem_path, read).header();
+    const DemWindowReader reader(dem_path, read);
+    reader.check_cells();  // one pass of reads: a bad file is refused before any stage, as read_dem would
+    grid = reader.header();
   } else {
     dem = read_dem(dem_path, read);
     grid = grid_of(dem);

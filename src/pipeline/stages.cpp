@@ -67,7 +67,8 @@ struct AltitudeRange {
   }
 };
 
-/// The tiles a stage of a run by tiles writes, sized to the memory limit for `bytes_per_cell` of state.
+/// The tiles of the terrain stage of a run by tiles: given, or sized to the memory limit as the
+/// density's windows are (their state per cell covers the DEM and its hillshade), with a halo of `halo` cells.
 hydro::tiled::TileGrid run_tiles(const RunState& s, int halo) {
   const TiledInput& in = *s.by_tiles;
   const int side = in.tiles.tile_size > 0 ? in.tiles.tile_size

@@ -65,4 +65,6 @@ expect_refused r2 "/density/weights/altitude: the terrain terms are not computed
   "$TP" run --set input.memory_limit_mb=500 --until density -o r2
 expect_refused r3 "/hydro/classify: not computed on tiles yet" "$TP" run "${tiled[@]}" --set input.tile_size=64 --set hydro.classify=true -o r3
 expect_refused r4 "/hydro/flow mfd: not computed on tiles yet" "$TP" run "${tiled[@]}" --set input.tile_size=64 --set hydro.flow=mfd -o r4
+gdal_calc.py --quiet -A "$SAMPLES/spDataLarge_srtm_zion.tif" --outfile nodata.tif --calc "A*0+65535" --NoDataValue 65535 --type UInt16
+expect_refused r5 "nodata.tif: holds no data" "$TP" run --set dem="$WORK/nodata.tif" "${tiled[@]}" --set input.tile_size=64 -o r5
 echo "run by tiles: ok"
