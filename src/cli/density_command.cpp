@@ -187,34 +187,39 @@ class DensityCommand final : public Command {
     if (!options.factors.empty() || !scenario.resolved["density"]["layers"].empty())
       throw bad_input("--layer: user layers are rescaled by their range over the grid, not computed on tiles yet");
     if (!plugins_.specs.empty()) throw bad_input("--plugin: plugins are not run on tiles yet");
-    const bool hydrometry = hydrometry_used(options);
-    const double reserved_mb = reserve_reader_memory(tiles.limit_mb());
+    const bool hydrometry = hydrometry_used(options), compute_hydrometry = hydrometry && hydrometry_path_.empty();
+    const hydro::HydroOptions hydro = pipeline::hydro_options(scenario);
+    if (compute_hydrometry && hydro.hydrometry.method != hydro::HydrometryMethod::belhadj)
+      throw bad_input("/hydro/hydrometry: the accumulation hydrometry is not computed on tiles yet (Belhadj's is); give --hydrometry FILE");
     const DemWindowReader reader(dem_.path, dem_.options());
     const RasterHeader& h = reader.header();
     // What the whole-grid command computes on the whole DEM (pipeline::hydro_for_density), computed
     // by tiles into the staging folder first, then read by windows: the inland water, Belhadj's hydrometry.
-    const MosaicFiles water{(dir / ".computed").string(), "inland_water"}, belhadj{water.dir, "hydrometry"};
+    std::optional<ScratchFolder> computed(std::in_place, (dir / ".computed").string());  // gone before the outputs are committed
+    const MosaicFiles water{computed->path(), "inland_water"}, belhadj{computed->path(), "hydrometry"};
     water.create();
     const pipeline::InlandWaterTiles w = pipeline::inland_water_by_tiles(
-        reader, pipeline::inland_water_settings(scenario), tiles, reserved_mb,
+        reader, pipeline::inland_water_settings(scenario), tiles, reserve_reader_memory(tiles.limit_mb()),
         [&](int t, int across, const Raster<std::uint8_t>& tile) { write_raster(water.tile(t, across), tile, WriteOptions{}); }, context.progress);
     water.finish(w.tiles, w.across);
     context.log.detail(pipeline::describe(w));
-    std::optional<DemWindowReader> computed;
-    if (hydrometry && hydrometry_path_.empty()) {
+    std::optional<DemWindowReader> hydrometry_tiles;
+    if (compute_hydrometry) {
       belhadj.create();
       const hydro::tiled::TiledBelhadjReport b = pipeline::hydrometry_by_tiles(
-          reader, pipeline::hydro_options(scenario), tiles, reserved_mb, water.dir + "/scratch",
+          reader, hydro, tiles, reserve_reader_memory(tiles.limit_mb()), computed->path() + "/scratch",
           [&](int t, int across, const Raster<float>& tile) { write_raster(belhadj.tile(t, across), tile, WriteOptions{}); }, context.progress);
       belhadj.finish(b.tiles, b.across);
-      computed.emplace(belhadj.vrt(), ReadOptions{});
+      hydrometry_tiles.emplace(belhadj.vrt(), ReadOptions{});
       context.log.detail(pipeline::describe(b));
     }
     pipeline::ReadHydrometry read_hydro;
-    if (computed) read_hydro = [&](const Dem& window, int c0, int r0) { return computed->read(c0, r0, window.cols(), window.rows()); };
+    if (hydrometry_tiles)
+      read_hydro = [&](const Dem& window, int c0, int r0) { return hydrometry_tiles->read(c0, r0, window.cols(), window.rows()); };
     else if (hydrometry)
       read_hydro = [&](const Dem& window, int, int) { return read_hydrometry(hydrometry_path_, window.georef(), window.cols(), window.rows()); };
     const density::ReadWindowInputs read = pipeline::density_windows(reader, scenario, options, water.vrt(), read_hydro);
+    const double reserved_mb = reserve_reader_memory(tiles.limit_mb());
     const char* layers[] = {"coast", "plateau", "plain", "hydrometry", "buildable", "density"};
     for (const char* l : layers)
       if (hydrometry || std::string(l) != "hydrometry") fs::create_directory(dir / l);
@@ -225,13 +230,9 @@ class DensityCommand final : public Command {
         },
         context.progress, reserved_mb);
     for (const char* l : layers)
-      if (hydrometry || std::string(l) != "hydrometry") {
-        std::vector<std::string> files;
-        for (int t = 0; t < report.tiles; ++t) files.push_back(tile_file(dir.string(), l, t, report.across));
-        write_vrt((dir / (std::string(l) + ".vrt")).string(), files, false);
-      }
+      if (hydrometry || std::string(l) != "hydrometry") MosaicFiles{dir.string(), l}.finish(report.tiles, report.across);
+    hydrometry_tiles.reset();
     computed.reset();
-    fs::remove_all(water.dir);
     outputs.commit();
     char line[360];
     std::snprintf(line, sizeof line,

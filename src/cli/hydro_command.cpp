@@ -196,14 +196,15 @@ class HydroCommand final : public Command {
                         const WriteOptions& file) const {
     if (o.hydrometry.method != HydrometryMethod::belhadj)
       return context.log.detail("hydrometry.tif left out: the accumulation hydrometry is not computed on tiles yet (Belhadj's is)");
+    const double reserved_mb = reserve_reader_memory(tiles.limit_mb());
+    const DemWindowReader reader(dem_.path, dem_.options());
     const MosaicFiles m{dir.string(), "hydrometry"};
     m.create();
-    const fs::path scratch = dir / ".scratch-hydrometry";
+    const ScratchFolder scratch((dir / ".scratch-hydrometry").string());
     const hydro::tiled::TiledBelhadjReport b = pipeline::hydrometry_by_tiles(
-        DemWindowReader(dem_.path, dem_.options()), o, tiles, reserve_reader_memory(tiles.limit_mb()), scratch.string(),
+        reader, o, tiles, reserved_mb, scratch.path(),
         [&](int t, int across, const Raster<float>& tile) { write_raster(m.tile(t, across), tile, file); }, context.progress);
     m.finish(b.tiles, b.across);
-    fs::remove_all(scratch);
     context.log.detail(pipeline::describe(b));
   }
 

@@ -46,16 +46,8 @@ std::string tiles_of_this_process(const TiledHydroRequest& q, Context& context, 
   if (leader)  // before the engine's first exchange, hence before any process writes a tile
     for (const Layer& l : layers)
       if (l.wanted) fs::create_directory(out / l.name);
-  const fs::path scratch = out / (".scratch-" + std::to_string(driver.rank()) + "-" + std::to_string(getpid()));
-  fs::create_directory(scratch);
-  struct RemoveScratch {
-    fs::path path;
-    ~RemoveScratch() {
-      std::error_code ec;
-      fs::remove_all(path, ec);
-    }
-  } remove_scratch{scratch};
-  o.scratch_dir = scratch.string();
+  const ScratchFolder scratch((out / (".scratch-" + std::to_string(driver.rank()) + "-" + std::to_string(getpid()))).string());
+  o.scratch_dir = scratch.path();
   o.tile_size = q.tile_size > 0 ? q.tile_size : hydro::tiled::tile_size_for(h.cols, h.rows, o.memory_limit_mb, threads, reserved_mb);
   const hydro::tiled::TileGrid grid(h.cols, h.rows, o.tile_size);
   auto tile_path = [&](const Layer& l, int t) { return tile_file(out.string(), l.name, t, grid.across()); };
@@ -86,11 +78,7 @@ std::string tiles_of_this_process(const TiledHydroRequest& q, Context& context, 
       context.progress, driver);
   if (!leader) return {};
   for (const Layer& l : layers)
-    if (l.wanted) {
-      std::vector<std::string> tiles;
-      for (int t = 0; t < grid.count(); ++t) tiles.push_back(tile_path(l, t));
-      write_vrt((out / (l.name + ".vrt")).string(), tiles, false);
-    }
+    if (l.wanted) MosaicFiles{out.string(), l.name}.finish(grid.count(), grid.across());
   char line[560];
   std::snprintf(line, sizeof line,
                 "tiles: %d of %d cells a side, %d at once; %llu spill labels, %llu edges; %llu cells of flats across tiles (%llu rounds); "

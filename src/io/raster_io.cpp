@@ -565,6 +565,16 @@ void write_vrt(const std::string& path, const std::vector<std::string>& tiles, b
   detail::commit_file(tmp, path);
 }
 
+ScratchFolder::ScratchFolder(std::string path) : path_(std::move(path)) {
+  std::filesystem::remove_all(path_);
+  std::filesystem::create_directories(path_);
+}
+
+ScratchFolder::~ScratchFolder() {
+  std::error_code ec;
+  std::filesystem::remove_all(path_, ec);
+}
+
 std::string MosaicFiles::tile(int t, int across) const {
   char file[64];
   std::snprintf(file, sizeof file, "tile_%04d_%04d.tif", t / across, t % across);

@@ -118,6 +118,20 @@ class DemWindowReader {
 /// temporary name, then renames it.
 void write_vrt(const std::string& path, const std::vector<std::string>& tiles, bool overwrite);
 
+/// A folder for temporary files, created empty and removed with everything in it when it goes
+/// out of scope, errors included.
+class ScratchFolder {
+ public:
+  explicit ScratchFolder(std::string path);
+  ~ScratchFolder();
+  ScratchFolder(const ScratchFolder&) = delete;
+  ScratchFolder& operator=(const ScratchFolder&) = delete;
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+};
+
 /// A raster written tile by tile: tile t of a mosaic `across` tiles wide as
 /// DIR/NAME/tile_RRRR_CCCC.tif, then DIR/NAME.vrt over them all.
 struct MosaicFiles {

@@ -13,9 +13,12 @@
 namespace terrapolis::pipeline {
 
 Raster<std::uint8_t> hillshade(const Dem& dem, double azimuth_deg, double altitude_deg, double z_factor) {
+  return hillshade(dem, cell_metrics(dem.georef(), dem.cols(), dem.rows()), azimuth_deg, altitude_deg, z_factor);
+}
+
+Raster<std::uint8_t> hillshade(const Dem& dem, const CellMetrics& m, double azimuth_deg, double altitude_deg, double z_factor) {
   Raster<std::uint8_t> out = dem.like<std::uint8_t>(0);
   out.nodata = 0;
-  const CellMetrics m = cell_metrics(dem.georef(), dem.cols(), dem.rows());
   const double zenith = (90.0 - altitude_deg) * M_PI / 180.0;
   // Math angle of the light, counter-clockwise from east.
   const double azimuth = std::fmod(360.0 - azimuth_deg + 90.0, 360.0) * M_PI / 180.0;

@@ -165,7 +165,13 @@ json run_scenario(const Scenario& scenario, const RunOptions& options, Progress&
   const ReadOptions read = read_options(scenario.resolved["input"]["band"].get<int>(), scenario.resolved["input"]["assume_crs"].get<std::string>());
   // Before creating anything, so that bad input leaves no folder: the whole DEM, or its grid when
   // the stages read it by windows (docs/scale.md).
-  const TileSettings tiles = tile_settings(scenario);
+  const TileSettings tiles = [&] {
+    try {
+      return tile_settings(scenario);
+    } catch (const Error& e) {
+      throw Error(e.kind(), scenario.source + ": " + e.what());
+    }
+  }();
   Dem dem;
   RasterHeader grid;
   if (tiles.given()) {
@@ -193,6 +199,11 @@ json run_scenario(const Scenario& scenario, const RunOptions& options, Progress&
   const bool rerun = std::any_of(plan.begin(), plan.end(), [](Action a) { return a != Action::run; });
   json saved;
   if (rerun) saved = load_manifest(output.string());
+  // A rerun may stop where its saved run stopped (a run by tiles, made --until density), never
+  // before a stage it made: that stage's files would stay without their entry in run.json.
+  for (std::size_t i = last + 1; rerun && i < stages().size(); ++i)
+    if (saved["summary"].contains(stages()[i].name))
+      throw bad_input(std::string("--until: the run made the ") + stages()[i].name + " stage: a rerun goes on to its last stage");
   // A rerun replaces its own run folder; the new run is built beside it and swapped in at the end.
   OutputSet run_folder("run", scenario_inputs(scenario), options.overwrite || rerun);
   const fs::path temp = run_folder.folder(output.string(), rerun);
@@ -208,11 +219,6 @@ json run_scenario(const Scenario& scenario, const RunOptions& options, Progress&
     state.settings = std::move(settings);
     json timings = json::array();
     json ran = json::array(), reused = json::array(), stale = json::array();
-    // A rerun may stop where its saved run stopped (a run by tiles, made --until density), never
-    // before a stage it made: that stage's files would stay without their entry in run.json.
-    for (std::size_t i = last + 1; rerun && i < stages().size(); ++i)
-      if (saved["summary"].contains(stages()[i].name))
-        throw bad_input(std::string("--until: the run made the ") + stages()[i].name + " stage: a rerun goes on to its last stage");
     for (std::size_t i = 0; i <= last; ++i) {
       const StageDef& stage = stages()[i];
       const Log stage_log = log.stage(stage.name);

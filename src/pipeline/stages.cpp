@@ -85,6 +85,7 @@ void terrain_run_tiles(RunState& s, Progress& progress) {
   elevation.create();
   shade.create();
   AltitudeRange range;
+  const CellMetrics metrics = cell_metrics(s.grid.georef, s.grid.cols, s.grid.rows);  // the whole grid's rows: a window's may differ in the last bit
   ProgressStep step(progress, "terrain by tiles");
   for (int t = 0; t < grid.count(); ++t) {
     const hydro::tiled::TileRect r = grid.rect(t);
@@ -92,7 +93,8 @@ void terrain_run_tiles(RunState& s, Progress& progress) {
     const Dem window = reader.read(c0, r0, std::min(s.grid.cols, r.col0 + r.cols + 1) - c0, std::min(s.grid.rows, r.row0 + r.rows + 1) - r0);
     const Dem z = hydro::tiled::crop(window, r.col0 - c0, r.row0 - r0, r.cols, r.rows);
     s.write_tile("terrain", elevation, t, grid.across(), z);
-    s.write_tile("terrain", shade, t, grid.across(), hydro::tiled::crop(hillshade(window), r.col0 - c0, r.row0 - r0, r.cols, r.rows));
+    const Raster<std::uint8_t> shaded = hillshade(window, metric_rows(metrics, r0, window.rows()));
+    s.write_tile("terrain", shade, t, grid.across(), hydro::tiled::crop(shaded, r.col0 - c0, r.row0 - r0, r.cols, r.rows));
     range.add(z);
     step.update(double(t + 1) / grid.count());
   }
@@ -180,15 +182,14 @@ void hydro_run_tiles(RunState& s, Progress& progress, const Log& log) {
   const hydro::HydroOptions& options = s.settings.hydro;
   const DemWindowReader reader(in.dem_path, in.read);
   const RasterHeader& g = s.grid;
-  const std::filesystem::path scratch = s.folder / ".scratch";
-  std::filesystem::create_directories(scratch);
+  const ScratchFolder scratch((s.folder / ".scratch").string());
   hydro::tiled::TiledOptions o;
   o.memory_limit_mb = in.tiles.limit_mb();
   o.reserved_mb = in.reserved_mb;
   o.sea_level = options.sea_level;
   o.streams_threshold_m2 = options.streams.threshold_km2 * 1e6;
   o.concurrent_tiles = hydro::tiled::allowed_threads();
-  o.scratch_dir = scratch.string();
+  o.scratch_dir = scratch.path();
   o.tile_size = in.tiles.tile_size > 0 ? in.tiles.tile_size
                                        : hydro::tiled::tile_size_for(g.cols, g.rows, o.memory_limit_mb, o.concurrent_tiles, in.reserved_mb);
   const int across = hydro::tiled::TileGrid(g.cols, g.rows, o.tile_size).across();
@@ -216,15 +217,21 @@ void hydro_run_tiles(RunState& s, Progress& progress, const Log& log) {
   s.write_mosaic("hydro", filled, report.tiles, across, Style::elevation);
   s.write_mosaic("hydro", flowdir, report.tiles, across, Style::flow_direction);
   s.write_mosaic("hydro", accumulation, report.tiles, across, Style::accumulation);
+  s.write("hydro", "streams.geojson", streams, Style::streams);
+  json figures = hydro_figures(streams, largest_km2, 0);
+  streams = {};
+  // Each pass sizes its tiles to what the limit leaves once the process's memory is counted again.
+  s.by_tiles->reserve();
   const MosaicFiles hydrometry = s.mosaic("hydrometry");
   hydrometry.create();
   const hydro::tiled::TiledBelhadjReport b = hydrometry_by_tiles(
-      reader, options, in.tiles, in.reserved_mb, scratch.string(),
+      reader, options, in.tiles, in.reserved_mb, scratch.path(),
       [&](int t, int n, const Raster<float>& tile) { s.write_tile("hydro", hydrometry, t, n, tile); }, progress);
   s.write_mosaic("hydro", hydrometry, b.tiles, b.across, Style::unit_ramp);
-  s.write("hydro", "streams.geojson", streams, Style::streams);
-  s.summary["hydro"] = hydro_figures(streams, largest_km2, b.iterations);
+  figures["belhadj_iterations"] = b.iterations;
+  s.summary["hydro"] = figures;
   log.detail("hydro tiles: " + std::to_string(report.tiles) + " of " + std::to_string(report.tile_size) + " cells a side; " + describe(b));
+  s.by_tiles->reserve();
   const MosaicFiles water = s.mosaic(std::filesystem::path(kInlandWater).stem().string());
   water.create();
   const InlandWaterTiles w = inland_water_by_tiles(
@@ -233,7 +240,6 @@ void hydro_run_tiles(RunState& s, Progress& progress, const Log& log) {
   s.write_mosaic("hydro", water, w.tiles, w.across, Style::water);
   inland_water_figures(s, w.flat_lakes, w.flat_lake_km2);
   log.detail(describe(w));
-  std::filesystem::remove_all(scratch);
 }
 
 void hydro_run(RunState& s, Progress& progress, const Log& log) {

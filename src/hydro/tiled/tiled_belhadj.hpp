@@ -31,9 +31,10 @@ inline constexpr double kBelhadjBytesPerCell = 96;
 /// `memory_limit_mb` less `reserved_mb`). A cell's state after t steps depends on the cells within
 /// t + 2 of it only (its neighbours' previous state, their neighbours' altitudes), so a tile computed
 /// with a halo of t + 2 cells is exact. The stop is global (the mean quantity over the whole grid):
-/// passes with a halo of 32, 64, 128... steps sum each tile's quantities until one step's mean falls
-/// under the threshold; the last pass runs that many steps and keeps each tile's Acc in `scratch_dir`
-/// (8 bytes a cell, removed on return), then rescales them by the whole grid's range. The stop test
+/// passes of 32, 64, 128... steps (each tile with a halo of the steps + 2) sum each tile's quantities
+/// until one step's mean falls under the threshold; the last pass runs that many steps and keeps each
+/// tile's Acc in `scratch_dir` (8 bytes a cell, removed on return; on an error, with the caller's
+/// scratch folder), then rescales them by the whole grid's range. The stop test
 /// sums the quantities tile by tile, the whole grid row by row: the two means may differ in their
 /// last bit, which changes the iterations only when a mean lies that close to the threshold.
 TiledBelhadjReport run_tiled_belhadj(int cols, int rows, const Georef& georef, const ReadWindow& read, const BelhadjOptions& options,
