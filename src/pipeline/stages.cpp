@@ -220,8 +220,6 @@ void hydro_run_tiles(RunState& s, Progress& progress, const Log& log) {
   s.write("hydro", "streams.geojson", streams, Style::streams);
   json figures = hydro_figures(streams, largest_km2, 0);
   streams = {};
-  // Each pass sizes its tiles to what the limit leaves once the process's memory is counted again.
-  s.by_tiles->reserve();
   const MosaicFiles hydrometry = s.mosaic("hydrometry");
   hydrometry.create();
   const hydro::tiled::TiledBelhadjReport b = hydrometry_by_tiles(
@@ -231,7 +229,6 @@ void hydro_run_tiles(RunState& s, Progress& progress, const Log& log) {
   figures["belhadj_iterations"] = b.iterations;
   s.summary["hydro"] = figures;
   log.detail("hydro tiles: " + std::to_string(report.tiles) + " of " + std::to_string(report.tile_size) + " cells a side; " + describe(b));
-  s.by_tiles->reserve();
   const MosaicFiles water = s.mosaic(std::filesystem::path(kInlandWater).stem().string());
   water.create();
   const InlandWaterTiles w = inland_water_by_tiles(

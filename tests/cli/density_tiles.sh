@@ -67,12 +67,12 @@ for o in coast plateau plain buildable density; do
 done
 [[ ! -e $work/cor_tiled/hydrometry.vrt && ! -e $work/cor_tiled/hydrometry ]] || fail "corsica: hydrometry written although unused"
 
-# Memory: Zion with r_max 1.5 km within 82 MB for the whole process (the window and the global state,
+# Memory: Zion with r_max 1.5 km within 90 MB for the whole process (the window and the global state,
 # GDAL's bounded cache and open files, the process itself: about 75 MB), from the report and the
 # peak resident memory.
 "$bin" -q density "$zion" "$work/small_whole" --hydrometry "$hydrometry" --r-max 1500
 # Under AddressSanitizer the process holds about 280 MB more from the start (its shadow memory).
-limit=82 min_tiles=4
+limit=90 min_tiles=4
 [[ -n ${ASAN_OPTIONS:-} ]] && limit=400 min_tiles=1
 "$bin" -v density "$zion" "$work/small_tiled" --hydrometry "$hydrometry" --r-max 1500 --memory-limit $limit 2> "$work/small.log"
 for o in plain buildable density; do
