@@ -44,13 +44,12 @@ double plan_bytes(const DiscPlan& plan, int rows) {
 }  // namespace
 
 int density_tile_size_for(int cols, int rows, int halo_rows, int halo_cols, double global_bytes, double memory_limit_mb, double reserved_mb) {
-  const double limit = (memory_limit_mb - reserved_mb) * 1e6 - global_bytes;
-  for (int side = 1 << 15; side >= 64; side = side * 7 / 8) {
-    const double window = kDensityBytesPerCell * double(std::min(side, rows) + 2 * halo_rows) * double(std::min(side, cols) + 2 * halo_cols);
-    if (window <= limit) return side;
-  }
-  throw bad_input(hydro::tiled::too_little(memory_limit_mb, reserved_mb) + " for density tiles of 64 x 64 cells with a halo of " +
-                  std::to_string(halo_cols) + " x " + std::to_string(halo_rows) + " cells (r_max)");
+  return hydro::tiled::largest_tile_side(
+      [&](int side) {
+        return kDensityBytesPerCell * double(std::min(side, rows) + 2 * halo_rows) * double(std::min(side, cols) + 2 * halo_cols) + global_bytes;
+      },
+      memory_limit_mb, reserved_mb,
+      "density tiles of 64 x 64 cells with a halo of " + std::to_string(halo_cols) + " x " + std::to_string(halo_rows) + " cells (r_max)");
 }
 
 TiledDensityReport run_tiled_density(int cols, int rows, const Georef& georef, const ReadWindowInputs& read,
@@ -94,8 +93,8 @@ TiledDensityReport run_tiled_density(int cols, int rows, const Georef& georef, c
     for (int t = 0; t < grid.count(); ++t) {
       const TileRect r = grid.rect(t);
       const std::array<int, 2> halo = halo_of(r.row0, r.rows);
-      const int c0 = std::max(0, r.col0 - halo[1]), r0 = std::max(0, r.row0 - halo[0]);
-      const int c1 = std::min(cols, r.col0 + r.cols + halo[1]), r1 = std::min(rows, r.row0 + r.rows + halo[0]);
+      const TileRect w = grid.grown(t, halo[1], halo[0]);
+      const int c0 = w.col0, r0 = w.row0, c1 = w.col0 + w.cols, r1 = w.row0 + w.rows;
       report.halo_rows = std::max(report.halo_rows, halo[0]);
       report.halo_cols = std::max(report.halo_cols, halo[1]);
       report.window_bytes = std::max(report.window_bytes, kDensityBytesPerCell * double(c1 - c0) * double(r1 - r0));

@@ -88,13 +88,12 @@ void terrain_run_tiles(RunState& s, Progress& progress) {
   const CellMetrics metrics = cell_metrics(s.grid.georef, s.grid.cols, s.grid.rows);  // the whole grid's rows: a window's may differ in the last bit
   ProgressStep step(progress, "terrain by tiles");
   for (int t = 0; t < grid.count(); ++t) {
-    const hydro::tiled::TileRect r = grid.rect(t);
-    const int c0 = std::max(0, r.col0 - 1), r0 = std::max(0, r.row0 - 1);
-    const Dem window = reader.read(c0, r0, std::min(s.grid.cols, r.col0 + r.cols + 1) - c0, std::min(s.grid.rows, r.row0 + r.rows + 1) - r0);
-    const Dem z = hydro::tiled::crop(window, r.col0 - c0, r.row0 - r0, r.cols, r.rows);
+    const hydro::tiled::TileRect r = grid.rect(t), w = grid.grown(t, 1, 1);
+    const Dem window = reader.read(w.col0, w.row0, w.cols, w.rows);
+    const Dem z = hydro::tiled::crop(window, r.col0 - w.col0, r.row0 - w.row0, r.cols, r.rows);
     s.write_tile("terrain", elevation, t, grid.across(), z);
-    const Raster<std::uint8_t> shaded = hillshade(window, metric_rows(metrics, r0, window.rows()));
-    s.write_tile("terrain", shade, t, grid.across(), hydro::tiled::crop(shaded, r.col0 - c0, r.row0 - r0, r.cols, r.rows));
+    const Raster<std::uint8_t> shaded = hillshade(window, metric_rows(metrics, w.row0, w.rows));
+    s.write_tile("terrain", shade, t, grid.across(), hydro::tiled::crop(shaded, r.col0 - w.col0, r.row0 - w.row0, r.cols, r.rows));
     range.add(z);
     step.update(double(t + 1) / grid.count());
   }

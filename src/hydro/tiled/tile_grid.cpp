@@ -38,6 +38,12 @@ TileRect TileGrid::rect(int tile) const {
           row_bounds_[std::size_t(j) + 1] - row_bounds_[std::size_t(j)]};
 }
 
+TileRect TileGrid::grown(int tile, int halo_cols, int halo_rows) const {
+  const TileRect r = rect(tile);
+  const int c0 = std::max(0, r.col0 - halo_cols), r0 = std::max(0, r.row0 - halo_rows);
+  return {c0, r0, std::min(cols(), r.col0 + r.cols + halo_cols) - c0, std::min(rows(), r.row0 + r.rows + halo_rows) - r0};
+}
+
 int TileGrid::tile_of(int col, int row) const {
   const int i = int(std::upper_bound(col_bounds_.begin(), col_bounds_.end(), col) - col_bounds_.begin()) - 1;
   const int j = int(std::upper_bound(row_bounds_.begin(), row_bounds_.end(), row) - row_bounds_.begin()) - 1;
@@ -61,16 +67,21 @@ std::string too_little(double memory_limit_mb, double reserved_mb) {
   return "/input/memory_limit_mb: " + std::to_string(int(memory_limit_mb)) + " MB" + held + " is too little";
 }
 
-int tile_size_for(int cols, int rows, double memory_limit_mb, int concurrent, double reserved_mb) {
+int largest_tile_side(const std::function<double(int side)>& bytes, double memory_limit_mb, double reserved_mb, const std::string& what) {
   const double limit = (memory_limit_mb - reserved_mb) * 1e6;
-  for (int side = 1 << 15; side >= 64; side = side * 7 / 8) {
-    const TileGrid grid(cols, rows, side);
-    const double tile = kTileBytesPerCell * double(side + 4) * double(side + 4) * concurrent;
-    const double global = kGlobalBytesPerTileSide * double(grid.count()) * double(side) + 40.0 * rows;
-    if (tile + global <= limit) return side;
-  }
-  throw bad_input(too_little(memory_limit_mb, reserved_mb) + " for tiles of 64 x 64 cells on a " +
-                  std::to_string(cols) + " x " + std::to_string(rows) + " mosaic");
+  for (int side = 1 << 15; side >= 64; side = side * 7 / 8)
+    if (bytes(side) <= limit) return side;
+  throw bad_input(too_little(memory_limit_mb, reserved_mb) + " for " + what);
+}
+
+int tile_size_for(int cols, int rows, double memory_limit_mb, int concurrent, double reserved_mb) {
+  return largest_tile_side(
+      [&](int side) {
+        const TileGrid grid(cols, rows, side);
+        const double tile = kTileBytesPerCell * double(side + 4) * double(side + 4) * concurrent;
+        return tile + kGlobalBytesPerTileSide * double(grid.count()) * double(side) + 40.0 * rows;
+      },
+      memory_limit_mb, reserved_mb, "tiles of 64 x 64 cells on a " + std::to_string(cols) + " x " + std::to_string(rows) + " mosaic");
 }
 
 }  // namespace terrapolis::hydro::tiled

@@ -28,13 +28,11 @@ int halo_for(int steps) { return steps + 2; }
 std::string acc_file(const std::string& dir, int tile) { return dir + "/belhadj_acc_" + std::to_string(tile) + ".bin"; }
 
 int belhadj_tile_size_for(int cols, int rows, int halo, double memory_limit_mb, double reserved_mb) {
-  const double limit = (memory_limit_mb - reserved_mb) * 1e6 - 64.0 * rows;  // the whole grid's metrics
-  for (int side = 1 << 15; side >= 64; side = side * 7 / 8) {
-    const double window = kBelhadjBytesPerCell * double(std::min(side, cols) + 2 * halo) * double(std::min(side, rows) + 2 * halo);
-    if (window <= limit) return side;
-  }
-  throw bad_input(too_little(memory_limit_mb, reserved_mb) + " for hydrometry tiles of 64 x 64 cells with a halo of " + std::to_string(halo) +
-                  " cells (Belhadj's iterations)");
+  return largest_tile_side(
+      [&](int side) {  // a window and the whole grid's metrics
+        return kBelhadjBytesPerCell * double(std::min(side, cols) + 2 * halo) * double(std::min(side, rows) + 2 * halo) + 64.0 * rows;
+      },
+      memory_limit_mb, reserved_mb, "hydrometry tiles of 64 x 64 cells with a halo of " + std::to_string(halo) + " cells (Belhadj's iterations)");
 }
 
 }  // namespace
@@ -69,14 +67,11 @@ TiledBelhadjReport run_tiled_belhadj(int cols, int rows, const Georef& georef, c
   // Runs `steps` steps on tile t and its halo, calling each(model, step) before every step
   // (the quantities the step starts from) and after the last.
   auto on_tile = [&](int t, int steps, auto&& each) {
-    const TileRect r = grid.rect(t);
-    const int halo = halo_for(steps);
-    const int c0 = std::max(0, r.col0 - halo), r0 = std::max(0, r.row0 - halo);
-    const int c1 = std::min(cols, r.col0 + r.cols + halo), r1 = std::min(rows, r.row0 + r.rows + halo);
-    report.window_bytes = std::max(report.window_bytes, kBelhadjBytesPerCell * double(c1 - c0) * double(r1 - r0));
-    const Dem window = read(c0, r0, c1 - c0, r1 - r0);
-    BelhadjModel model(window, metric_rows(metrics, r0, r1 - r0), options.vertical, options.sea_level, options.share, range);
-    const TileRect core{r.col0 - c0, r.row0 - r0, r.cols, r.rows};
+    const TileRect r = grid.rect(t), w = grid.grown(t, halo_for(steps), halo_for(steps));
+    report.window_bytes = std::max(report.window_bytes, kBelhadjBytesPerCell * double(w.cols) * double(w.rows));
+    const Dem window = read(w.col0, w.row0, w.cols, w.rows);
+    BelhadjModel model(window, metric_rows(metrics, w.row0, w.rows), options.vertical, options.sea_level, options.share, range);
+    const TileRect core{r.col0 - w.col0, r.row0 - w.row0, r.cols, r.rows};
     for (int k = 0; k < steps; ++k) {
       each(model, core, k);
       model.step();

@@ -33,11 +33,10 @@ TileSurfaces surfaces_of(const TileGrid& grid, int t, const ReadWindow& read, co
   TileSurfaces s;
   s.core = grid.rect(t);
   const TileRect& r = s.core;
-  const int c0 = std::max(0, r.col0 - 1), r0 = std::max(0, r.row0 - 1);
-  const int c1 = std::min(grid.cols(), r.col0 + r.cols + 1), r1 = std::min(grid.rows(), r.row0 + r.rows + 1);
-  s.window = read(c0, r0, c1 - c0, r1 - r0);
-  s.ox = r.col0 - c0;
-  s.oy = r.row0 - r0;
+  const TileRect w = grid.grown(t, 1, 1);
+  s.window = read(w.col0, w.row0, w.cols, w.rows);
+  s.ox = r.col0 - w.col0;
+  s.oy = r.row0 - w.row0;
   const std::size_t n = std::size_t(r.cols) * std::size_t(r.rows);
   std::vector<std::uint8_t> seed(n);
   for (int y = 0; y < r.rows; ++y)
@@ -187,15 +186,12 @@ struct IdSet {
 }  // namespace
 
 int flat_water_tile_size_for(int cols, int rows, double memory_limit_mb, double reserved_mb) {
-  const double limit = (memory_limit_mb - reserved_mb) * 1e6;
-  for (int side = 1 << 15; side >= 64; side = side * 7 / 8) {
-    const TileGrid grid(cols, rows, side);
-    const double tile = kFlatWaterBytesPerCell * double(std::min(side, cols) + 4) * double(std::min(side, rows) + 4);
-    const double frames = kFlatWaterBytesPerEdgeCell * 4.0 * double(side) * double(grid.count());
-    if (tile + frames <= limit) return side;
-  }
-  throw bad_input(too_little(memory_limit_mb, reserved_mb) + " for flat water tiles of 64 x 64 cells on a " + std::to_string(cols) + " x " +
-                  std::to_string(rows) + " mosaic");
+  return largest_tile_side(
+      [&](int side) {  // a tile and its halo, the frames of all tiles
+        const double tile = kFlatWaterBytesPerCell * double(std::min(side, cols) + 4) * double(std::min(side, rows) + 4);
+        return tile + kFlatWaterBytesPerEdgeCell * 4.0 * double(side) * double(TileGrid(cols, rows, side).count());
+      },
+      memory_limit_mb, reserved_mb, "flat water tiles of 64 x 64 cells on a " + std::to_string(cols) + " x " + std::to_string(rows) + " mosaic");
 }
 
 TiledFlatWaterReport run_tiled_flat_water(int cols, int rows, const Georef& georef, const ReadWindow& read, const FlatWaterOptions& options,
@@ -223,8 +219,8 @@ TiledFlatWaterReport run_tiled_flat_water(int cols, int rows, const Georef& geor
     const TileSurfaces s = surfaces_of(grid, t, read, metrics, options);
     const std::vector<std::int64_t> ids = mosaic.ids_of(t, s);
     const TileRect& r = s.core;
-    const int e0 = std::max(0, r.col0 - 2), f0 = std::max(0, r.row0 - 2);
-    const int e1 = std::min(cols, r.col0 + r.cols + 2), f1 = std::min(rows, r.row0 + r.rows + 2), w = e1 - e0;
+    const TileRect around = grid.grown(t, 2, 2);
+    const int e0 = around.col0, f0 = around.row0, e1 = e0 + around.cols, f1 = f0 + around.rows, w = around.cols;
     std::vector<std::int64_t> near(std::size_t(w) * std::size_t(f1 - f0), kNone);
     for (int y = f0; y < f1; ++y)
       for (int x = e0; x < e1; ++x) {

@@ -35,6 +35,8 @@ class TileGrid {
   TileRect rect(int tile) const;
   /// The tile holding cell (col,row) of the mosaic (inside it).
   int tile_of(int col, int row) const;
+  /// Tile `tile` grown by a halo of `halo_cols` and `halo_rows` cells, within the mosaic.
+  TileRect grown(int tile, int halo_cols, int halo_rows) const;
 
  private:
   std::vector<int> col_bounds_, row_bounds_;
@@ -140,6 +142,10 @@ inline constexpr double kTileBytesPerCell = 48;
 /// within `memory_limit_mb` less `reserved_mb` (what the process and the mosaic's reader hold:
 /// reserve_reader_memory); throws bad_input when not even 64-cell tiles fit.
 int tile_size_for(int cols, int rows, double memory_limit_mb, int concurrent, double reserved_mb = 0);
+/// The largest tile side, from 32768 down by eighths to 64, whose state `bytes(side)` fits
+/// `memory_limit_mb` less `reserved_mb`; throws bad_input (too_little ... "for `what`") when none does.
+int largest_tile_side(const std::function<double(int side)>& bytes, double memory_limit_mb, double reserved_mb, const std::string& what);
+
 /// The start of the error of a memory limit too small for any tiling ("/input/memory_limit_mb: L MB
 /// (R MB of it held by ...) is too little").
 std::string too_little(double memory_limit_mb, double reserved_mb);
