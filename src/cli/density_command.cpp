@@ -198,7 +198,7 @@ class DensityCommand final : public Command {
     std::optional<ScratchFolder> computed(std::in_place, (dir / ".computed").string());  // gone before the outputs are committed
     const MosaicFiles water{computed->path(), "inland_water"}, belhadj{computed->path(), "hydrometry"};
     water.create();
-    const pipeline::InlandWaterTiles w = pipeline::inland_water_by_tiles(
+    const hydro::tiled::TiledFlatWaterReport w = pipeline::inland_water_by_tiles(
         reader, pipeline::inland_water_settings(scenario), tiles, reserve_reader_memory(tiles.limit_mb()),
         [&](int t, int across, const Raster<std::uint8_t>& tile) { write_raster(water.tile(t, across), tile, WriteOptions{}); }, context.progress);
     water.finish(w.tiles, w.across);
@@ -226,7 +226,7 @@ class DensityCommand final : public Command {
     const density::TiledDensityReport report = density::run_tiled_density(
         h.cols, h.rows, h.georef, read, options, tiles.tile_size, tiles.limit_mb(),
         [&](int t, int across, const density::DensityResult& tile) {
-          write_rasters(tile, options, terms(scenario), [&](const std::string& n) { return tile_file(dir.string(), n, t, across); });
+          write_rasters(tile, options, terms(scenario), [&](const std::string& n) { return MosaicFiles{dir.string(), n}.tile(t, across); });
         },
         context.progress, reserved_mb);
     for (const char* l : layers)

@@ -50,7 +50,7 @@ std::string tiles_of_this_process(const TiledHydroRequest& q, Context& context, 
   o.scratch_dir = scratch.path();
   o.tile_size = q.tile_size > 0 ? q.tile_size : hydro::tiled::tile_size_for(h.cols, h.rows, o.memory_limit_mb, threads, reserved_mb);
   const hydro::tiled::TileGrid grid(h.cols, h.rows, o.tile_size);
-  auto tile_path = [&](const Layer& l, int t) { return tile_file(out.string(), l.name, t, grid.across()); };
+  auto tile_path = [&](const Layer& l, int t) { return MosaicFiles{out.string(), l.name}.tile(t, grid.across()); };
   hydro::tiled::TileSinks sinks;
   if (q.filled) sinks.filled = [&](int t, const Dem& z) { write_raster(tile_path(layers[0], t), z, q.filled_file); };
   if (q.flowdir)
@@ -95,10 +95,6 @@ std::string tiles_of_this_process(const TiledHydroRequest& q, Context& context, 
 }
 
 }  // namespace
-
-std::string tile_file(const std::string& out_dir, const std::string& layer, int tile, int across) {
-  return MosaicFiles{out_dir, layer}.tile(tile, across);
-}
 
 void set_tile_distribution(TileDistribution* d) { distribution = d; }
 

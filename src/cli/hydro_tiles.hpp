@@ -31,8 +31,6 @@ struct TiledHydroRequest {
   WriteOptions filled_file, flowdir_file, accumulation_file, basins_file;  ///< description, metadata, COG, overwrite
 };
 
-/// OUTDIR/LAYER/tile_RRRR_CCCC.tif: the file of tile `tile` of a mosaic `across` tiles wide.
-std::string tile_file(const std::string& out_dir, const std::string& layer, int tile, int across);
 
 
 /// Writes OUTDIR/filled.vrt, flowdir.vrt, accumulation.vrt (basins.vrt) over one GeoTIFF a tile in

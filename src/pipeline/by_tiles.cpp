@@ -5,20 +5,17 @@
 #include <cstdio>
 
 #include "core/error.hpp"
-#include "hydro/tiled/tiled_flat_water.hpp"
 #include "io/mask_io.hpp"
 
 namespace terrapolis::pipeline {
 
-InlandWaterTiles inland_water_by_tiles(const DemWindowReader& dem, const InlandWaterSettings& water, const TileSettings& tiles,
-                                       double reserved_mb, const WriteTile<std::uint8_t>& write, Progress& progress) {
+hydro::tiled::TiledFlatWaterReport inland_water_by_tiles(const DemWindowReader& dem, const InlandWaterSettings& water, const TileSettings& tiles,
+                                                         double reserved_mb, const WriteTile<std::uint8_t>& write, Progress& progress) {
   if (!water.reservoirs.empty()) throw bad_input("/water/reservoirs: not flooded on tiles yet");
   const RasterHeader& h = dem.header();
-  InlandWaterTiles out;
-  out.tile_size = tiles.tile_size > 0 ? tiles.tile_size : hydro::tiled::flat_water_tile_size_for(h.cols, h.rows, tiles.limit_mb(), reserved_mb);
-  const hydro::tiled::TiledFlatWaterReport f = hydro::tiled::run_tiled_flat_water(
-      h.cols, h.rows, h.georef, [&](int c0, int r0, int cols, int rows) { return dem.read(c0, r0, cols, rows); }, water.flat_water,
-      out.tile_size,
+  const int side = tiles.tile_size > 0 ? tiles.tile_size : hydro::tiled::flat_water_tile_size_for(h.cols, h.rows, tiles.limit_mb(), reserved_mb);
+  return hydro::tiled::run_tiled_flat_water(
+      h.cols, h.rows, h.georef, [&](int c0, int r0, int cols, int rows) { return dem.read(c0, r0, cols, rows); }, water.flat_water, side,
       [&](int t, int across, const Raster<std::uint8_t>& lakes) {
         if (water.water_mask.empty()) return write(t, across, lakes);
         Raster<std::uint8_t> mask = read_mask(water.water_mask, lakes.georef(), lakes.cols(), lakes.rows());
@@ -26,18 +23,12 @@ InlandWaterTiles inland_water_by_tiles(const DemWindowReader& dem, const InlandW
         write(t, across, mask);
       },
       progress);
-  out.tiles = f.tiles;
-  out.across = f.across;
-  out.flat_lakes = f.lakes;
-  out.flat_lake_km2 = f.area_km2;
-  out.surfaces = f.surfaces;
-  return out;
 }
 
-std::string describe(const InlandWaterTiles& r) {
+std::string describe(const hydro::tiled::TiledFlatWaterReport& r) {
   char line[300];
   std::snprintf(line, sizeof line, "inland water tiles: %d of %d cells a side, %zu lakes the DEM flattens, %.2f km2 (%zu level surfaces on tile edges "
-                "or large enough, joined across tiles)", r.tiles, r.tile_size, r.flat_lakes, r.flat_lake_km2, r.surfaces);
+                "or large enough, joined across tiles)", r.tiles, r.tile_size, r.lakes, r.area_km2, r.surfaces);
   return line;
 }
 

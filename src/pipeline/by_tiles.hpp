@@ -11,6 +11,7 @@
 #include "density/tiled_density.hpp"
 #include "hydro/hydro.hpp"
 #include "hydro/tiled/tiled_belhadj.hpp"
+#include "hydro/tiled/tiled_flat_water.hpp"
 #include "io/raster_io.hpp"
 #include "pipeline/scenario.hpp"
 #include "pipeline/stage_options.hpp"
@@ -20,19 +21,12 @@ namespace terrapolis::pipeline {
 template <class T>
 using WriteTile = std::function<void(int tile, int across, const Raster<T>& raster)>;
 
-struct InlandWaterTiles {
-  int tiles = 0, across = 0, tile_size = 0;
-  std::size_t flat_lakes = 0;  ///< as InlandWater::flat_lakes
-  double flat_lake_km2 = 0;
-  std::size_t surfaces = 0;    ///< level surfaces joined across tiles or large enough
-};
-
 /// pipeline::inland_water by tiles: the lakes the DEM flattens (hydro::tiled::run_tiled_flat_water)
 /// and water.water_mask, 1 water, 0 not. Reservoirs are refused (bad_input).
-InlandWaterTiles inland_water_by_tiles(const DemWindowReader& dem, const InlandWaterSettings& water, const TileSettings& tiles,
+hydro::tiled::TiledFlatWaterReport inland_water_by_tiles(const DemWindowReader& dem, const InlandWaterSettings& water, const TileSettings& tiles,
                                        double reserved_mb, const WriteTile<std::uint8_t>& write, Progress& progress);
 /// The log line of inland_water_by_tiles.
-std::string describe(const InlandWaterTiles& report);
+std::string describe(const hydro::tiled::TiledFlatWaterReport& report);
 
 /// The hydrometry of run_hydro by tiles: Belhadj's (the accumulation method is refused, bad_input),
 /// keeping its Acc in `scratch_dir` meanwhile.

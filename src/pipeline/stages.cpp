@@ -230,11 +230,11 @@ void hydro_run_tiles(RunState& s, Progress& progress, const Log& log) {
   log.detail("hydro tiles: " + std::to_string(report.tiles) + " of " + std::to_string(report.tile_size) + " cells a side; " + describe(b));
   const MosaicFiles water = s.mosaic(std::filesystem::path(kInlandWater).stem().string());
   water.create();
-  const InlandWaterTiles w = inland_water_by_tiles(
+  const hydro::tiled::TiledFlatWaterReport w = inland_water_by_tiles(
       reader, s.settings.water, in.tiles, in.reserved_mb,
       [&](int t, int n, const Raster<std::uint8_t>& tile) { s.write_tile("hydro", water, t, n, tile); }, progress);
   s.write_mosaic("hydro", water, w.tiles, w.across, Style::water);
-  inland_water_figures(s, w.flat_lakes, w.flat_lake_km2);
+  inland_water_figures(s, w.lakes, w.area_km2);
   log.detail(describe(w));
 }
 

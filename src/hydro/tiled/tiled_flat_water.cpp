@@ -198,6 +198,7 @@ TiledFlatWaterReport run_tiled_flat_water(int cols, int rows, const Georef& geor
                                           int tile_size, const WriteMaskTile& write, Progress& progress) {
   const TileGrid grid(cols, rows, std::max(tile_size, 8));
   TiledFlatWaterReport report;
+  report.tile_size = std::max(tile_size, 8);
   report.tiles = grid.count();
   report.across = grid.across();
   const CellMetrics metrics = cell_metrics(georef, cols, rows);

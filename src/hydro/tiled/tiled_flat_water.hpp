@@ -16,7 +16,7 @@ namespace terrapolis::hydro::tiled {
 using WriteMaskTile = std::function<void(int tile, int across, const Raster<std::uint8_t>& mask)>;
 
 struct TiledFlatWaterReport {
-  int tiles = 0, across = 0;
+  int tile_size = 0, tiles = 0, across = 0;
   std::size_t lakes = 0;         ///< surfaces kept, as FlatWater::lakes
   double area_km2 = 0;           ///< their area (summed tile by tile)
   std::size_t surfaces = 0;      ///< level surfaces that reach a tile's frame or are large enough, given a mosaic-wide id
