@@ -16,7 +16,7 @@
 namespace terrapolis::hydro::tiled {
 namespace {
 
-/// Acc kept between the last two passes; nodata and sea cells are marked apart (Acc >= 0).
+/// Acc kept between the last two passes (>= 0); NaN on nodata, this on the sea.
 constexpr double kSea = -1;
 
 /// The first pass's halo; each further search for the stop doubles it.
@@ -64,8 +64,8 @@ TiledBelhadjReport run_tiled_belhadj(int cols, int rows, const Georef& georef, c
   }
   if (!(range[0] <= range[1])) throw bad_input("hydrometry: the DEM has no land cell (all nodata or below sea level)");
 
-  // Runs `steps` steps on tile t and its halo, calling each(model, step) before every step
-  // (the quantities the step starts from) and after the last.
+  // Runs `steps` steps on tile t and its halo, calling each(model, window, core, step) before every
+  // step (the quantities the step starts from) and after the last.
   auto on_tile = [&](int t, int steps, auto&& each) {
     const TileRect r = grid.rect(t), w = grid.grown(t, halo_for(steps), halo_for(steps));
     report.window_bytes = std::max(report.window_bytes, kBelhadjBytesPerCell * double(w.cols) * double(w.rows));
@@ -73,10 +73,10 @@ TiledBelhadjReport run_tiled_belhadj(int cols, int rows, const Georef& georef, c
     BelhadjModel model(window, metric_rows(metrics, w.row0, w.rows), options.vertical, options.sea_level, options.share, range);
     const TileRect core{r.col0 - w.col0, r.row0 - w.row0, r.cols, r.rows};
     for (int k = 0; k < steps; ++k) {
-      each(model, core, k);
+      each(model, window, core, k);
       model.step();
     }
-    each(model, core, steps);
+    each(model, window, core, steps);
   };
 
   // 2. The stop: each tile's quantities at the start of each step, summed over the whole grid.
@@ -87,7 +87,7 @@ TiledBelhadjReport run_tiled_belhadj(int cols, int rows, const Georef& georef, c
     valid = 0;
     ProgressStep step(progress, "hydrometry by tiles: iterations (up to " + std::to_string(steps) + ")");
     for (int t = 0; t < grid.count(); ++t) {
-      on_tile(t, steps, [&](const BelhadjModel& model, const TileRect& core, int k) {
+      on_tile(t, steps, [&](const BelhadjModel& model, const Dem&, const TileRect& core, int k) {
         if (k == steps) return;
         double sum = 0;
         for (int y = core.row0; y < core.row0 + core.rows; ++y)
@@ -116,7 +116,7 @@ TiledBelhadjReport run_tiled_belhadj(int cols, int rows, const Georef& georef, c
     ProgressStep step(progress, "hydrometry by tiles");
     for (int t = 0; t < grid.count(); ++t) {
       std::vector<double> acc;
-      on_tile(t, report.iterations, [&](const BelhadjModel& model, const TileRect& core, int k) {
+      on_tile(t, report.iterations, [&](const BelhadjModel& model, const Dem& window, const TileRect& core, int k) {
         if (k < report.iterations) return;
         acc.reserve(std::size_t(core.cols) * std::size_t(core.rows));
         for (int y = core.row0; y < core.row0 + core.rows; ++y)
@@ -126,7 +126,7 @@ TiledBelhadjReport run_tiled_belhadj(int cols, int rows, const Georef& georef, c
               hi = std::max(hi, model.acc(x, y));
               acc.push_back(model.acc(x, y));
             } else {
-              acc.push_back(kSea);  // nodata or sea: the DEM tells them apart
+              acc.push_back(std::isnan(window(x, y)) ? NAN : kSea);
             }
           }
       });
@@ -147,11 +147,8 @@ TiledBelhadjReport run_tiled_belhadj(int cols, int rows, const Georef& georef, c
         throw processing_error(scratch_dir + ": the hydrometry's tile " + std::to_string(t) + " was not read back");
     }
     std::filesystem::remove(acc_file(scratch_dir, t));
-    const Dem dem = read(r.col0, r.row0, r.cols, r.rows);
-    Raster<float> out = dem.like<float>(NAN);
-    for (std::size_t i = 0; i < acc.size(); ++i)
-      if (acc[i] >= 0) out[i] = belhadj_rescale(acc[i], lo, hi);
-      else if (!std::isnan(dem[i])) out[i] = 0.0f;  // sea
+    Raster<float> out(r.cols, r.rows, shifted(georef, r.col0, r.row0));
+    for (std::size_t i = 0; i < acc.size(); ++i) out[i] = std::isnan(acc[i]) ? NAN : acc[i] < 0 ? 0.0f : belhadj_rescale(acc[i], lo, hi);
     write(t, grid.across(), out);
   }
   return report;
