@@ -906,9 +906,9 @@ const StageDef& stage(const std::string& name) {
 
 const std::vector<StageDef>& stages() {
   static const std::vector<StageDef> list = {
-      {"terrain", {"dem", "input"}, terrain_prepare, terrain_run, terrain_load, terrain_summary},
-      {"hydro", {"water", "hydro"}, hydro_prepare, hydro_run, hydro_load, hydro_summary},
-      {"density", {"density", "plugins"}, density_prepare, density_run, density_load, density_summary},
+      {"terrain", {"dem", "input"}, terrain_prepare, terrain_run, terrain_load, terrain_summary, true},
+      {"hydro", {"water", "hydro"}, hydro_prepare, hydro_run, hydro_load, hydro_summary, true},
+      {"density", {"density", "plugins"}, density_prepare, density_run, density_load, density_summary, true},
       {"sites", {"sites", "seed"}, sites_prepare, sites_run, sites_load, sites_summary},
       {"network", {"network"}, network_prepare, network_run, network_load, network_summary},
       {"roads", {"roads"}, roads_prepare, roads_run, roads_load, roads_summary},
