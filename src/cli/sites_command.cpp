@@ -54,14 +54,15 @@ class SitesCommand final : public Command {
     const bool dem = std::filesystem::is_regular_file(dir_);
     if (!dem && dem_.given()) throw bad_input("--band, --assume-crs: only for a DEM, and " + dir_ + " is a density folder");
     const pipeline::DensityFolder in = dem ? run_density(scenario, dem_.read(dir_), options, context) : pipeline::read_density_folder(dir_);
+    const sites::LandRasters land(in.density, in.buildable);
     pipeline::ExistingPlaces existing;
     if (!existing_file.empty()) {
-      existing = pipeline::read_existing_places(existing_file, in.buildable);
+      existing = pipeline::read_existing_places(existing_file, land);
       options.existing = existing.sites;
       for (const auto& w : pipeline::existing_place_warnings(existing)) context.log.warn(w);
     }
     const auto t1 = std::chrono::steady_clock::now();
-    const sites::SitesResult result = sites::place_sites(in.density, in.buildable, options, context.progress);
+    const sites::SitesResult result = sites::place_sites(land, options, context.progress);
     const auto t2 = std::chrono::steady_clock::now();
     const Crs& crs = in.density.georef().crs;
     const VectorLayer cities = sites::cities_layer(result, crs);

@@ -2,6 +2,8 @@
 // SPDX-License-Identifier: MIT
 #include "pipeline/by_tiles.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 #include "core/error.hpp"
@@ -65,6 +67,36 @@ density::ReadWindowInputs density_windows(const DemWindowReader& dem, const Scen
     in.hydrometry = hydrometry ? hydrometry(in.dem, c0, r0) : in.dem.like<float>(0.0f);
     return in;
   };
+}
+
+// A band's cells hold 9 bytes (density 4, buildable 1, the catchments' owner 4); a block's 7 (density,
+// buildable, the disc test's row gaps), and its window grows by the largest disc: a quarter of the
+// budget for a block itself leaves room for margins of half its side.
+LandTiles::LandTiles(const DemWindowReader& density, const DemWindowReader& buildable, const Georef& grid, const TileSettings& tiles,
+                     double budget_mb)
+    : Land(grid, density.header().cols, density.header().rows), density_(density), buildable_(buildable) {
+  if (buildable.header().cols != cols() || buildable.header().rows != rows())
+    throw bad_input("sites: the buildable mask and the density model are not on the same grid");
+  const double bytes = std::max(budget_mb, 1.0) * 1e6;
+  band_rows_ = int(std::clamp(bytes / 2 / (9.0 * cols()), 1.0, double(rows())));
+  block_side_ = tiles.tile_size > 0 ? tiles.tile_size : std::max(64, int(std::sqrt(bytes / 4 / 7.0)));
+}
+
+sites::LandView LandTiles::window(int col0, int row0, int cols, int rows) const {
+  sites::LandView v;
+  v.col0 = col0, v.row0 = row0, v.cols = cols, v.rows = rows;
+  v.stride = std::size_t(cols);
+  const Dem d = density_.read(col0, row0, cols, rows), b = buildable_.read(col0, row0, cols, rows);
+  v.own_density.assign(d.data(), d.data() + d.size());
+  v.own_buildable.resize(b.size());
+  for (std::size_t i = 0; i < b.size(); ++i) v.own_buildable[i] = b[i] == 1 ? 1 : 0;  // nodata (NaN) is not buildable
+  v.density = v.own_density.data();
+  v.buildable = v.own_buildable.data();
+  return v;
+}
+
+void LandTiles::for_each_band(const std::function<void(const sites::LandView&)>& f) const {
+  for (int r = 0; r < rows(); r += band_rows_) f(window(0, r, cols(), std::min(band_rows_, rows() - r)));
 }
 
 }  // namespace terrapolis::pipeline

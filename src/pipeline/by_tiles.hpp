@@ -15,6 +15,7 @@
 #include "io/raster_io.hpp"
 #include "pipeline/scenario.hpp"
 #include "pipeline/stage_options.hpp"
+#include "sites/land.hpp"
 
 namespace terrapolis::pipeline {
 
@@ -43,5 +44,23 @@ using ReadHydrometry = std::function<Raster<float>(const Dem& window, int c0, in
 /// Holds references to `dem`, `scenario` and `options`.
 density::ReadWindowInputs density_windows(const DemWindowReader& dem, const Scenario& scenario, const density::DensityOptions& options,
                                           const std::string& inland_water, const ReadHydrometry& hydrometry);
+
+/// The land of the sites stage read from the density stage's tiles (density.vrt, buildable.vrt):
+/// bands of rows and blocks sized to the memory limit, the disc tests' blocks grown by the largest
+/// disc. Holds references to the two readers.
+class LandTiles : public sites::Land {
+ public:
+  /// `budget_mb`: what the land's bands and blocks may hold at once. `grid`: the run's DEM's
+  /// georeferencing (a VRT's geotransform may differ from it in the last bit).
+  LandTiles(const DemWindowReader& density, const DemWindowReader& buildable, const Georef& grid, const TileSettings& tiles, double budget_mb);
+  void for_each_band(const std::function<void(const sites::LandView&)>& f) const override;
+  sites::LandView window(int col0, int row0, int cols, int rows) const override;
+  int block_side() const override { return block_side_; }
+  int band_rows() const { return band_rows_; }
+
+ private:
+  const DemWindowReader &density_, &buildable_;
+  int block_side_ = 0, band_rows_ = 0;
+};
 
 }  // namespace terrapolis::pipeline

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <set>
 
 #include "core/error.hpp"
 #include "io/crs.hpp"
@@ -118,10 +119,11 @@ void check_existing_places(const std::string& path, const Crs& crs) {
   if (raw.empty()) throw bad_input(path + ": holds no place");
 }
 
-ExistingPlaces read_existing_places(const std::string& path, const Raster<std::uint8_t>& buildable) {
+ExistingPlaces read_existing_places(const std::string& path, const sites::Land& land) {
   ExistingPlaces out;
-  std::vector<std::uint8_t> taken(buildable.size(), 0);
-  std::vector<RawPlace> raw = read_raw(path, buildable.georef().crs);
+  std::set<std::pair<int, int>> taken;  // (col, row)
+  const auto inside = [&](int c, int r) { return c >= 0 && r >= 0 && c < land.cols() && r < land.rows(); };
+  std::vector<RawPlace> raw = read_raw(path, land.georef().crs);
   // The largest first: where two places share a cell, the larger keeps it.
   std::stable_sort(raw.begin(), raw.end(), [](const RawPlace& a, const RawPlace& b) { return a.population > b.population; });
   for (std::size_t k = 0; k < raw.size(); ++k) {
@@ -133,27 +135,29 @@ ExistingPlaces read_existing_places(const std::string& path, const Raster<std::u
       ++out.without_people;
       continue;
     }
-    const auto [col, row] = std::isfinite(p.x) && std::isfinite(p.y) ? cell_of(buildable.georef(), p.x, p.y) : std::array<int, 2>{-1, -1};
-    if (!buildable.inside(col, row)) {
+    const auto [col, row] = std::isfinite(p.x) && std::isfinite(p.y) ? cell_of(land.georef(), p.x, p.y) : std::array<int, 2>{-1, -1};
+    if (!inside(col, row)) {
       out.outside.push_back(name);
       continue;
     }
     // Its cell, or the nearest free buildable one within two cells (a coastal town on a sea cell of
     // a coarse grid, a second place in the same cell).
     int best_c = -1, best_r = -1, best_d = 1 << 30;
+    const int c0 = std::max(0, col - 2), r0 = std::max(0, row - 2);
+    const sites::LandView near = land.window(c0, r0, std::min(land.cols(), col + 3) - c0, std::min(land.rows(), row + 3) - r0);
     for (int r = row - 2; r <= row + 2; ++r)
       for (int c = col - 2; c <= col + 2; ++c) {
-        if (!buildable.inside(c, r) || buildable(c, r) != 1 || taken[buildable.index(c, r)]) continue;
+        if (!inside(c, r) || near.buildable[near.at(c, r)] != 1 || taken.count({c, r})) continue;
         const int d = (c - col) * (c - col) + (r - row) * (r - row);
         if (d < best_d) best_d = d, best_c = c, best_r = r;
       }
     if (best_c < 0)
       throw bad_input(path + ": " + name + ": lies on water, nodata or unbuildable land with no free buildable cell within two cells; move it or leave it out");
     if (best_d > 0) out.moved.push_back(name);
-    taken[buildable.index(best_c, best_r)] = 1;
+    taken.insert({best_c, best_r});
     sites::Site s;
     s.col = best_c, s.row = best_r;
-    const auto xy = buildable.georef().cell_centre(best_c, best_r);
+    const auto xy = land.georef().cell_centre(best_c, best_r);
     s.x = xy[0], s.y = xy[1];
     s.population = std::int64_t(std::llround(p.population));
     s.existing = true;

@@ -34,7 +34,7 @@ struct ExistingPlaces {
 std::vector<std::string> existing_place_warnings(const ExistingPlaces& places);
 /// Throws bad_input naming the file and the place when one lies farther than two cells from a free
 /// buildable cell, or its population is negative; and when no place with people lies on the grid.
-ExistingPlaces read_existing_places(const std::string& path, const Raster<std::uint8_t>& buildable);
+ExistingPlaces read_existing_places(const std::string& path, const sites::Land& land);
 
 /// What of those checks needs no grid (the file, its fields, every population a number >= 0), for
 /// a run to refuse a bad file before any stage starts.

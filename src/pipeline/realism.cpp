@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
+#include <optional>
 #include <random>
 
 #include "core/geodesy.hpp"
@@ -28,19 +30,29 @@ constexpr double kPlausiblePeoplePerKm2 = 45000;
 
 std::vector<std::string> settlement_warnings(const RunState& s, const sites::SitesResult& r) {
   std::vector<std::string> warnings;
-  const Dem& dem = s.dem;
+  // The 9 x 9 cells around each centre (NaN outside the grid): from the DEM, or its file by windows.
+  std::optional<DemWindowReader> tiles;
+  if (s.by_tiles) tiles.emplace(s.by_tiles->dem_path, s.by_tiles->read);
+  const auto around = [&](int col, int row) {
+    if (tiles) return tiles->read(col - 4, row - 4, 9, 9);
+    Dem near(9, 9, s.dem.georef(), std::numeric_limits<float>::quiet_NaN());
+    for (int r = 0; r < 9; ++r)
+      for (int c = 0; c < 9; ++c)
+        if (s.dem.inside(col - 4 + c, row - 4 + r)) near(c, r) = s.dem(col - 4 + c, row - 4 + r);
+    return near;
+  };
   int flat = 0, nodata = 0;
   std::string first_flat;
   for (const auto& site : r.sites) {
-    const float z = dem(site.col, site.row);
+    const Dem near = around(site.col, site.row);
+    const float z = near(4, 4);
     if (std::isnan(z)) {
       ++nodata;
       continue;
     }
     bool same = true;
-    for (int dr = -4; dr <= 4 && same; ++dr)
-      for (int dc = -4; dc <= 4 && same; ++dc)
-        same = dem.inside(site.col + dc, site.row + dr) && dem(site.col + dc, site.row + dr) == z;
+    for (int dr = 0; dr < 9 && same; ++dr)
+      for (int dc = 0; dc < 9 && same; ++dc) same = near(dc, dr) == z;  // false on NaN
     if (same && flat++ == 0) first_flat = "city " + std::to_string(site.id) + " at " + std::to_string(int(std::lround(z))) + " m";
   }
   if (flat)

@@ -200,7 +200,7 @@ json run_scenario(const Scenario& scenario, const RunOptions& options, Progress&
   const bool rerun = std::any_of(plan.begin(), plan.end(), [](Action a) { return a != Action::run; });
   json saved;
   if (rerun) saved = load_manifest(output.string());
-  // A rerun may stop where its saved run stopped (a run by tiles, made --until density), never
+  // A rerun may stop where its saved run stopped (a run by tiles, made --until network), never
   // before a stage it made: that stage's files would stay without their entry in run.json.
   for (std::size_t i = last + 1; rerun && i < stages().size(); ++i)
     if (saved["summary"].contains(stages()[i].name))

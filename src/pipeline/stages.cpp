@@ -451,13 +451,28 @@ void sites_run(RunState& s, Progress& progress, const Log& log) {
   if (s.summary.contains("density") && s.summary["density"].contains("land_area_km2"))
     options.land_area_km2 = s.summary["density"]["land_area_km2"].get<double>();
   const std::string existing_file = s.scenario.path("/sites/existing");
+  // By tiles: the density stage's tiles read by bands and blocks within the memory limit.
+  std::optional<DemWindowReader> density_tiles, buildable_tiles;
+  std::unique_ptr<sites::Land> land;
+  if (s.by_tiles) {
+    s.by_tiles->reserve();
+    density_tiles.emplace(saved(s, "density.vrt"));
+    buildable_tiles.emplace(saved(s, "buildable.vrt"));
+    const TiledInput& in = *s.by_tiles;
+    auto tiles = std::make_unique<LandTiles>(*density_tiles, *buildable_tiles, s.grid.georef, in.tiles, in.tiles.limit_mb() - in.reserved_mb);
+    log.detail("sites by tiles: bands of " + std::to_string(tiles->band_rows()) + " rows, disc tests by blocks of " +
+               std::to_string(tiles->block_side()) + " cells a side");
+    land = std::move(tiles);
+  } else {
+    land = std::make_unique<sites::LandRasters>(*s.density, *s.buildable);
+  }
   ExistingPlaces existing;
   if (!existing_file.empty()) {
-    existing = read_existing_places(existing_file, *s.buildable);
+    existing = read_existing_places(existing_file, *land);
     options.existing = existing.sites;
   }
-  const sites::SitesResult r = sites::place_sites(*s.density, *s.buildable, options, progress);
-  const Crs& crs = s.dem.georef().crs;
+  const sites::SitesResult r = sites::place_sites(*land, options, progress);
+  const Crs& crs = s.grid.georef.crs;
   s.cities = sites::cities_layer(r, crs);
   s.write("sites", "cities.geojson", *s.cities, Style::cities);
   s.write("sites", "city_extents.geojson", sites::city_extents_layer(r, crs), Style::city_extents);
@@ -509,7 +524,7 @@ void sites_run(RunState& s, Progress& progress, const Log& log) {
                            {"generated", r.sites.size() - existing.sites.size()},
                            {"generated_people", population - std::llround(r.existing_population) - r.growth_to_existing}};
   }
-  if (options.growth > 0) summary["growth"] = growth_figures(r, options, s.dem.georef().crs);
+  if (options.growth > 0) summary["growth"] = growth_figures(r, options, crs);
   std::vector<std::string> warnings = existing_file.empty() ? std::vector<std::string>() : existing_warnings(existing, options, r);
   for (auto& w : settlement_warnings(s, r)) warnings.push_back(std::move(w));
   const std::string reference = s.scenario.path("/sites/reference");
@@ -521,14 +536,16 @@ void sites_run(RunState& s, Progress& progress, const Log& log) {
 }
 
 void sites_load(RunState& s) {
-  s.cities = read_vector(saved(s, "cities.geojson"), s.dem.georef().crs);
+  s.cities = read_vector(saved(s, "cities.geojson"), s.grid.georef.crs);
   s.sites = sites::sites_from_layer(*s.cities, saved(s, "cities.geojson"));
-  sites::snap_to_cells(s.sites, s.dem.georef(), s.dem.cols(), s.dem.rows());  // the network a full run builds
+  sites::snap_to_cells(s.sites, s.grid.georef, s.grid.cols, s.grid.rows);  // the network a full run builds
 }
 
 void sites_prepare(const Scenario& scenario, const RasterHeader& grid, Settings& s) {
   s.sites = sites_options(scenario);
   check_file("/sites/reference", scenario.path("/sites/reference"));
+  if (tile_settings(scenario).given() && !scenario.path("/sites/reference").empty())
+    throw bad_input("/sites/reference: the realism figures are not computed on tiles yet (they read the whole density)");
   if (const std::string existing = scenario.path("/sites/existing"); !existing.empty()) {
     check_file("/sites/existing", existing);
     // Its format and figures now (whether each place finds land needs the density).
@@ -606,7 +623,7 @@ void sites_summary(const json& figures, SummaryText& out) {
 // ---- network (Belhadj 2007 §4.3.2; docs/sites.md) -------------------------------------------
 
 void network_run(RunState& s, Progress& progress, const Log&) {
-  const Crs& crs = s.dem.georef().crs;
+  const Crs& crs = s.grid.georef.crs;
   const network::SiteGraph graph = network::build_network(s.sites, crs, s.settings.network, progress);
   s.network = network::network_layer(graph, s.sites, crs);
   s.write("network", "network.geojson", *s.network, Style::network);
@@ -618,7 +635,7 @@ void network_run(RunState& s, Progress& progress, const Log&) {
                           {"kept_length_km", round_to(length_m / 1000, 0.01)}};
 }
 
-void network_load(RunState& s) { s.network = read_vector(saved(s, "network.geojson"), s.dem.georef().crs); }
+void network_load(RunState& s) { s.network = read_vector(saved(s, "network.geojson"), s.grid.georef.crs); }
 
 void network_prepare(const Scenario& scenario, const RasterHeader&, Settings& s) { s.network = network_options(scenario); }
 
@@ -909,8 +926,8 @@ const std::vector<StageDef>& stages() {
       {"terrain", {"dem", "input"}, terrain_prepare, terrain_run, terrain_load, terrain_summary, true},
       {"hydro", {"water", "hydro"}, hydro_prepare, hydro_run, hydro_load, hydro_summary, true},
       {"density", {"density", "plugins"}, density_prepare, density_run, density_load, density_summary, true},
-      {"sites", {"sites", "seed"}, sites_prepare, sites_run, sites_load, sites_summary},
-      {"network", {"network"}, network_prepare, network_run, network_load, network_summary},
+      {"sites", {"sites", "seed"}, sites_prepare, sites_run, sites_load, sites_summary, true},
+      {"network", {"network"}, network_prepare, network_run, network_load, network_summary, true},
       {"roads", {"roads"}, roads_prepare, roads_run, roads_load, roads_summary},
       {"access", {"access"}, access_prepare, access_run, access_load, access_summary},
   };

@@ -29,32 +29,35 @@ std::uint64_t bounded(std::mt19937_64& generator, std::uint64_t n) {
 
 constexpr std::uint16_t kFar = std::numeric_limits<std::uint16_t>::max();
 
-/// The disc tests of Algorithm 14 (intersecte_seuil), for discs centred on cell centres.
-/// A disc of radius r touches a cell when the cell's centre is within r metres of its centre.
+/// The disc tests of Algorithm 14 (intersecte_seuil), for discs centred on cell centres, on a
+/// window of the land: a block of candidates grown by the largest disc (clear_classes_of). The
+/// grid's edges count as uninhabitable; a window's edge inside the grid does not, and the margin
+/// makes it never matter (clear_classes_of).
 class DiscTester {
  public:
-  DiscTester(const std::vector<std::uint8_t>& habitable, int cols, int rows, const GridDistance& distance)
-      : habitable_(habitable), cols_(cols), rows_(rows), distance_(distance) {}
+  DiscTester(const LandView& window, int cols, int rows, const GridDistance& distance)
+      : w_(window), cols_(cols), rows_(rows), distance_(distance) {}
 
   /// Row pass of a separable distance transform: for every cell, the number of columns to
   /// the nearest uninhabitable cell of its row (the columns just outside the grid count as
   /// uninhabitable), capped at 65535. The column pass is evaluated exactly, per candidate,
   /// in clear_distance_m.
   void build_row_pass() {
-    row_gap_.assign(habitable_.size(), kFar);
-    tbb::parallel_for(tbb::blocked_range<int>(0, rows_), [&](const tbb::blocked_range<int>& range) {
+    row_gap_.assign(std::size_t(w_.cols) * std::size_t(w_.rows), kFar);
+    const long none = -long(kFar) - 1;  // no uninhabitable cell seen yet in the window (the gap stays kFar)
+    const long west = w_.col0 == 0 ? -1 : none, east = w_.col0 + w_.cols == cols_ ? cols_ : long(cols_) + kFar + w_.cols;
+    tbb::parallel_for(tbb::blocked_range<int>(w_.row0, w_.row0 + w_.rows), [&](const tbb::blocked_range<int>& range) {
       for (int r = range.begin(); r < range.end(); ++r) {
-        const std::size_t base = std::size_t(r) * std::size_t(cols_);
-        long last = -1;  // the virtual column west of the grid
-        for (int c = 0; c < cols_; ++c) {
-          if (!habitable_[base + std::size_t(c)]) last = c;
-          row_gap_[base + std::size_t(c)] = std::uint16_t(std::min<long>(c - last, kFar));
+        std::uint16_t* gap = row_gap_.data() + std::size_t(r - w_.row0) * std::size_t(w_.cols);  // gap[c - col0]
+        long last = west;  // the virtual column west of the grid, or none
+        for (int c = w_.col0; c < w_.col0 + w_.cols; ++c) {
+          if (!w_.habitable(c, r)) last = c;
+          gap[c - w_.col0] = std::uint16_t(std::min<long>(c - last, kFar));
         }
-        last = cols_;  // the virtual column east of the grid
-        for (int c = cols_ - 1; c >= 0; --c) {
-          if (!habitable_[base + std::size_t(c)]) last = c;
-          auto& g = row_gap_[base + std::size_t(c)];
-          g = std::uint16_t(std::min<long>({long(g), last - c, long(kFar)}));
+        last = east;  // the virtual column east of the grid, or none
+        for (int c = w_.col0 + w_.cols - 1; c >= w_.col0; --c) {
+          if (!w_.habitable(c, r)) last = c;
+          gap[c - w_.col0] = std::uint16_t(std::min<long>({long(gap[c - w_.col0]), last - c, long(kFar)}));
         }
       }
     });
@@ -75,7 +78,7 @@ class DiscTester {
           best = dy;
           break;
         }
-        const double gap = row_gap_[std::size_t(r) * std::size_t(cols_) + std::size_t(c0)];
+        const double gap = row_gap_[std::size_t(r - w_.row0) * std::size_t(w_.cols) + std::size_t(c0 - w_.col0)];
         const double dx = gap * distance_.width_between(r0, r);
         best = std::min(best, std::sqrt(dx * dx + dy * dy));
       }
@@ -97,39 +100,111 @@ class DiscTester {
       const int r = r0 - int(std::lround(north / h));
       const int c = c0 + int(std::lround(east / distance_.width_between(r0, r)));
       if (c < 0 || r < 0 || c >= cols_ || r >= rows_) return true;
-      if (!habitable_[std::size_t(r) * std::size_t(cols_) + std::size_t(c)]) return true;
+      if (!w_.habitable(c, r)) return true;
     }
     return false;
   }
 
  private:
-  const std::vector<std::uint8_t>& habitable_;
+  const LandView& w_;
   int cols_, rows_;
   const GridDistance& distance_;
-  std::vector<std::uint16_t> row_gap_;
+  std::vector<std::uint16_t> row_gap_;  // over the window
 };
 
-/// Marks the cells whose centre lies strictly inside the disc of `s` (the centre test of the
-/// inclusion rules).
-void mark_disc(const Site& s, const GridDistance& distance, int cols, int rows, std::vector<std::uint8_t>& covered) {
-  const double y0 = distance.northing(s.row);
-  for (int dir : {1, -1})
-    for (int r = dir == 1 ? s.row : s.row - 1; r >= 0 && r < rows; r += dir) {
-      const double dy = std::abs(distance.northing(r) - y0);
-      if (dy >= s.radius_m) break;
-      const double w = distance.width_between(s.row, r);
-      const int reach = int(std::sqrt(s.radius_m * s.radius_m - dy * dy) / w) + 1;
-      for (int c = std::max(0, s.col - reach); c <= std::min(cols - 1, s.col + reach); ++c)
-        if (distance(s.col, s.row, c, r) < s.radius_m) covered[std::size_t(r) * std::size_t(cols) + std::size_t(c)] = 1;
-    }
+/// For each candidate cell (pool, in density order), the number of leading radius classes (ascending
+/// `radius`) whose disc is clear of uninhabitable land: the growth stops at the first intersection.
+/// It depends on the land alone, so every candidate is tested once, block by block of the land
+/// (Land::block_side), each block read with a margin as wide as the largest disc: a window's edge
+/// inside the grid is farther from its candidates than any disc reaches, so the result is the
+/// whole grid's.
+std::vector<int> clear_classes_of(const Land& land, const std::vector<std::uint32_t>& pool, const std::vector<double>& radius,
+                                  const SitesOptions& options, const GridDistance& distance, ProgressStep& step) {
+  std::vector<int> limit(pool.size(), 0);
+  if (radius.empty() || pool.empty()) return limit;
+  const int cols = land.cols(), rows = land.rows();
+  const bool exact = options.disc_test == SitesOptions::DiscTest::exact;
+  const double cap = radius.back() + 1.0;  // the exact test's search radius, beyond the largest disc
+  const CellMetrics& m = distance.metrics();
+  const double width = std::max(*std::min_element(m.width_m.begin(), m.width_m.end()), 1e-9);
+  const double height = std::max(*std::min_element(m.height_m.begin(), m.height_m.end()), 1e-9);
+  const auto margin = [&](double cell_m, int extent) { return int(std::min<double>(std::ceil(cap / cell_m) + 2, extent)); };
+  const int margin_cols = margin(width, cols), margin_rows = margin(height, rows);
+  const int side = land.block_side() > 0 ? land.block_side() : std::max(cols, rows);
+  const int across = (cols + side - 1) / side;
+  // Candidates by block (then density order).
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> by_block(pool.size());
+  for (std::size_t k = 0; k < pool.size(); ++k) {
+    const std::uint32_t c = pool[k] % std::uint32_t(cols), r = pool[k] / std::uint32_t(cols);
+    by_block[k] = {std::uint64_t(r / std::uint32_t(side)) * std::uint64_t(across) + c / std::uint32_t(side), std::uint32_t(k)};
+  }
+  std::sort(by_block.begin(), by_block.end());
+  for (std::size_t begin = 0; begin < by_block.size();) {
+    std::size_t end = begin;
+    while (end < by_block.size() && by_block[end].first == by_block[begin].first) ++end;
+    const int bc = int(by_block[begin].first % std::uint64_t(across)), br = int(by_block[begin].first / std::uint64_t(across));
+    const int c0 = std::max(0, bc * side - margin_cols), r0 = std::max(0, br * side - margin_rows);
+    const int c1 = std::min(cols, (bc + 1) * side + margin_cols), r1 = std::min(rows, (br + 1) * side + margin_rows);
+    const LandView window = land.window(c0, r0, c1 - c0, r1 - r0);
+    DiscTester tester(window, cols, rows, distance);
+    if (exact) tester.build_row_pass();
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, 16), [&](const tbb::blocked_range<std::size_t>& range) {
+      for (std::size_t b = range.begin(); b < range.end(); ++b) {
+        const std::uint32_t k = by_block[b].second;
+        const int c = int(pool[k] % std::uint32_t(cols)), r = int(pool[k] / std::uint32_t(cols));
+        if (exact) {
+          const double d = tester.clear_distance_m(c, r, cap);
+          limit[k] = int(std::lower_bound(radius.begin(), radius.end(), d) - radius.begin());  // classes with radius < d
+        } else {
+          int i = 0;
+          while (i < int(radius.size()) && !tester.circle_hits(c, r, radius[std::size_t(i)])) ++i;
+          limit[k] = i;
+        }
+      }
+    });
+    begin = end;
+    step.update(double(end) / double(by_block.size()));
+  }
+  return limit;
 }
 
-/// Cells whose centre lies strictly inside one of the discs of `sites`.
-std::vector<std::uint8_t> covered_cells(const std::vector<Site>& sites, const GridDistance& distance, int cols, int rows) {
-  std::vector<std::uint8_t> covered(std::size_t(cols) * std::size_t(rows), 0);
-  for (const Site& s : sites) mark_disc(s, distance, cols, rows, covered);
-  return covered;
-}
+/// The candidate cells, for the test of which of them lie inside a disc.
+class CandidateCells {
+ public:
+  explicit CandidateCells(const std::vector<std::uint32_t>& pool) : by_cell_(pool.size()) {
+    for (std::size_t k = 0; k < pool.size(); ++k) by_cell_[k] = {pool[k], std::uint32_t(k)};
+    std::sort(by_cell_.begin(), by_cell_.end());
+  }
+
+  /// Flags (by candidate) those whose cell centre lies strictly inside the disc of `s` (the centre
+  /// test of the inclusion rules).
+  void mark_disc(const Site& s, const GridDistance& distance, int cols, int rows, std::vector<std::uint8_t>& covered) const {
+    const double y0 = distance.northing(s.row);
+    for (int dir : {1, -1})
+      for (int r = dir == 1 ? s.row : s.row - 1; r >= 0 && r < rows; r += dir) {
+        const double dy = std::abs(distance.northing(r) - y0);
+        if (dy >= s.radius_m) break;
+        const double w = distance.width_between(s.row, r);
+        const int reach = int(std::sqrt(s.radius_m * s.radius_m - dy * dy) / w) + 1;
+        const std::uint32_t row_start = std::uint32_t(r) * std::uint32_t(cols);
+        const std::uint32_t first = row_start + std::uint32_t(std::max(0, s.col - reach));
+        const std::uint32_t last = row_start + std::uint32_t(std::min(cols - 1, s.col + reach));
+        for (auto it = std::lower_bound(by_cell_.begin(), by_cell_.end(), std::pair<std::uint32_t, std::uint32_t>{first, 0});
+             it != by_cell_.end() && it->first <= last; ++it)
+          if (distance(s.col, s.row, int(it->first - row_start), r) < s.radius_m) covered[it->second] = 1;
+      }
+  }
+
+  /// Flags the candidates inside one of the discs of `sites`.
+  std::vector<std::uint8_t> covered(const std::vector<Site>& sites, const GridDistance& distance, int cols, int rows) const {
+    std::vector<std::uint8_t> flags(by_cell_.size(), 0);
+    for (const Site& s : sites) mark_disc(s, distance, cols, rows, flags);
+    return flags;
+  }
+
+ private:
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> by_cell_;  // (cell, candidate), by cell
+};
 
 /// Places left for new settlements out of `room`: those the existing places do not take, and at
 /// least the new people's share of the room (where more places are given than the lattice
@@ -143,14 +218,16 @@ std::size_t free_room(std::size_t room, double to_place, const SitesResult& resu
 /// The rank_size quotas: the region's people (the figure given, else the default density times
 /// the land area), the settled share of them split by the rank-size law (its exponent given, or
 /// read from the catchments of a first placement), at most as many places as the land holds.
-QuotaTable rank_size_table(const Raster<float>& density, const Raster<std::uint8_t>& buildable, const SitesOptions& options,
+QuotaTable rank_size_table(const Land& land, const SitesOptions& options,
                            const CellMetrics& metrics, double cell_size, SitesResult& result, Progress& progress) {
   double land_km2 = options.land_area_km2;
   if (!(land_km2 > 0)) {
     double m2 = 0;
-    for (int r = 0; r < density.rows(); ++r)
-      for (int c = 0; c < density.cols(); ++c)
-        if (buildable(c, r) == 1) m2 += metrics.area_m2[std::size_t(r)];
+    land.for_each_band([&](const LandView& v) {
+      for (int r = v.row0; r < v.row0 + v.rows; ++r)
+        for (int c = 0; c < v.cols; ++c)
+          if (v.buildable[v.at(c, r)] == 1) m2 += metrics.area_m2[std::size_t(r)];
+    });
     land_km2 = m2 * 1e-6;
   }
   result.population_assumed = !(options.population > 0);
@@ -198,11 +275,11 @@ QuotaTable rank_size_table(const Raster<float>& density, const Raster<std::uint8
     pilot.existing.clear();
     pilot.growth = 0;
     pilot.min_distance_share = 0;  // the catchments of the densest sites, unspaced, give the sizes their spread
-    const SitesResult central = place_sites(density, buildable, pilot, progress);
+    const SitesResult central = place_sites(land, pilot, progress);
     result.room = central.room;
     result.count_limited = central.count_limited;
     std::vector<double> settled;
-    for (double p : catchment_people(density, buildable, central.sites, result.settled_population))
+    for (double p : catchment_people(land, central.sites, result.settled_population))
       if (p >= options.min_population) settled.push_back(p);
     const double q = rank_size_exponent(settled);
     if (std::isfinite(q)) result.sizes_exponent = q;  // fewer than 3 catchments that large: zipf_exponent
@@ -228,31 +305,63 @@ QuotaTable rank_size_table(const Raster<float>& density, const Raster<std::uint8
   return table;
 }
 
-/// Habitable cells: buildable == 1 with a density value.
-std::vector<std::uint8_t> habitable_cells(const Raster<float>& density, const Raster<std::uint8_t>& buildable) {
-  std::vector<std::uint8_t> habitable(density.size());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, density.size(), 1 << 16), [&](const tbb::blocked_range<std::size_t>& range) {
-    for (std::size_t i = range.begin(); i < range.end(); ++i)
-      habitable[i] = buildable[i] == 1 && !buildable.is_nodata(i) && std::isfinite(density[i]);
+/// The candidates: M distinct cells drawn uniformly among the habitable ones (partial Fisher-Yates
+/// over their row-major list), by density, decreasing; equal densities keep the draw order, itself
+/// random. The list is never held: the shuffle keeps only the positions it moved, and one pass over
+/// the land turns the drawn positions into cells.
+struct Candidates {
+  std::vector<std::uint32_t> cells;
+  std::vector<float> density;
+};
+Candidates draw_candidates(const Land& land, std::int64_t wanted, std::uint64_t seed) {
+  if (std::uint64_t(land.cols()) * std::uint64_t(land.rows()) > std::numeric_limits<std::uint32_t>::max())
+    throw bad_input("sites: grid larger than 2^32 cells");
+  std::uint64_t habitable = 0;
+  land.for_each_band([&](const LandView& v) {
+    for (int r = v.row0; r < v.row0 + v.rows; ++r)
+      for (int c = 0; c < v.cols; ++c) habitable += v.habitable(c, r);
   });
-  return habitable;
-}
-
-/// M distinct candidates drawn uniformly among the habitable cells (partial Fisher-Yates), by
-/// density, decreasing; equal densities keep the draw order, itself random.
-std::vector<std::uint32_t> draw_candidates(const Raster<float>& density, const std::vector<std::uint8_t>& habitable, std::int64_t wanted,
-                                           std::uint64_t seed) {
-  std::vector<std::uint32_t> pool;
-  if (density.size() > std::numeric_limits<std::uint32_t>::max()) throw bad_input("sites: grid larger than 2^32 cells");
-  for (std::size_t i = 0; i < habitable.size(); ++i)
-    if (habitable[i]) pool.push_back(std::uint32_t(i));
-  if (pool.empty()) throw bad_input("sites: no buildable cell in the density model");
-  const std::size_t m = std::size_t(std::clamp<std::int64_t>(wanted, 1, std::int64_t(pool.size())));
+  if (habitable == 0) throw bad_input("sites: no buildable cell in the density model");
+  const std::size_t m = std::size_t(std::clamp<std::int64_t>(wanted, 1, std::int64_t(std::min<std::uint64_t>(habitable, INT64_MAX))));
+  // Position p of the list holds habitable cell number p until the shuffle moves it. Position k is
+  // final once step k is done (later steps swap positions after it).
+  std::unordered_map<std::uint64_t, std::uint64_t> moved;
+  const auto at = [&](std::uint64_t p) {
+    const auto it = moved.find(p);
+    return it == moved.end() ? p : it->second;
+  };
   std::mt19937_64 generator(seed);
-  for (std::size_t k = 0; k < m; ++k) std::swap(pool[k], pool[k + bounded(generator, pool.size() - k)]);
-  pool.resize(m);
-  std::stable_sort(pool.begin(), pool.end(), [&](std::uint32_t a, std::uint32_t b) { return density[a] > density[b]; });
-  return pool;
+  std::vector<std::uint64_t> drawn(m);  // habitable cell numbers, in draw order
+  for (std::size_t k = 0; k < m; ++k) {
+    const std::uint64_t j = k + bounded(generator, habitable - k);
+    drawn[k] = at(j);
+    moved[j] = at(k);
+  }
+  // Habitable cell numbers to cells and their densities, in one pass.
+  std::vector<std::uint32_t> order(m);
+  std::iota(order.begin(), order.end(), 0u);
+  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return drawn[a] < drawn[b]; });
+  Candidates drawn_cells{std::vector<std::uint32_t>(m), std::vector<float>(m)};
+  std::uint64_t number = 0;
+  std::size_t next = 0;
+  land.for_each_band([&](const LandView& v) {
+    for (int r = v.row0; r < v.row0 + v.rows && next < m; ++r)
+      for (int c = 0; c < v.cols && next < m; ++c) {
+        if (!v.habitable(c, r)) continue;
+        if (drawn[order[next]] == number) {
+          drawn_cells.cells[order[next]] = std::uint32_t(r) * std::uint32_t(land.cols()) + std::uint32_t(c);
+          drawn_cells.density[order[next]] = v.density[v.at(c, r)];
+          ++next;
+        }
+        ++number;
+      }
+  });
+  std::iota(order.begin(), order.end(), 0u);  // back to draw order
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::uint32_t a, std::uint32_t b) { return drawn_cells.density[a] > drawn_cells.density[b]; });
+  Candidates out{std::vector<std::uint32_t>(m), std::vector<float>(m)};
+  for (std::size_t k = 0; k < m; ++k) out.cells[k] = drawn_cells.cells[order[k]], out.density[k] = drawn_cells.density[order[k]];
+  return out;
 }
 
 /// The centres placed so far, bucketed on a grid of blocks at least `block_metres` wide, for the
@@ -299,12 +408,16 @@ class Spacing {
 class Growth {
  public:
   /// `radius`: ascending radius index i of Algorithm 14 (r = r_min + i dr); class = n - 1 - i.
-  Growth(const Raster<float>& density, const std::vector<std::uint8_t>& habitable, std::vector<std::uint32_t> pool,
-         std::vector<double> radius, const SitesOptions& options, const GridDistance& distance)
-      : density_(density), pool_(std::move(pool)), radius_(std::move(radius)), options_(options), cols_(density.cols()),
-        distance_(distance), tester_(habitable, density.cols(), density.rows(), distance) {
-    if (options.disc_test == SitesOptions::DiscTest::exact) tester_.build_row_pass();
+  Growth(const Land& land, Candidates candidates, std::vector<double> radius, const SitesOptions& options, const GridDistance& distance,
+         Progress& progress)
+      : georef_(land.georef()), pool_(std::move(candidates.cells)), pool_density_(std::move(candidates.density)),
+        radius_(std::move(radius)), options_(options), cols_(land.cols()), rows_(land.rows()), distance_(distance), cells_(pool_) {
+    ProgressStep step(progress, "sites: disc tests");
+    limit_ = clear_classes_of(land, pool_, radius_, options, distance, step);
   }
+
+  /// Flags the candidates that lie inside one of the discs of `sites`.
+  std::vector<std::uint8_t> covered(const std::vector<Site>& sites) const { return cells_.covered(sites, distance_, cols_, rows_); }
 
   /// Central-place spacing, by radius index j: the settlement of rank k (the next of class j has
   /// rank first_rank[j] + those of j placed) keeps share x sqrt(land / k) from every centre at least
@@ -326,29 +439,26 @@ class Growth {
   /// of unbuildable land for them (a city on land cut by water or steep slopes). Each, largest
   /// first, goes to the densest candidate whose cell no disc covers, its disc then reaching over
   /// that land, as a city's does around a bay. `covered` gains every disc placed.
-  void crowd(std::vector<int>& quota, QuotaTable& table, std::vector<Site>& out, std::vector<std::uint8_t>& covered,
-             const GridDistance& distance) {
+  void crowd(std::vector<int>& quota, QuotaTable& table, std::vector<Site>& out, std::vector<std::uint8_t>& covered) {
     const int n = int(radius_.size());
     int j = n - 1;
     for (std::size_t k = 0; k < pool_.size(); ++k) {
       while (j >= 0 && quota[std::size_t(j)] == 0) --j;
       if (j < 0) break;
-      if (covered[pool_[k]]) continue;
+      if (covered[k]) continue;
       --quota[std::size_t(j)];
       ++table.classes[std::size_t(n - 1 - j)].placed;
       out.push_back(site_at(k, j));
-      mark_disc(out.back(), distance, cols_, density_.rows(), covered);
+      cells_.mark_disc(out.back(), distance_, cols_, rows_, covered);
     }
   }
 
-  /// From candidate `next_` on, with quota[] left, skipping candidates whose cell is `covered`;
-  /// appends the sites to `out`. Disc tests run in parallel a batch ahead; the quota bookkeeping is
-  /// sequential, in density order.
+  /// From candidate `next_` on, with quota[] left, skipping the `covered` candidates; appends the
+  /// sites to `out`, in density order.
   void grow(const std::vector<std::uint8_t>* covered, std::vector<int>& quota, QuotaTable& table, std::vector<Site>& out, ProgressStep& step) {
     const std::size_t m = pool_.size();
     const int n = int(radius_.size());
     int remaining = std::accumulate(quota.begin(), quota.end(), 0);
-    std::vector<int> limit;
     // One grid of centres per class, holding those it keeps its distance from (its blocks as wide
     // as the distance of its last rank, the least it keeps).
     const bool spaced = !first_rank_.empty();
@@ -371,14 +481,10 @@ class Growth {
     const std::size_t batch = 4096;
     while (next_ < m && remaining > 0) {
       const std::size_t begin = next_, end = std::min(m, begin + batch);
-      limit.assign(end - begin, 0);
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, 16), [&](const tbb::blocked_range<std::size_t>& range) {
-        for (std::size_t k = range.begin(); k < range.end(); ++k)
-          limit[k - begin] = covered && (*covered)[pool_[k]] ? 0 : clear_classes(pool_[k]);
-      });
       for (std::size_t k = begin; k < end && remaining > 0; ++k, next_ = k) {
         const int c = int(pool_[k] % std::uint32_t(cols_)), r = int(pool_[k] / std::uint32_t(cols_));
-        int j = limit[k - begin] - 1;  // the largest valid class with quota left, spaced from the larger centres
+        // The largest valid class with quota left, spaced from the larger centres.
+        int j = (covered && (*covered)[k] ? 0 : limit_[k]) - 1;
         while (j >= 0 && (quota[std::size_t(j)] == 0 || too_close(c, r, j))) --j;
         if (j < 0) continue;  // supprimer(L_sites, S)
         --quota[std::size_t(j)];
@@ -401,42 +507,32 @@ class Growth {
   }
 
  private:
-  /// Number of leading classes whose disc is clear: the growth stops at the first intersection.
-  int clear_classes(std::uint32_t cell) const {
-    const int c = int(cell % std::uint32_t(cols_)), r = int(cell / std::uint32_t(cols_));
-    if (options_.disc_test == SitesOptions::DiscTest::exact) {
-      const double d = tester_.clear_distance_m(c, r, radius_.back() + 1.0);
-      return int(std::lower_bound(radius_.begin(), radius_.end(), d) - radius_.begin());  // classes with radius < d
-    }
-    int i = 0;
-    while (i < int(radius_.size()) && !tester_.circle_hits(c, r, radius_[std::size_t(i)])) ++i;
-    return i;
-  }
-
   /// The site of candidate k in radius index j.
   Site site_at(std::size_t k, int j) {
     const int n = int(radius_.size());
     Site s;
     s.col = int(pool_[k] % std::uint32_t(cols_));
     s.row = int(pool_[k] / std::uint32_t(cols_));
-    const auto xy = density_.georef().cell_centre(s.col, s.row);
+    const auto xy = georef_.cell_centre(s.col, s.row);
     s.x = xy[0];
     s.y = xy[1];
     s.radius_m = radius_[std::size_t(j)];
     s.radius_class = n - 1 - j;
     s.population = std::llround(options_.people_per_m * s.radius_m);
-    s.density = density_[pool_[k]];
+    s.density = pool_density_[k];
     rank_of_[pool_[k]] = k;
     return s;
   }
 
-  const Raster<float>& density_;
-  const std::vector<std::uint32_t> pool_;
+  const Georef& georef_;
+  const std::vector<std::uint32_t> pool_;   // candidate cells, by density, decreasing
+  const std::vector<float> pool_density_;   // their densities
   const std::vector<double> radius_;
   const SitesOptions& options_;
-  const int cols_;
+  const int cols_, rows_;
   const GridDistance& distance_;
-  DiscTester tester_;
+  const CandidateCells cells_;
+  std::vector<int> limit_;  // by candidate: the leading classes whose disc is clear (clear_classes_of)
   double share_ = 0, land_m2_ = 0;
   std::vector<std::size_t> first_rank_, last_rank_;
   std::vector<std::int64_t> floor_;
@@ -471,19 +567,18 @@ void keep_central_places_apart(Growth& growth, const QuotaTable& table, const st
 /// rank_size: every settlement of the law gets a place. Those the growth and its refills left
 /// without one are crowded in (Growth::crowd) and the list is put back in size order, parents
 /// first; result.crowded counts them.
-void crowd_the_rest(Growth& growth, QuotaTable& table, const std::vector<std::uint8_t>& occupied, const GridDistance& distance,
-                    int cols, int rows, SitesResult& result) {
+void crowd_the_rest(Growth& growth, QuotaTable& table, const std::vector<std::uint8_t>& occupied, SitesResult& result) {
   const int n = int(table.classes.size());
   std::vector<int> quota(static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i) quota[std::size_t(i)] = table.classes[std::size_t(n - 1 - i)].quota;
   for (const Site& s : result.sites) --quota[std::size_t(n - 1 - s.radius_class)];
   if (std::accumulate(quota.begin(), quota.end(), 0) == 0) return;
-  std::vector<std::uint8_t> covered = covered_cells(result.sites, distance, cols, rows);
+  std::vector<std::uint8_t> covered = growth.covered(result.sites);
   for (std::size_t i = 0; i < occupied.size(); ++i) covered[i] |= occupied[i];
   std::vector<Site>& sites = result.sites;
   for (std::size_t k = 0; k < sites.size(); ++k) sites[k].id = int(k);
   const std::size_t before = sites.size();
-  growth.crowd(quota, table, sites, covered, distance);
+  growth.crowd(quota, table, sites, covered);
   result.crowded = std::int64_t(sites.size() - before);
   for (std::size_t k = before; k < sites.size(); ++k) sites[k].id = int(k);
   growth.sort_by_size(sites);
@@ -515,20 +610,22 @@ void grow_existing(SitesResult& result, std::vector<Site>& existing) {
 
 SitesResult place_sites(const Raster<float>& density, const Raster<std::uint8_t>& buildable, const SitesOptions& options,
                         Progress& progress) {
+  return place_sites(LandRasters(density, buildable), options, progress);
+}
+
+SitesResult place_sites(const Land& land, const SitesOptions& options, Progress& progress) {
   check_settings(options);
   if (options.growth > 0 && options.existing.empty()) throw bad_input("/sites/growth: needs /sites/existing, the places that grow");
-  const int cols = density.cols(), rows = density.rows();
-  if (buildable.cols() != cols || buildable.rows() != rows)
-    throw bad_input("sites: the buildable mask and the density model are not on the same grid");
+  const int cols = land.cols(), rows = land.rows();
   if (cols < 1 || rows < 1) throw bad_input("sites: empty density grid");
-  const GridDistance distance(density.georef(), cols, rows);
+  const GridDistance distance(land.georef(), cols, rows);
   const CellMetrics& metrics = distance.metrics();
   // The DEM's scale e of Algorithm 13 (1/e = metres per cell): the coarser side of a cell at the centre row.
   const int centre = rows / 2;
   const double cell_size = std::max(metrics.width_m[std::size_t(centre)], metrics.height_m[std::size_t(centre)]);
   SitesResult result;
   QuotaTable table = options.quotas == SitesOptions::Quotas::belhadj2007 ? compute_quotas(cell_size, options)
-                                                                         : rank_size_table(density, buildable, options, metrics, cell_size, result, progress);
+                                                                         : rank_size_table(land, options, metrics, cell_size, result, progress);
   const int n = int(table.classes.size());
   // Ascending radius index i of Algorithm 14 (r = r_min + i dr); class = n - 1 - i.
   std::vector<double> radius(static_cast<std::size_t>(n));
@@ -541,17 +638,16 @@ SitesResult place_sites(const Raster<float>& density, const Raster<std::uint8_t>
   result.dr_m = table.dr_m;
   result.seed = options.seed;
 
-  const std::vector<std::uint8_t> habitable = habitable_cells(density, buildable);
   const std::int64_t wanted = options.candidates > 0 ? std::int64_t(options.candidates) : 20 * std::int64_t(table.total());
-  std::vector<std::uint32_t> pool = draw_candidates(density, habitable, wanted, options.seed);
-  result.candidates = int(pool.size());
-  Growth growth(density, habitable, std::move(pool), std::move(radius), options, distance);
+  Candidates candidates = draw_candidates(land, wanted, options.seed);
+  result.candidates = int(candidates.cells.size());
+  Growth growth(land, std::move(candidates), std::move(radius), options, distance, progress);
 
   // Existing settlements occupy their built-up discs (grown by the whole growth share in a growth
   // scenario, the most they may reach): no generated centre falls in one.
   std::vector<Site> existing = options.existing;
   for (Site& e : existing) e.radius_m = urban_radius_m(double(e.population) * (1 + options.growth), options);
-  const std::vector<std::uint8_t> occupied = existing.empty() ? std::vector<std::uint8_t>() : covered_cells(existing, distance, cols, rows);
+  const std::vector<std::uint8_t> occupied = existing.empty() ? std::vector<std::uint8_t>() : growth.covered(existing);
   if (options.quotas == SitesOptions::Quotas::rank_size && options.min_distance_share > 0 && result.land_area_km2 > 0)
     keep_central_places_apart(growth, table, existing, options.min_distance_share, result.land_area_km2);
   std::vector<Site> placed;
@@ -574,7 +670,7 @@ SitesResult place_sites(const Raster<float>& density, const Raster<std::uint8_t>
     for (int i = 0; i < n; ++i) quota[std::size_t(i)] = table.classes[std::size_t(n - 1 - i)].quota - kept[std::size_t(i)];
     if (std::accumulate(quota.begin(), quota.end(), 0) == 0) break;
     ProgressStep step(progress, "sites: refill " + std::to_string(round + 1));
-    std::vector<std::uint8_t> covered = covered_cells(result.sites, distance, cols, rows);
+    std::vector<std::uint8_t> covered = growth.covered(result.sites);
     for (std::size_t i = 0; i < occupied.size(); ++i) covered[i] |= occupied[i];
     std::vector<Site> merged = result.sites;
     const std::size_t before = merged.size();
@@ -583,7 +679,7 @@ SitesResult place_sites(const Raster<float>& density, const Raster<std::uint8_t>
     growth.sort_by_size(merged);
     result.sites = resolve_inclusions(merged, options.mode, distance, cols, rows);
   }
-  if (options.quotas == SitesOptions::Quotas::rank_size) crowd_the_rest(growth, table, occupied, distance, cols, rows, result);
+  if (options.quotas == SitesOptions::Quotas::rank_size) crowd_the_rest(growth, table, occupied, result);
   for (Site& s : result.sites) {
     QuotaClass& c = table.classes[std::size_t(s.radius_class)];
     // rank_size: within a class, sites (by density order) take the class's sizes, largest first.
@@ -614,7 +710,10 @@ SitesResult place_sites(const Raster<float>& density, const Raster<std::uint8_t>
         x.radius_m = table.classes[c].radius_m;
         x.parent = -1;
         x.depth = 0;
-        if (x.existing) x.density = std::isfinite(density(x.col, x.row)) ? density(x.col, x.row) : 0.0;
+        if (x.existing) {
+          const float d = land.window(x.col, x.row, 1, 1).density[0];
+          x.density = std::isfinite(d) ? d : 0.0;
+        }
         ++table.classes[c].kept, ++table.classes[c].placed;
       }
     result.sites = std::move(all);

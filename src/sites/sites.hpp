@@ -9,6 +9,7 @@
 #include "core/geodesy.hpp"
 #include "core/progress.hpp"
 #include "core/raster.hpp"
+#include "sites/land.hpp"
 
 namespace terrapolis::sites {
 
@@ -213,8 +214,7 @@ std::vector<std::int64_t> rank_size_split(double total, double q, std::size_t co
 /// density finite) in proportion to density x cell area, each cell's people going to the site
 /// whose centre is nearest (ties: the lower index). The result adds up to `total` (up to
 /// rounding) when a site and a habitable cell exist.
-std::vector<double> catchment_people(const Raster<float>& density, const Raster<std::uint8_t>& buildable, const std::vector<Site>& sites,
-                                     double total);
+std::vector<double> catchment_people(const Land& land, const std::vector<Site>& sites, double total);
 
 /// `total` people spread over the habitable cells as catchment_people spreads them (in proportion
 /// to density x cell area), per cell; 0 elsewhere.
@@ -249,6 +249,8 @@ QuotaTable rank_size_quotas(double cell_size_m, const std::vector<std::int64_t>&
 /// Candidates are drawn with options.seed; the result depends only on the inputs and options.
 SitesResult place_sites(const Raster<float>& density, const Raster<std::uint8_t>& buildable, const SitesOptions& options,
                         Progress& progress);
+/// place_sites on a Land: the land in memory or read from a mosaic's tiles, with the same result.
+SitesResult place_sites(const Land& land, const SitesOptions& options, Progress& progress);
 
 /// Distance in metres between the centres of two cells of a grid, by the mid-latitude formula
 /// with the exact meridian arc (geodesic to well under a millimetre within a few kilometres);

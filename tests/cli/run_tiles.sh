@@ -1,13 +1,16 @@
 #!/usr/bin/env bash
 # `terrapolis run` tile by tile (input.tile_size, input.memory_limit_mb; docs/scale.md): the
 # terrain, hydro and density stages read the DEM by windows and write one GeoTIFF a tile and a VRT
-# per raster, the same cells as the run on the whole grid, the same streams and figures; memory
-# bounded by the limit; what is not computed on tiles yet refused before any stage.
+# per raster, the same cells as the run on the whole grid, the same streams and figures; the sites
+# stage reads the density's tiles by bands and blocks, and the settlements and the network are the
+# whole grid's bytes; memory bounded by the limit; what is not computed on tiles yet refused before
+# any stage.
 # SPDX-License-Identifier: MIT
 source "$(dirname "$0")/lib.sh" "$@"
 cd "$WORK"
 rasters=(elevation hillshade filled flowdir accumulation hydrometry inland_water coast plateau plain buildable density)
-tiled=(--set density.preset=belhadj2007 --until density)
+layers=(streams.geojson cities.geojson city_extents.geojson network.geojson)
+tiled=(--set density.preset=belhadj2007 --until network)
 
 # The bundled DEM (GEBCO 15", sea below 0) on 3 x 3 tiles of 64 cells.
 "$TP" -q run "${tiled[@]}" -o whole
@@ -16,7 +19,8 @@ for r in "${rasters[@]}"; do
   same_cells "whole/$r.tif" "tiles/$r.vrt" || fail "$r differs from the whole grid's run"
   [[ $(ls tiles/$r/tile_*.tif | wc -l) -eq 9 ]] || fail "expected 9 tiles of $r"
 done
-cmp -s whole/streams.geojson tiles/streams.geojson || fail "streams.geojson differs from the whole grid's run"
+for l in "${layers[@]}"; do cmp -s "whole/$l" "tiles/$l" || fail "$l differs from the whole grid's run"; done
+grep -q "sites by tiles: bands of" tiles.log || fail "the sites stage did not read the tiles"
 same_summary() {
   /usr/bin/python3 -c 'import json, sys; a, b = (json.load(open(f + "/run.json"))["summary"] for f in sys.argv[1:]); sys.exit(a != b)' "$1" "$2"
 }
@@ -25,10 +29,11 @@ grep -q "TERRAPOLIS_STAGE=density" <(gdalinfo tiles/density/tile_0001_0002.tif) 
 grep -q 'density.vrt' tiles/project.qgs || fail "the QGIS project does not show the tiled rasters"
 grep -q "no preview.png: the run worked tile by tile" tiles.log || fail "no word of the preview left out"
 
-# A rerun from the density stage reads the hydro stage's tiles back.
+# A rerun from the density stage reads the hydro stage's tiles back, the sites stage the density's.
 "$TP" -q run "${tiled[@]}" --set input.tile_size=64 --set density.r_max_m=4000 --from density -o tiles
-"$TP" -q run --set density.preset=belhadj2007 --set density.r_max_m=4000 --until density -o whole4
+"$TP" -q run --set density.preset=belhadj2007 --set density.r_max_m=4000 --until network -o whole4
 same_cells whole4/density.tif tiles/density.vrt || fail "--from density on tiles differs from the whole grid's run"
+cmp -s whole4/cities.geojson tiles/cities.geojson || fail "--from density on tiles: other settlements than the whole grid's run"
 expect_fail 2 "--until: the run made the density stage: a rerun goes on to its last stage" "$TP" run --set sites.population=1000 --until hydro --from hydro -o "$(
   "$TP" -q run --until roads -o full > /dev/null && echo full)"
 
@@ -43,7 +48,7 @@ for r in "${rasters[@]}"; do
   [[ $r == plain ]] && continue
   same_cells "nz_whole/$r.tif" "nz_tiles/$r.vrt" || fail "nz: $r differs from the whole grid's run"
 done
-cmp -s nz_whole/streams.geojson nz_tiles/streams.geojson || fail "nz: streams.geojson differs"
+for l in "${layers[@]}"; do cmp -s "nz_whole/$l" "nz_tiles/$l" || fail "nz: $l differs"; done
 /usr/bin/python3 - "$limit" <<'PY' || fail "nz: figures or memory"
 import json, sys
 w, t = (json.load(open(f + "/run.json")) for f in ("nz_whole", "nz_tiles"))
@@ -55,16 +60,24 @@ print(f"nz: peak {peak:.0f} MB by tiles (limit {sys.argv[1]} MB), {whole:.0f} MB
 import os
 assert os.environ.get("ASAN_OPTIONS") or peak <= float(sys.argv[1]) < whole, (peak, whole)
 PY
+
+# The region as it is: the real places of Cap Corse (GeoNames) kept where they are, on tiles too.
+places=(--set sites.existing="$SOURCE/tests/data/geonames_capcorse.geojson" --set sites.population=94347)
+"$TP" -q run "${tiled[@]}" "${places[@]}" -o places_whole
+"$TP" -q run "${tiled[@]}" "${places[@]}" --set input.tile_size=50 -o places_tiles
+for l in cities.geojson network.geojson; do cmp -s "places_whole/$l" "places_tiles/$l" || fail "sites.existing: $l differs on tiles"; done
 no_leftovers "$WORK"
 [[ -z $(find . -name '.scratch*') ]] || fail "a scratch folder was left behind"
 
 # Refused before any stage, exit 2, no folder: the later stages, and what the tiles do not compute yet.
-expect_refused r1 "/input/tile_size: a run works tile by tile up to the density stage yet .*--until density" \
+expect_refused r1 "/input/tile_size: a run works tile by tile up to the network stage yet .*--until network" \
   "$TP" run --set input.tile_size=64 -o r1
 expect_refused r2 "/density/weights/altitude: the terrain terms are not computed on tiles yet" \
   "$TP" run --set input.memory_limit_mb=500 --until density -o r2
 expect_refused r3 "/hydro/classify: not computed on tiles yet" "$TP" run "${tiled[@]}" --set input.tile_size=64 --set hydro.classify=true -o r3
 expect_refused r4 "/hydro/flow mfd: not computed on tiles yet" "$TP" run "${tiled[@]}" --set input.tile_size=64 --set hydro.flow=mfd -o r4
+expect_refused r6 "/sites/reference: the realism figures are not computed on tiles yet" \
+  "$TP" run "${tiled[@]}" --set input.tile_size=64 --set sites.reference="$SOURCE/tests/data/geonames_capcorse.geojson" -o r6
 gdal_calc.py --quiet -A "$SAMPLES/spDataLarge_srtm_zion.tif" --outfile nodata.tif --calc "A*0+65535" --NoDataValue 65535 --type UInt16
 expect_refused r5 "nodata.tif: holds no data" "$TP" run --set dem="$WORK/nodata.tif" "${tiled[@]}" --set input.tile_size=64 -o r5
 echo "run by tiles: ok"

@@ -37,21 +37,21 @@ TEST(SettlementCatchment, SplitOverAGivenCount) {
 // Centres in columns 2 and 6: column 4 is 200 m from both and goes to the lower index.
 TEST(SettlementCatchment, NearestCentreByHand) {
   auto g = fixtures::flat_scenario(10, 1, 100.0);
-  auto people = catchment_people(g.density, g.buildable, {at(1, 0), at(6, 0)}, 1000);
+  auto people = catchment_people(LandRasters(g.density, g.buildable), {at(1, 0), at(6, 0)}, 1000);
   EXPECT_NEAR(people[0], 400, 1e-9);
   EXPECT_NEAR(people[1], 600, 1e-9);
-  people = catchment_people(g.density, g.buildable, {at(2, 0), at(6, 0)}, 1000);
+  people = catchment_people(LandRasters(g.density, g.buildable), {at(2, 0), at(6, 0)}, 1000);
   EXPECT_NEAR(people[0], 500, 1e-9);
-  people = catchment_people(g.density, g.buildable, {at(6, 0), at(2, 0)}, 1000);
+  people = catchment_people(LandRasters(g.density, g.buildable), {at(6, 0), at(2, 0)}, 1000);
   EXPECT_NEAR(people[0], 600, 1e-9);
   EXPECT_NEAR(people[1], 400, 1e-9);
   // Unbuildable and nodata land holds nobody: columns 1-3 against 4-8.
   g.buildable[0] = 0;
   g.density[9] = std::numeric_limits<float>::quiet_NaN();
-  people = catchment_people(g.density, g.buildable, {at(1, 0), at(6, 0)}, 1000);
+  people = catchment_people(LandRasters(g.density, g.buildable), {at(1, 0), at(6, 0)}, 1000);
   EXPECT_NEAR(people[0], 375, 1e-9);
   EXPECT_NEAR(people[1], 625, 1e-9);
-  EXPECT_TRUE(catchment_people(g.density, g.buildable, {}, 1000).empty());
+  EXPECT_TRUE(catchment_people(LandRasters(g.density, g.buildable), {}, 1000).empty());
 }
 
 // 21 x 21 cells, density 0.001 but 1 at (5,5); centres at (5,5) and (15,15). The cells with
@@ -61,7 +61,7 @@ TEST(SettlementCatchment, OnePeakGivesItsCentreTheCatchmentsPeople) {
   auto g = fixtures::flat_scenario(21, 21, 100.0);
   for (std::size_t i = 0; i < g.density.size(); ++i) g.density[i] = 0.001f;
   g.density(5, 5) = 1.0f;
-  const auto people = catchment_people(g.density, g.buildable, {at(5, 5), at(15, 15)}, 14400);
+  const auto people = catchment_people(LandRasters(g.density, g.buildable), {at(5, 5), at(15, 15)}, 14400);
   EXPECT_NEAR(people[0], 12300, 0.5);
   EXPECT_NEAR(people[1], 2100, 0.5);
   EXPECT_NEAR(people[0] + people[1], 14400, 1e-6);
@@ -83,7 +83,7 @@ TEST(SettlementCatchment, SizesFollowTheCatchmentsExponent) {
   pilot.min_distance_share = 0;  // the first placement is unspaced
   const SitesResult central = place_sites(g.density, g.buildable, pilot, progress);
   std::vector<double> large;
-  for (double p : catchment_people(g.density, g.buildable, central.sites, 110000))
+  for (double p : catchment_people(LandRasters(g.density, g.buildable), central.sites, 110000))
     if (p >= 1000) large.push_back(p);
   ASSERT_GE(large.size(), 3u);
   const double q = rank_size_exponent(large);
