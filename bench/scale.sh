@@ -15,7 +15,7 @@
 # terrapolis-mpi on WEAK_RANKS (default "1 2"), one thread a rank: cells/s a rank, CPU, peak
 # resident memory of each rank (GNU time), the engine's reported state, disk written. WEAK_DIR:
 # where the mosaic and outputs go (default a temporary folder; removed at the end).
-# RUN=1: a run to the density stage on such a continent, whole grid vs input.memory_limit_mb (RUN_COPIES, RUN_MEMORY).
+# RUN=1: a run to the network stage (RUN_UNTIL) on such a continent, whole grid vs input.memory_limit_mb (RUN_COPIES, RUN_MEMORY).
 # DENSITY=1: the density stage instead, whole grid vs tile by tile (DENSITY_OPTIONS, ";"-separated).
 # SPDX-License-Identifier: MIT
 set -euo pipefail
@@ -173,17 +173,17 @@ if [[ ${WEAK:-0} == 1 ]]; then
   exit
 fi
 
-# A run by tiles (RUN=1): `terrapolis run --until density` (density.preset belhadj2007) on the
-# mirror-tiled continent of RUN_COPIES copies of WEAK_DEM (default 36: 5.2e7 cells), on the whole
-# grid and with input.memory_limit_mb RUN_MEMORY (default 400): wall, CPU, peak resident memory,
-# each stage's time and peak, and the tiled rasters checked against the whole grid's.
+# A run by tiles (RUN=1): `terrapolis run --until network` (RUN_UNTIL; density.preset belhadj2007)
+# on the mirror-tiled continent of RUN_COPIES copies of WEAK_DEM (default 36: 5.2e7 cells), on the
+# whole grid and with input.memory_limit_mb RUN_MEMORY (default 400): wall, CPU, peak resident
+# memory, each stage's time and peak, and the tiled outputs checked against the whole grid's.
 run_bench() {
   local copies=${RUN_COPIES:-36} memory=${RUN_MEMORY:-400} dem=${WEAK_DEM:-../shared/dems/N47E009.hgt} dir
   dir=$(mktemp -d "${WEAK_DIR:-$work}/continent.XXXXXX")
   trap "rm -rf '$work' '$dir'" EXIT
   mirror_images "$dem" "$dir"
   mosaic "$copies" "$dir"
-  local set=(--set dem="$dir/continent-$copies.vrt" --set density.preset=belhadj2007 --set outputs.preview=false --until density)
+  local set=(--set dem="$dir/continent-$copies.vrt" --set density.preset=belhadj2007 --set outputs.preview=false --until "${RUN_UNTIL:-network}")
   echo "run by tiles: $copies copies of $(basename "$dem"), $(gdalinfo "$dir/continent-$copies.vrt" | sed -n 's/^Size is //p') cells, $(nproc) cores"
   local label out
   for label in whole tiled; do
@@ -202,6 +202,11 @@ print(f"  {sys.argv[1]:<6} wall {wall:6.0f} s  cpu {user + sys_:6.0f} s  peak {k
 PY
   done
   for r in elevation filled accumulation hydrometry inland_water buildable density; do same_cells "$dir/whole/$r.tif" "$dir/tiled/$r.vrt"; done
+  for l in streams cities city_extents network; do
+    [[ -f $dir/whole/$l.geojson ]] || continue
+    cmp -s "$dir/whole/$l.geojson" "$dir/tiled/$l.geojson" && echo "  $l.geojson: the same bytes" || echo "  $l.geojson DIFFERS"
+  done
+  /usr/bin/python3 -c 'import json, sys; s = json.load(open(sys.argv[1]))["summary"]; print("  sites:", s.get("sites", {}).get("cities"), "settlements,", s.get("sites", {}).get("population"), "people; network:", s.get("network"))' "$dir/tiled/run.json"
 }
 if [[ ${RUN:-0} == 1 ]]; then
   run_bench

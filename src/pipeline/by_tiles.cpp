@@ -69,25 +69,38 @@ density::ReadWindowInputs density_windows(const DemWindowReader& dem, const Scen
   };
 }
 
-// A band's cells hold 9 bytes (density 4, buildable 1, the catchments' owner 4); a block's 7 (density,
-// buildable, the disc test's row gaps), and its window grows by the largest disc: a quarter of the
-// budget for a block itself leaves room for margins of half its side.
+// A window's cells hold 13 bytes while read (a raster read as floats, 4, and GDAL's copy of it, 4;
+// the view's density and buildable, 5); a band's 4 more (the catchments' owner), a block's 2 (the
+// disc test's row gaps). A band or a block holds at most half the budget.
+constexpr double kBandBytes = 17, kBlockBytes = 15;
+
 LandTiles::LandTiles(const DemWindowReader& density, const DemWindowReader& buildable, const Georef& grid, const TileSettings& tiles,
                      double budget_mb)
     : Land(grid, density.header().cols, density.header().rows), density_(density), buildable_(buildable) {
   if (buildable.header().cols != cols() || buildable.header().rows != rows())
     throw bad_input("sites: the buildable mask and the density model are not on the same grid");
-  const double bytes = std::max(budget_mb, 1.0) * 1e6;
-  band_rows_ = int(std::clamp(bytes / 2 / (9.0 * cols()), 1.0, double(rows())));
-  block_side_ = tiles.tile_size > 0 ? tiles.tile_size : std::max(64, int(std::sqrt(bytes / 4 / 7.0)));
+  bytes_ = std::max(budget_mb, 1.0) * 1e6;
+  band_rows_ = int(std::clamp(bytes_ / 2 / (kBandBytes * cols()), 1.0, double(rows())));
+  tile_size_ = tiles.tile_size;
+}
+
+int LandTiles::block_side(int margin_cols, int margin_rows) const {
+  if (tile_size_ > 0) return tile_size_;
+  // The largest side whose window, grown by the margins, holds half the budget (at least 16 cells).
+  const double a = 2.0 * margin_cols, b = 2.0 * margin_rows, c = bytes_ / 2 / kBlockBytes;  // (s + a)(s + b) = c
+  const double side = (-(a + b) + std::sqrt((a - b) * (a - b) + 4 * c)) / 2;
+  return std::max(16, int(side));
 }
 
 sites::LandView LandTiles::window(int col0, int row0, int cols, int rows) const {
   sites::LandView v;
   v.col0 = col0, v.row0 = row0, v.cols = cols, v.rows = rows;
   v.stride = std::size_t(cols);
-  const Dem d = density_.read(col0, row0, cols, rows), b = buildable_.read(col0, row0, cols, rows);
-  v.own_density.assign(d.data(), d.data() + d.size());
+  {
+    const Dem d = density_.read(col0, row0, cols, rows);
+    v.own_density.assign(d.data(), d.data() + d.size());
+  }
+  const Dem b = buildable_.read(col0, row0, cols, rows);
   v.own_buildable.resize(b.size());
   for (std::size_t i = 0; i < b.size(); ++i) v.own_buildable[i] = b[i] == 1 ? 1 : 0;  // nodata (NaN) is not buildable
   v.density = v.own_density.data();

@@ -55,12 +55,13 @@ class LandTiles : public sites::Land {
   LandTiles(const DemWindowReader& density, const DemWindowReader& buildable, const Georef& grid, const TileSettings& tiles, double budget_mb);
   void for_each_band(const std::function<void(const sites::LandView&)>& f) const override;
   sites::LandView window(int col0, int row0, int cols, int rows) const override;
-  int block_side() const override { return block_side_; }
+  int block_side(int margin_cols, int margin_rows) const override;
   int band_rows() const { return band_rows_; }
 
  private:
   const DemWindowReader &density_, &buildable_;
-  int block_side_ = 0, band_rows_ = 0;
+  int tile_size_ = 0, band_rows_ = 0;
+  double bytes_ = 0;
 };
 
 }  // namespace terrapolis::pipeline

@@ -9,6 +9,9 @@
 #include <array>
 #include <cmath>
 #include <filesystem>
+#include <limits>
+#include <memory>
+#include <vector>
 
 #include "core/error.hpp"
 #include "core/geodesy.hpp"
@@ -73,30 +76,68 @@ struct LegendEntry {
   bool line;
 };
 
-/// Terrain: hillshade tinted by land / sea, then the density where it exists.
-void draw_terrain(Canvas& canvas, const RunState& state, double sx, double sy) {
-  const Dem& dem = state.dem;
-  const int width = canvas.width(), height = canvas.height();
-  const Raster<std::uint8_t> shade = hillshade(dem);
-  for (int y = 0; y < height; ++y) {
-    const int r = std::min(dem.rows() - 1, int((y + 0.5) * sy));
-    for (int x = 0; x < width; ++x) {
-      const int c = std::min(dem.cols() - 1, int((x + 0.5) * sx));
-      const float z = dem(c, r);
-      if (std::isnan(z)) { canvas.blend(x, y, hex(0xdddddd), 1); continue; }
-      const float s = shade(c, r) / 255.0f;
-      const Rgb base = z <= 0 ? hex(0x9ecae1) : hex(0xe8e4d0);
-      canvas.blend(x, y, {base[0] * (0.45f + 0.55f * s), base[1] * (0.45f + 0.55f * s), base[2] * (0.45f + 0.55f * s)}, 1);
+/// The rows of the terrain the preview samples: the DEM, its hillshade and the density (when the run
+/// made one), from memory, or for a run by tiles read a row at a time from its VRTs (the same cells).
+class TerrainRows {
+ public:
+  explicit TerrainRows(const RunState& state) : state_(state), cols_(state.grid.cols) {
+    if (!state.by_tiles) {
+      shade_ = hillshade(state.dem);
+      return;
     }
+    const auto reader = [&](const char* name) { return std::make_unique<DemWindowReader>((state.folder / name).string()); };
+    elevation_ = reader("elevation.vrt");
+    shaded_ = reader("hillshade.vrt");
+    if (std::filesystem::exists(state.folder / "density.vrt")) density_ = reader("density.vrt");
   }
-  if (state.density) {
-    for (int y = 0; y < height; ++y) {
-      const int r = std::min(dem.rows() - 1, int((y + 0.5) * sy));
-      for (int x = 0; x < width; ++x) {
-        const int c = std::min(dem.cols() - 1, int((x + 0.5) * sx));
-        const float d = (*state.density)(c, r);
-        if (!std::isnan(d) && d > 0) canvas.blend(x, y, density_color(d), 0.55f);
+  bool has_density() const { return state_.by_tiles ? bool(density_) : bool(state_.density); }
+  /// Row r of the three (density NaN without one).
+  void read(int r, std::vector<float>& z, std::vector<float>& shade, std::vector<float>& density) const {
+    z.resize(std::size_t(cols_));
+    shade.resize(std::size_t(cols_));
+    density.assign(std::size_t(cols_), std::numeric_limits<float>::quiet_NaN());
+    if (!state_.by_tiles) {
+      for (int c = 0; c < cols_; ++c) {
+        z[std::size_t(c)] = state_.dem(c, r);
+        shade[std::size_t(c)] = float(shade_(c, r));
+        if (state_.density) density[std::size_t(c)] = (*state_.density)(c, r);
       }
+      return;
+    }
+    const auto row = [&](const DemWindowReader& reader, std::vector<float>& out) {
+      const Dem values = reader.read(0, r, cols_, 1);
+      std::copy_n(values.data(), cols_, out.data());
+    };
+    row(*elevation_, z);
+    row(*shaded_, shade);
+    for (float& s : shade)
+      if (std::isnan(s)) s = 0;  // the hillshade's nodata value is 0
+    if (density_) row(*density_, density);
+  }
+
+ private:
+  const RunState& state_;
+  int cols_;
+  Raster<std::uint8_t> shade_;
+  std::unique_ptr<DemWindowReader> elevation_, shaded_, density_;
+};
+
+/// Terrain: hillshade tinted by land / sea, then the density where it exists.
+void draw_terrain(Canvas& canvas, const TerrainRows& terrain, int cols, int rows, double sx, double sy) {
+  const int width = canvas.width(), height = canvas.height();
+  std::vector<float> z, shade, density;
+  int loaded = -1;
+  for (int y = 0; y < height; ++y) {
+    const int r = std::min(rows - 1, int((y + 0.5) * sy));
+    if (r != loaded) terrain.read(loaded = r, z, shade, density);
+    for (int x = 0; x < width; ++x) {
+      const int c = std::min(cols - 1, int((x + 0.5) * sx));
+      if (std::isnan(z[std::size_t(c)])) { canvas.blend(x, y, hex(0xdddddd), 1); continue; }
+      const float s = shade[std::size_t(c)] / 255.0f;
+      const Rgb base = z[std::size_t(c)] <= 0 ? hex(0x9ecae1) : hex(0xe8e4d0);
+      canvas.blend(x, y, {base[0] * (0.45f + 0.55f * s), base[1] * (0.45f + 0.55f * s), base[2] * (0.45f + 0.55f * s)}, 1);
+      const float d = density[std::size_t(c)];
+      if (!std::isnan(d) && d > 0) canvas.blend(x, y, density_color(d), 0.55f);
     }
   }
 }
@@ -149,21 +190,23 @@ static TerrapolisWritePng png_writer() {
 }
 
 void write_preview(const RunState& state, const std::string& path, int width) {
-  const Dem& dem = state.dem;
-  const CellMetrics m = cell_metrics(dem.georef(), dem.cols(), dem.rows());
-  const double mean_w = m.width_m[dem.rows() / 2], mean_h = m.height_m[dem.rows() / 2];
-  const int height = std::max(16, int(std::lround(width * (dem.rows() * mean_h) / (dem.cols() * mean_w))));
+  const int cols = state.grid.cols, rows = state.grid.rows;
+  const Georef& georef = state.grid.georef;
+  const CellMetrics m = cell_metrics(georef, cols, rows);
+  const double mean_w = m.width_m[std::size_t(rows / 2)], mean_h = m.height_m[std::size_t(rows / 2)];
+  const int height = std::max(16, int(std::lround(width * (rows * mean_h) / (cols * mean_w))));
   Canvas canvas(width, height);
-  const double sx = double(dem.cols()) / width, sy = double(dem.rows()) / height;
+  const double sx = double(cols) / width, sy = double(rows) / height;
 
-  draw_terrain(canvas, state, sx, sy);
+  const TerrainRows terrain(state);
+  draw_terrain(canvas, terrain, cols, rows, sx, sy);
 
   // Vectors, in the DEM's CRS (layers written in another CRS are transformed).
-  const GridLocator locator(dem.georef());
+  const GridLocator locator(georef);
   std::vector<LegendEntry> legend;
   auto to_px = [&](const VectorLayer& layer, std::vector<std::array<double, 2>> pts) {
     std::optional<CrsTransform> t;
-    if (layer.crs.wkt != dem.georef().crs.wkt) t.emplace(layer.crs, dem.georef().crs);
+    if (layer.crs.wkt != georef.crs.wkt) t.emplace(layer.crs, georef.crs);
     for (auto& p : pts) {
       if (t) p = (*t)(p[0], p[1]);
       const auto q = locator.crs_to_pixel(p[0], p[1]);
@@ -239,7 +282,7 @@ void write_preview(const RunState& state, const std::string& path, int width) {
       if (pass == Style::cities) legend.push_back({hex(0xcb181d), "cities", false});
     }
   }
-  if (state.density) legend.insert(legend.begin(), {hex(0xf03b20), "density", false});
+  if (terrain.has_density()) legend.insert(legend.begin(), {hex(0xf03b20), "density", false});
   legend.insert(legend.begin(), {hex(0x9ecae1), "sea", false});
 
   const std::vector<TerrapolisPngText> texts = draw_legend(canvas, legend, unit);

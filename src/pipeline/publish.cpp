@@ -20,9 +20,8 @@ void publish(RunState& state, nlohmann::ordered_json& manifest, const Log& log) 
                                    {"description", "every vector layer in one GeoPackage, each with its QGIS style"}, {"kind", "geopackage"}});
     log.detail("wrote run.gpkg");
   }
-  // The preview draws the whole DEM in memory: not for a run by tiles (its rasters are VRTs QGIS opens).
-  if (outputs["preview"].get<bool>() && state.by_tiles) log.detail("no preview.png: the run worked tile by tile");
-  if (outputs["preview"].get<bool>() && !state.by_tiles) {
+  // A run by tiles reads the rows the preview samples from its VRTs.
+  if (outputs["preview"].get<bool>()) {
     write_preview(state, (state.folder / "preview.png").string(), outputs["preview_width"].get<int>());
     manifest["outputs"].push_back({{"file", "preview.png"}, {"stage", "publish"}, {"description", "quicklook of the run"}, {"kind", "image"}});
   }

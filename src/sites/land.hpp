@@ -48,8 +48,9 @@ class Land {
   virtual void for_each_band(const std::function<void(const LandView&)>& f) const = 0;
   /// A window inside the grid.
   virtual LandView window(int col0, int row0, int cols, int rows) const = 0;
-  /// The side, in cells, of the blocks the disc tests read at once (each grown by the largest disc).
-  virtual int block_side() const = 0;
+  /// The side, in cells, of the blocks the disc tests read at once, each grown by `margin_cols` and
+  /// `margin_rows` cells (the largest disc) on every side; 0: the whole grid at once.
+  virtual int block_side(int margin_cols, int margin_rows) const = 0;
 
  private:
   Georef georef_;
@@ -64,7 +65,7 @@ class LandRasters : public Land {
   LandRasters(const Raster<float>& density, const Raster<std::uint8_t>& buildable, int block_side = 0, int band_rows = 0);
   void for_each_band(const std::function<void(const LandView&)>& f) const override;
   LandView window(int col0, int row0, int cols, int rows) const override;
-  int block_side() const override { return block_side_; }
+  int block_side(int, int) const override { return block_side_; }
 
  private:
   const Raster<float>& density_;

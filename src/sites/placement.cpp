@@ -130,7 +130,7 @@ std::vector<int> clear_classes_of(const Land& land, const std::vector<std::uint3
   const double height = std::max(*std::min_element(m.height_m.begin(), m.height_m.end()), 1e-9);
   const auto margin = [&](double cell_m, int extent) { return int(std::min<double>(std::ceil(cap / cell_m) + 2, extent)); };
   const int margin_cols = margin(width, cols), margin_rows = margin(height, rows);
-  const int side = land.block_side() > 0 ? land.block_side() : std::max(cols, rows);
+  const int given = land.block_side(margin_cols, margin_rows), side = given > 0 ? given : std::max(cols, rows);
   const int across = (cols + side - 1) / side;
   // Candidates by block (then density order).
   std::vector<std::pair<std::uint64_t, std::uint32_t>> by_block(pool.size());

@@ -2,8 +2,8 @@
 # `terrapolis run` tile by tile (input.tile_size, input.memory_limit_mb; docs/scale.md): the
 # terrain, hydro and density stages read the DEM by windows and write one GeoTIFF a tile and a VRT
 # per raster, the same cells as the run on the whole grid, the same streams and figures; the sites
-# stage reads the density's tiles by bands and blocks, and the settlements and the network are the
-# whole grid's bytes; memory bounded by the limit; what is not computed on tiles yet refused before
+# stage reads the density's tiles by bands and blocks, and the settlements, the network and
+# preview.png are the whole grid's bytes; memory bounded by the limit; what is not computed on tiles yet refused before
 # any stage.
 # SPDX-License-Identifier: MIT
 source "$(dirname "$0")/lib.sh" "$@"
@@ -27,7 +27,7 @@ same_summary() {
 same_summary whole tiles || fail "the run's figures differ from the whole grid's"
 grep -q "TERRAPOLIS_STAGE=density" <(gdalinfo tiles/density/tile_0001_0002.tif) || fail "a tile without its provenance"
 grep -q 'density.vrt' tiles/project.qgs || fail "the QGIS project does not show the tiled rasters"
-grep -q "no preview.png: the run worked tile by tile" tiles.log || fail "no word of the preview left out"
+cmp -s whole/preview.png tiles/preview.png || fail "preview.png differs from the whole grid's run (drawn from the VRTs' rows)"
 
 # A rerun from the density stage reads the hydro stage's tiles back, the sites stage the density's.
 "$TP" -q run "${tiled[@]}" --set input.tile_size=64 --set density.r_max_m=4000 --from density -o tiles
