@@ -8,6 +8,18 @@
 
 namespace terrapolis::sites {
 
+std::uint64_t Land::habitable_cells() const {
+  if (!habitable_) {
+    std::uint64_t n = 0;
+    for_each_band([&](const LandView& v) {
+      for (int r = v.row0; r < v.row0 + v.rows; ++r)
+        for (int c = 0; c < v.cols; ++c) n += v.habitable(c, r);
+    });
+    habitable_ = n;
+  }
+  return *habitable_;
+}
+
 LandRasters::LandRasters(const Raster<float>& density, const Raster<std::uint8_t>& buildable, int block_side, int band_rows)
     : Land(density.georef(), density.cols(), density.rows()), density_(density), buildable_(buildable), block_side_(block_side),
       band_rows_(band_rows > 0 ? band_rows : std::max(1, density.rows())) {

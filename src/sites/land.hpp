@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <vector>
 
 #include "core/raster.hpp"
@@ -48,6 +49,9 @@ class Land {
   virtual void for_each_band(const std::function<void(const LandView&)>& f) const = 0;
   /// A window inside the grid.
   virtual LandView window(int col0, int row0, int cols, int rows) const = 0;
+  /// The habitable cells (LandView::habitable), counted on the first call: one pass less for every
+  /// later placement on the same land (the catchment sizes place twice).
+  std::uint64_t habitable_cells() const;
   /// The side, in cells, of the blocks the disc tests read at once, each grown by `margin_cols` and
   /// `margin_rows` cells (the largest disc) on every side; 0: the whole grid at once.
   virtual int block_side(int margin_cols, int margin_rows) const = 0;
@@ -55,6 +59,7 @@ class Land {
  private:
   Georef georef_;
   int cols_, rows_;
+  mutable std::optional<std::uint64_t> habitable_;
 };
 
 /// The land in memory: views into the two rasters, read without a copy. `block_side` and

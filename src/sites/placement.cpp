@@ -316,11 +316,7 @@ struct Candidates {
 Candidates draw_candidates(const Land& land, std::int64_t wanted, std::uint64_t seed) {
   if (std::uint64_t(land.cols()) * std::uint64_t(land.rows()) > std::numeric_limits<std::uint32_t>::max())
     throw bad_input("sites: grid larger than 2^32 cells");
-  std::uint64_t habitable = 0;
-  land.for_each_band([&](const LandView& v) {
-    for (int r = v.row0; r < v.row0 + v.rows; ++r)
-      for (int c = 0; c < v.cols; ++c) habitable += v.habitable(c, r);
-  });
+  const std::uint64_t habitable = land.habitable_cells();
   if (habitable == 0) throw bad_input("sites: no buildable cell in the density model");
   const std::size_t m = std::size_t(std::clamp<std::int64_t>(wanted, 1, std::int64_t(std::min<std::uint64_t>(habitable, INT64_MAX))));
   // Position p of the list holds habitable cell number p until the shuffle moves it. Position k is
