@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <limits>
+#include <memory>
+#include <optional>
 
 #include "cli/command.hpp"
 #include "cli/commands_list.hpp"
@@ -17,6 +19,7 @@
 #include "hydro/hydrometry.hpp"
 #include "io/output_set.hpp"
 #include "io/raster_io.hpp"
+#include "pipeline/by_tiles.hpp"
 #include "pipeline/density_folder.hpp"
 #include "pipeline/places.hpp"
 #include "pipeline/stage_options.hpp"
@@ -53,18 +56,40 @@ class SitesCommand final : public Command {
     const auto t0 = std::chrono::steady_clock::now();
     const bool dem = std::filesystem::is_regular_file(dir_);
     if (!dem && dem_.given()) throw bad_input("--band, --assume-crs: only for a DEM, and " + dir_ + " is a density folder");
-    const pipeline::DensityFolder in = dem ? run_density(scenario, dem_.read(dir_), options, context) : pipeline::read_density_folder(dir_);
-    const sites::LandRasters land(in.density, in.buildable);
+    const pipeline::TileSettings tiles = schema_.settings([&] { return pipeline::tile_settings(scenario); });
+    // A density folder written by tiles (density.vrt), or a limit given: the land read by bands and blocks.
+    const std::filesystem::path folder(dir_);
+    const bool by_tiles = !dem && (tiles.given() || (!std::filesystem::exists(folder / "density.tif") && std::filesystem::exists(folder / "density.vrt")));
+    if (dem && tiles.given())
+      throw bad_input("--tile-size, --memory-limit: for a density folder (a DEM by tiles: terrapolis run --until network)");
+    pipeline::DensityFolder in;
+    std::optional<DemWindowReader> density_tiles, buildable_tiles;
+    std::unique_ptr<sites::Land> land;
+    if (by_tiles) {
+      const auto file = [&](const char* name) {
+        const std::filesystem::path tif = folder / (std::string(name) + ".tif"), vrt = folder / (std::string(name) + ".vrt");
+        if (std::filesystem::exists(tif)) return tif.string();
+        if (std::filesystem::exists(vrt)) return vrt.string();
+        throw bad_input(dir_ + ": no " + name + ".tif or " + name + ".vrt in it");
+      };
+      const double reserved = reserve_reader_memory(tiles.limit_mb());
+      density_tiles.emplace(file("density"));
+      buildable_tiles.emplace(file("buildable"));
+      land = std::make_unique<pipeline::LandTiles>(*density_tiles, *buildable_tiles, density_tiles->header().georef, tiles, reserved);
+    } else {
+      in = dem ? run_density(scenario, dem_.read(dir_), options, context) : pipeline::read_density_folder(dir_);
+      land = std::make_unique<sites::LandRasters>(in.density, in.buildable);
+    }
     pipeline::ExistingPlaces existing;
     if (!existing_file.empty()) {
-      existing = pipeline::read_existing_places(existing_file, land);
+      existing = pipeline::read_existing_places(existing_file, *land);
       options.existing = existing.sites;
       for (const auto& w : pipeline::existing_place_warnings(existing)) context.log.warn(w);
     }
     const auto t1 = std::chrono::steady_clock::now();
-    const sites::SitesResult result = sites::place_sites(land, options, context.progress);
+    const sites::SitesResult result = sites::place_sites(*land, options, context.progress);
     const auto t2 = std::chrono::steady_clock::now();
-    const Crs& crs = in.density.georef().crs;
+    const Crs& crs = land->georef().crs;
     const VectorLayer cities = sites::cities_layer(result, crs);
     const VectorLayer extents = sites::city_extents_layer(result, crs);
     write_vector((out_dir / "cities.geojson").string(), cities);

@@ -7,6 +7,7 @@
 #include <cstdio>
 
 #include "core/error.hpp"
+#include "hydro/tiled/tiled_hydro.hpp"
 #include "io/mask_io.hpp"
 
 namespace terrapolis::pipeline {
@@ -75,11 +76,15 @@ density::ReadWindowInputs density_windows(const DemWindowReader& dem, const Scen
 constexpr double kBandBytes = 17, kBlockBytes = 15;
 
 LandTiles::LandTiles(const DemWindowReader& density, const DemWindowReader& buildable, const Georef& grid, const TileSettings& tiles,
-                     double budget_mb)
+                     double reserved_mb)
     : Land(grid, density.header().cols, density.header().rows), density_(density), buildable_(buildable) {
   if (buildable.header().cols != cols() || buildable.header().rows != rows())
     throw bad_input("sites: the buildable mask and the density model are not on the same grid");
-  bytes_ = std::max(budget_mb, 1.0) * 1e6;
+  const double least = 4 * kBandBytes * cols();  // half of it a band of two rows
+  bytes_ = (tiles.limit_mb() - reserved_mb) * 1e6;
+  if (tiles.memory_limit_mb > 0 && bytes_ < least)
+    throw bad_input(hydro::tiled::too_little(tiles.limit_mb(), reserved_mb) + " for the sites' bands of " + std::to_string(cols()) + " columns");
+  bytes_ = std::max(bytes_, least);  // a tile size without a limit
   band_rows_ = int(std::clamp(bytes_ / 2 / (kBandBytes * cols()), 1.0, double(rows())));
   tile_size_ = tiles.tile_size;
 }

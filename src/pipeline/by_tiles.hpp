@@ -50,9 +50,10 @@ density::ReadWindowInputs density_windows(const DemWindowReader& dem, const Scen
 /// disc. Holds references to the two readers.
 class LandTiles : public sites::Land {
  public:
-  /// `budget_mb`: what the land's bands and blocks may hold at once. `grid`: the run's DEM's
-  /// georeferencing (a VRT's geotransform may differ from it in the last bit).
-  LandTiles(const DemWindowReader& density, const DemWindowReader& buildable, const Georef& grid, const TileSettings& tiles, double budget_mb);
+  /// The bands and blocks hold what `tiles`' limit leaves once `reserved_mb` is counted (throws
+  /// bad_input when that is less than a band of two rows). `grid`: the run's DEM's georeferencing
+  /// (a VRT's geotransform may differ from it in the last bit).
+  LandTiles(const DemWindowReader& density, const DemWindowReader& buildable, const Georef& grid, const TileSettings& tiles, double reserved_mb);
   void for_each_band(const std::function<void(const sites::LandView&)>& f) const override;
   sites::LandView window(int col0, int row0, int cols, int rows) const override;
   int block_side(int margin_cols, int margin_rows) const override;

@@ -459,7 +459,7 @@ void sites_run(RunState& s, Progress& progress, const Log& log) {
     density_tiles.emplace(saved(s, "density.vrt"));
     buildable_tiles.emplace(saved(s, "buildable.vrt"));
     const TiledInput& in = *s.by_tiles;
-    auto tiles = std::make_unique<LandTiles>(*density_tiles, *buildable_tiles, s.grid.georef, in.tiles, in.tiles.limit_mb() - in.reserved_mb);
+    auto tiles = std::make_unique<LandTiles>(*density_tiles, *buildable_tiles, s.grid.georef, in.tiles, in.reserved_mb);
     log.detail("sites by tiles: bands of " + std::to_string(tiles->band_rows()) + " rows, " +
                std::to_string(int(in.tiles.limit_mb() - in.reserved_mb)) + " MB for the land's bands and blocks");
     land = std::move(tiles);

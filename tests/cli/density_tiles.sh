@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # `terrapolis density` tile by tile (--tile-size, --memory-limit, a folder of tiles, a VRT): each
 # tile computed with a halo of r_max + r_min; the VRT of every output equals the whole-grid file
-# cell for cell; memory bounded by the window; refusals; nothing left behind.
+# cell for cell; the sites command on the tiled folder places the whole folder's settlements; memory
+# bounded by the window; refusals; nothing left behind.
 # SPDX-License-Identifier: MIT
 source "$(dirname "$0")/lib.sh" "$@"
 bin=$TP samples=$SAMPLES work=$WORK
@@ -30,6 +31,17 @@ diff <(grep -v "^Density report" "$work/whole.txt") <(grep -v "^Density report" 
 line=$(grep "^density tiles: [0-9]" "$work/tiled.log") || fail "no tile report: $(cat "$work/tiled.log")"
 [[ $line =~ halo\ ([0-9]+)\ x\ ([0-9]+)\ cells ]] || fail "unreadable tile report: $line"
 (( BASH_REMATCH[1] >= 70 && BASH_REMATCH[1] <= 80 && BASH_REMATCH[2] >= 56 && BASH_REMATCH[2] <= 64 )) || fail "unexpected halo: $line"
+
+# The sites command on the tiled density folder (density.vrt, buildable.vrt): the land read by bands
+# and blocks, the whole folder's settlements byte for byte; and on the whole folder within a limit.
+"$bin" -q sites "$work/whole" "$work/sites_whole" > /dev/null
+"$bin" -v sites "$work/tiled" "$work/sites_tiled" > /dev/null 2> "$work/sites.log"
+"$bin" -q sites "$work/whole" "$work/sites_limit" --memory-limit 100 > /dev/null
+for f in cities.geojson city_extents.geojson; do
+  cmp -s "$work/sites_whole/$f" "$work/sites_tiled/$f" || fail "sites on the tiled density: $f differs"
+  cmp -s "$work/sites_whole/$f" "$work/sites_limit/$f" || fail "sites --memory-limit: $f differs"
+done
+expect_fail 2 "--tile-size, --memory-limit: for a density folder" "$bin" sites "$zion" "$work/sites_dem" --tile-size 50
 
 # The hydrometry computed by tiles too (Belhadj's diffusion, each tile with a halo of its
 # iterations + 2): the same cells as the whole-grid command on the same mosaic. (Against the one
