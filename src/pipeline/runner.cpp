@@ -62,6 +62,18 @@ std::vector<Action> plan_stages(const RunOptions& options) {
   return plan;
 }
 
+/// A section of the scenario as a rerun compares it: how a run by tiles is cut (input.tile_size,
+/// input.memory_limit_mb) gives the same cells, so only whether it worked by tiles counts (its
+/// rasters are VRTs then, the whole grid's GeoTIFFs otherwise).
+json compared(const std::string& key, json section) {
+  if (key != "input" || !section.is_object()) return section;
+  const bool by_tiles = section.value("tile_size", 0) > 0 || section.value("memory_limit_mb", 0.0) > 0;
+  section.erase("tile_size");
+  section.erase("memory_limit_mb");
+  section["by_tiles"] = by_tiles;
+  return section;
+}
+
 /// A saved stage is read back only for the same DEM and the same parameters of its own (those of
 /// the stages before it are checked too when they are read back; a rerun one makes it stale).
 void check_reusable(const std::filesystem::path& folder, const json& saved, const Scenario& scenario, const std::string& dem_sha256,
@@ -77,7 +89,7 @@ void check_reusable(const std::filesystem::path& folder, const json& saved, cons
       throw bad_input(folder.string() + ": the saved run has no " + stage.name + " stage; rerun from it");
     if (plan[i] != Action::load) continue;
     for (const auto& key : stage.sections) {
-      if (!saved["scenario"].contains(key) || saved["scenario"][key] != scenario.resolved[key])
+      if (!saved["scenario"].contains(key) || compared(key, saved["scenario"][key]) != compared(key, scenario.resolved[key]))
         throw bad_input(folder.string() + ": the saved run used other '" + key + "' parameters; rerun from " + stage.name +
                         " (--from " + stage.name + ")");
       // The same settings may name a file whose content changed since (a new mask, refitted trees).

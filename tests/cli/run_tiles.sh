@@ -34,6 +34,9 @@ cmp -s whole/preview.png tiles/preview.png || fail "preview.png differs from the
 "$TP" -q run --set density.preset=belhadj2007 --set density.r_max_m=4000 --until network -o whole4
 same_cells whole4/density.tif tiles/density.vrt || fail "--from density on tiles differs from the whole grid's run"
 cmp -s whole4/cities.geojson tiles/cities.geojson || fail "--from density on tiles: other settlements than the whole grid's run"
+# Another limit cuts other tiles of the same cells: a rerun from the sites reuses the saved stages.
+"$TP" -q run "${tiled[@]}" --set input.memory_limit_mb=2000 --set density.r_max_m=4000 --from sites -o tiles
+cmp -s whole4/cities.geojson tiles/cities.geojson || fail "--from sites with another memory limit: other settlements"
 expect_fail 2 "--until: the run made the density stage: a rerun goes on to its last stage" "$TP" run --set sites.population=1000 --until hydro --from hydro -o "$(
   "$TP" -q run --until roads -o full > /dev/null && echo full)"
 
