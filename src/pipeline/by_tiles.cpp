@@ -72,29 +72,35 @@ density::ReadWindowInputs density_windows(const DemWindowReader& dem, const Scen
 
 // A window's cells hold 13 bytes while read (a raster read as floats, 4, and GDAL's copy of it, 4;
 // the view's density and buildable, 5); a band's 4 more (the catchments' owner), a block's 2 (the
-// disc test's row gaps). A band or a block holds at most half the budget.
-constexpr double kBandBytes = 17, kBlockBytes = 15;
+// disc test's row gaps). Measured, the process grows by about 1.5 times that (the VRT's buffers,
+// freed chunks the allocator keeps): 25 and 21 bytes a cell are counted, and a band or a block
+// holds at most a third of the budget (5.2e7 cells peaked 5 % over a 300 MB limit at 17 and 15
+// bytes and half the budget).
+constexpr double kBandBytes = 25, kBlockBytes = 21, kShare = 1.0 / 3;
 
 LandTiles::LandTiles(const DemWindowReader& density, const DemWindowReader& buildable, const Georef& grid, const TileSettings& tiles,
                      double reserved_mb)
     : Land(grid, density.header().cols, density.header().rows), density_(density), buildable_(buildable) {
   if (buildable.header().cols != cols() || buildable.header().rows != rows())
     throw bad_input("sites: the buildable mask and the density model are not on the same grid");
-  const double least = 4 * kBandBytes * cols();  // half of it a band of two rows
+  const double least = 2 * kBandBytes * cols() / kShare;  // a band of two rows
   bytes_ = (tiles.limit_mb() - reserved_mb) * 1e6;
   if (tiles.memory_limit_mb > 0 && bytes_ < least)
     throw bad_input(hydro::tiled::too_little(tiles.limit_mb(), reserved_mb) + " for the sites' bands of " + std::to_string(cols()) + " columns");
   bytes_ = std::max(bytes_, least);  // a tile size without a limit
-  band_rows_ = int(std::clamp(bytes_ / 2 / (kBandBytes * cols()), 1.0, double(rows())));
+  band_rows_ = int(std::clamp(bytes_ * kShare / (kBandBytes * cols()), 1.0, double(rows())));
   tile_size_ = tiles.tile_size;
+  if (buildable.header().georef.transform != density.header().georef.transform)
+    throw bad_input("sites: the buildable mask and the density model are not on the same grid (different geotransform)");
 }
 
 int LandTiles::block_side(int margin_cols, int margin_rows) const {
-  if (tile_size_ > 0) return tile_size_;
-  // The largest side whose window, grown by the margins, holds half the budget (at least 16 cells).
-  const double a = 2.0 * margin_cols, b = 2.0 * margin_rows, c = bytes_ / 2 / kBlockBytes;  // (s + a)(s + b) = c
-  const double side = (-(a + b) + std::sqrt((a - b) * (a - b) + 4 * c)) / 2;
-  return std::max(16, int(side));
+  // The largest side whose window, grown by the margins, holds a third of the budget (at least 16
+  // cells: a window of the largest disc and 16 cells then holds more); a tile size given is kept
+  // when smaller.
+  const double a = 2.0 * margin_cols, b = 2.0 * margin_rows, c = bytes_ * kShare / kBlockBytes;  // (s + a)(s + b) = c
+  const int side = std::max(16, int((-(a + b) + std::sqrt((a - b) * (a - b) + 4 * c)) / 2));
+  return tile_size_ > 0 ? std::min(tile_size_, side) : side;
 }
 
 sites::LandView LandTiles::window(int col0, int row0, int cols, int rows) const {
@@ -113,8 +119,5 @@ sites::LandView LandTiles::window(int col0, int row0, int cols, int rows) const 
   return v;
 }
 
-void LandTiles::for_each_band(const std::function<void(const sites::LandView&)>& f) const {
-  for (int r = 0; r < rows(); r += band_rows_) f(window(0, r, cols(), std::min(band_rows_, rows() - r)));
-}
 
 }  // namespace terrapolis::pipeline

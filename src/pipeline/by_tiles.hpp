@@ -54,10 +54,9 @@ class LandTiles : public sites::Land {
   /// bad_input when that is less than a band of two rows). `grid`: the run's DEM's georeferencing
   /// (a VRT's geotransform may differ from it in the last bit).
   LandTiles(const DemWindowReader& density, const DemWindowReader& buildable, const Georef& grid, const TileSettings& tiles, double reserved_mb);
-  void for_each_band(const std::function<void(const sites::LandView&)>& f) const override;
   sites::LandView window(int col0, int row0, int cols, int rows) const override;
   int block_side(int margin_cols, int margin_rows) const override;
-  int band_rows() const { return band_rows_; }
+  int band_rows() const override { return band_rows_; }
 
  private:
   const DemWindowReader &density_, &buildable_;

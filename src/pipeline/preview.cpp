@@ -132,10 +132,13 @@ void draw_terrain(Canvas& canvas, const TerrainRows& terrain, int cols, int rows
     if (r != loaded) terrain.read(loaded = r, z, shade, density);
     for (int x = 0; x < width; ++x) {
       const int c = std::min(cols - 1, int((x + 0.5) * sx));
-      if (std::isnan(z[std::size_t(c)])) { canvas.blend(x, y, hex(0xdddddd), 1); continue; }
-      const float s = shade[std::size_t(c)] / 255.0f;
-      const Rgb base = z[std::size_t(c)] <= 0 ? hex(0x9ecae1) : hex(0xe8e4d0);
-      canvas.blend(x, y, {base[0] * (0.45f + 0.55f * s), base[1] * (0.45f + 0.55f * s), base[2] * (0.45f + 0.55f * s)}, 1);
+      if (std::isnan(z[std::size_t(c)])) {
+        canvas.blend(x, y, hex(0xdddddd), 1);
+      } else {
+        const float s = shade[std::size_t(c)] / 255.0f;
+        const Rgb base = z[std::size_t(c)] <= 0 ? hex(0x9ecae1) : hex(0xe8e4d0);
+        canvas.blend(x, y, {base[0] * (0.45f + 0.55f * s), base[1] * (0.45f + 0.55f * s), base[2] * (0.45f + 0.55f * s)}, 1);
+      }
       const float d = density[std::size_t(c)];
       if (!std::isnan(d) && d > 0) canvas.blend(x, y, density_color(d), 0.55f);
     }

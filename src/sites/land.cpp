@@ -13,7 +13,7 @@ std::uint64_t Land::habitable_cells() const {
     std::uint64_t n = 0;
     for_each_band([&](const LandView& v) {
       for (int r = v.row0; r < v.row0 + v.rows; ++r)
-        for (int c = 0; c < v.cols; ++c) n += v.habitable(c, r);
+        for (int c = v.col0; c < v.col0 + v.cols; ++c) n += v.habitable(c, r);
     });
     habitable_ = n;
   }
@@ -39,8 +39,9 @@ LandView LandRasters::window(int col0, int row0, int cols, int rows) const {
   return v;
 }
 
-void LandRasters::for_each_band(const std::function<void(const LandView&)>& f) const {
-  for (int r = 0; r < rows(); r += band_rows_) f(window(0, r, cols(), std::min(band_rows_, rows() - r)));
+void Land::for_each_band(const std::function<void(const LandView&)>& f) const {
+  const int band = std::max(1, band_rows());
+  for (int r = 0; r < rows(); r += band) f(window(0, r, cols(), std::min(band, rows() - r)));
 }
 
 }  // namespace terrapolis::sites

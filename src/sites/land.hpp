@@ -45,8 +45,9 @@ class Land {
   const Georef& georef() const { return georef_; }
   int cols() const { return cols_; }
   int rows() const { return rows_; }
-  /// The whole grid once, in row order, by bands of whole rows (`f` is called once a band).
-  virtual void for_each_band(const std::function<void(const LandView&)>& f) const = 0;
+  /// The whole grid once, in row order, by bands of band_rows() whole rows (`f` is called once a band).
+  void for_each_band(const std::function<void(const LandView&)>& f) const;
+  virtual int band_rows() const = 0;
   /// A window inside the grid.
   virtual LandView window(int col0, int row0, int cols, int rows) const = 0;
   /// The habitable cells (LandView::habitable), counted on the first call: one pass less for every
@@ -68,9 +69,9 @@ class LandRasters : public Land {
  public:
   /// Throws bad_input when the two rasters are not on one grid.
   LandRasters(const Raster<float>& density, const Raster<std::uint8_t>& buildable, int block_side = 0, int band_rows = 0);
-  void for_each_band(const std::function<void(const LandView&)>& f) const override;
   LandView window(int col0, int row0, int cols, int rows) const override;
   int block_side(int, int) const override { return block_side_; }
+  int band_rows() const override { return band_rows_; }
 
  private:
   const Raster<float>& density_;

@@ -225,7 +225,7 @@ QuotaTable rank_size_table(const Land& land, const SitesOptions& options,
     double m2 = 0;
     land.for_each_band([&](const LandView& v) {
       for (int r = v.row0; r < v.row0 + v.rows; ++r)
-        for (int c = 0; c < v.cols; ++c)
+        for (int c = v.col0; c < v.col0 + v.cols; ++c)
           if (v.buildable[v.at(c, r)] == 1) m2 += metrics.area_m2[std::size_t(r)];
     });
     land_km2 = m2 * 1e-6;
@@ -342,7 +342,7 @@ Candidates draw_candidates(const Land& land, std::int64_t wanted, std::uint64_t 
   std::size_t next = 0;
   land.for_each_band([&](const LandView& v) {
     for (int r = v.row0; r < v.row0 + v.rows && next < m; ++r)
-      for (int c = 0; c < v.cols && next < m; ++c) {
+      for (int c = v.col0; c < v.col0 + v.cols && next < m; ++c) {
         if (!v.habitable(c, r)) continue;
         if (drawn[order[next]] == number) {
           drawn_cells.cells[order[next]] = std::uint32_t(r) * std::uint32_t(land.cols()) + std::uint32_t(c);
