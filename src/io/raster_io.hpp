@@ -100,6 +100,7 @@ class DemWindowReader {
   DemWindowReader(const DemWindowReader&) = delete;
   DemWindowReader& operator=(const DemWindowReader&) = delete;
   const RasterHeader& header() const { return header_; }
+  const std::string& path() const { return path_; }
   /// The cells [col0, col0 + cols) x [row0, row0 + rows); those outside the raster are NaN. The
   /// georeferencing is the window's. Serialised: one reader may be shared between threads.
   Dem read(int col0, int row0, int cols, int rows) const;

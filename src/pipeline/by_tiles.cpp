@@ -9,6 +9,7 @@
 #include "core/error.hpp"
 #include "hydro/tiled/tiled_hydro.hpp"
 #include "io/mask_io.hpp"
+#include "pipeline/density_folder.hpp"
 
 namespace terrapolis::pipeline {
 
@@ -81,8 +82,7 @@ constexpr double kBandBytes = 25, kBlockBytes = 21, kShare = 1.0 / 3;
 LandTiles::LandTiles(const DemWindowReader& density, const DemWindowReader& buildable, const Georef& grid, const TileSettings& tiles,
                      double reserved_mb)
     : Land(grid, density.header().cols, density.header().rows), density_(density), buildable_(buildable) {
-  if (buildable.header().cols != cols() || buildable.header().rows != rows())
-    throw bad_input("sites: the buildable mask and the density model are not on the same grid");
+  check_same_grid(density.header(), buildable.path(), buildable.header());
   const double least = 2 * kBandBytes * cols() / kShare;  // a band of two rows
   bytes_ = (tiles.limit_mb() - reserved_mb) * 1e6;
   if (tiles.memory_limit_mb > 0 && bytes_ < least)
@@ -90,8 +90,6 @@ LandTiles::LandTiles(const DemWindowReader& density, const DemWindowReader& buil
   bytes_ = std::max(bytes_, least);  // a tile size without a limit
   band_rows_ = int(std::clamp(bytes_ * kShare / (kBandBytes * cols()), 1.0, double(rows())));
   tile_size_ = tiles.tile_size;
-  if (buildable.header().georef.transform != density.header().georef.transform)
-    throw bad_input("sites: the buildable mask and the density model are not on the same grid (different geotransform)");
 }
 
 int LandTiles::block_side(int margin_cols, int margin_rows) const {
@@ -109,6 +107,7 @@ sites::LandView LandTiles::window(int col0, int row0, int cols, int rows) const 
   v.stride = std::size_t(cols);
   {
     const Dem d = density_.read(col0, row0, cols, rows);
+    check_density_values(density_.path(), d.data(), d.size());
     v.own_density.assign(d.data(), d.data() + d.size());
   }
   const Dem b = buildable_.read(col0, row0, cols, rows);

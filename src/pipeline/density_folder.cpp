@@ -11,6 +11,23 @@
 
 namespace terrapolis::pipeline {
 
+void check_density_values(const std::string& path, const float* values, std::size_t count) {
+  for (std::size_t i = 0; i < count; ++i) {
+    const float v = values[i];
+    if (!std::isnan(v) && !(v >= -1e-6f && v <= 1.0f + 1e-6f))
+      throw bad_input(path + ": density values must lie in [0,1] (found " + std::to_string(v) + ")");
+  }
+}
+
+void check_same_grid(const RasterHeader& density, const std::string& buildable_path, const RasterHeader& header) {
+  if (header.cols != density.cols || header.rows != density.rows)
+    throw bad_input(buildable_path + ": not on the grid of the density (" + std::to_string(header.cols) + "x" + std::to_string(header.rows) +
+                    " cells instead of " + std::to_string(density.cols) + "x" + std::to_string(density.rows) + ")");
+  for (std::size_t k = 0; k < 6; ++k)
+    if (std::abs(header.georef.transform[k] - density.georef.transform[k]) > 1e-9 * std::max(1.0, std::abs(density.georef.transform[k])))
+      throw bad_input(buildable_path + ": not on the grid of the density (different geotransform)");
+}
+
 DensityFolder read_density_folder(const std::string& dir) {
   namespace fs = std::filesystem;
   std::error_code ec;
@@ -20,18 +37,8 @@ DensityFolder read_density_folder(const std::string& dir) {
   if (!fs::exists(buildable_path, ec)) throw bad_input(buildable_path + ": no such file");
   DensityFolder in;
   in.density = read_dem(density_path);
-  for (std::size_t i = 0; i < in.density.size(); ++i) {
-    const float v = in.density[i];
-    if (!std::isnan(v) && !(v >= -1e-6f && v <= 1.0f + 1e-6f))
-      throw bad_input(density_path + ": density values must lie in [0,1] (found " + std::to_string(v) + ")");
-  }
-  const RasterHeader header = read_header(buildable_path);
-  if (header.cols != in.density.cols() || header.rows != in.density.rows())
-    throw bad_input(buildable_path + ": not on the grid of density.tif (" + std::to_string(header.cols) + "x" + std::to_string(header.rows) +
-                    " cells instead of " + std::to_string(in.density.cols()) + "x" + std::to_string(in.density.rows()) + ")");
-  for (std::size_t k = 0; k < 6; ++k)
-    if (std::abs(header.georef.transform[k] - in.density.georef().transform[k]) > 1e-9 * std::max(1.0, std::abs(in.density.georef().transform[k])))
-      throw bad_input(buildable_path + ": not on the grid of density.tif (different geotransform)");
+  check_density_values(density_path, in.density.data(), in.density.size());
+  check_same_grid(grid_of(in.density), buildable_path, read_header(buildable_path));
   // Same grid (checked above): the mask as is, nodata (NaN once read) kept as 255.
   const Raster<float> mask = read_dem(buildable_path);
   in.buildable = in.density.like<std::uint8_t>(255);

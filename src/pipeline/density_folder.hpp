@@ -5,6 +5,7 @@
 #include <string>
 
 #include "core/raster.hpp"
+#include "io/raster_io.hpp"
 
 namespace terrapolis::pipeline {
 
@@ -18,5 +19,10 @@ struct DensityFolder {
 /// Reads density.tif and buildable.tif from `dir`. Throws bad_input naming the file when the
 /// folder or a file is missing, a density lies outside [0,1], or the two are not on one grid.
 DensityFolder read_density_folder(const std::string& dir);
+
+/// Throws bad_input naming `path` at a density value outside [0,1] (NaN is nodata).
+void check_density_values(const std::string& path, const float* values, std::size_t count);
+/// Throws bad_input naming `buildable_path` unless it lies on `density`'s grid (size, geotransform).
+void check_same_grid(const RasterHeader& density, const std::string& buildable_path, const RasterHeader& buildable);
 
 }  // namespace terrapolis::pipeline

@@ -44,6 +44,14 @@ for f in cities.geojson city_extents.geojson; do
   cmp -s "$work/sites_whole/$f" "$work/sites_limit/$f" || fail "sites --memory-limit: $f differs"
 done
 expect_fail 2 "--tile-size, --memory-limit: for a density folder" "$bin" sites "$zion" "$work/sites_dem" --tile-size 50
+# Read by tiles, a folder gets the checks of a whole read: densities in [0,1], one grid.
+mkdir "$work/bad_density"
+gdal_calc.py --quiet -A "$work/whole/density.tif" --outfile "$work/bad_density/density.tif" --calc "A+2" --type Float32
+gdal_translate -q -srcwin 0 0 400 400 "$work/whole/buildable.tif" "$work/bad_density/buildable.tif"
+expect_fail 2 "buildable.tif: not on the grid of the density" "$bin" sites "$work/bad_density" "$work/sites_bad" --tile-size 50
+cp "$work/whole/buildable.tif" "$work/bad_density/buildable.tif"
+expect_fail 2 "density.tif: density values must lie in \[0,1\]" "$bin" sites "$work/bad_density" "$work/sites_bad" --tile-size 50
+[[ ! -e $work/sites_bad ]] || fail "a refused sites command left its folder"
 
 # The hydrometry computed by tiles too (Belhadj's diffusion, each tile with a halo of its
 # iterations + 2): the same cells as the whole-grid command on the same mosaic. (Against the one
