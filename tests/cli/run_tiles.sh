@@ -34,6 +34,8 @@ cmp -s whole/preview.png tiles/preview.png || fail "preview.png differs from the
 "$TP" -q run --set density.preset=belhadj2007 --set density.r_max_m=4000 --until network -o whole4
 same_cells whole4/density.tif tiles/density.vrt || fail "--from density on tiles differs from the whole grid's run"
 cmp -s whole4/cities.geojson tiles/cities.geojson || fail "--from density on tiles: other settlements than the whole grid's run"
+# A whole-grid run's saved files are GeoTIFFs, a tiled run's VRTs: neither is reused by the other.
+expect_fail 2 "the saved run used other 'input' parameters; rerun from terrain" "$TP" run "${tiled[@]}" --set input.tile_size=64 --from sites -o whole
 # Another limit cuts other tiles of the same cells: a rerun from the sites reuses the saved stages.
 "$TP" -q run "${tiled[@]}" --set input.memory_limit_mb=2000 --set density.r_max_m=4000 --from sites -o tiles
 cmp -s whole4/cities.geojson tiles/cities.geojson || fail "--from sites with another memory limit: other settlements"
