@@ -63,7 +63,6 @@ class SitesCommand final : public Command {
     if (dem && tiles.given())
       throw bad_input("--tile-size, --memory-limit: for a density folder (a DEM by tiles: terrapolis run --until network)");
     pipeline::DensityFolder in;
-    std::optional<DemWindowReader> density_tiles, buildable_tiles;
     std::unique_ptr<sites::Land> land;
     if (by_tiles) {
       const auto file = [&](const char* name) {
@@ -73,9 +72,7 @@ class SitesCommand final : public Command {
         throw bad_input(dir_ + ": no " + name + ".tif or " + name + ".vrt in it");
       };
       const double reserved = reserve_reader_memory(tiles.limit_mb());
-      density_tiles.emplace(file("density"));
-      buildable_tiles.emplace(file("buildable"));
-      land = std::make_unique<pipeline::LandTiles>(*density_tiles, *buildable_tiles, density_tiles->header().georef, tiles, reserved);
+      land = std::make_unique<pipeline::LandTiles>(file("density"), file("buildable"), std::nullopt, tiles, reserved);
     } else {
       in = dem ? run_density(scenario, dem_.read(dir_), options, context) : pipeline::read_density_folder(dir_);
       land = std::make_unique<sites::LandRasters>(in.density, in.buildable);

@@ -79,10 +79,19 @@ density::ReadWindowInputs density_windows(const DemWindowReader& dem, const Scen
 // bytes and half the budget).
 constexpr double kBandBytes = 25, kBlockBytes = 21, kShare = 1.0 / 3;
 
-LandTiles::LandTiles(const DemWindowReader& density, const DemWindowReader& buildable, const Georef& grid, const TileSettings& tiles,
+namespace {
+std::unique_ptr<DemWindowReader> open_reader(const std::string& path) { return std::make_unique<DemWindowReader>(path); }
+}  // namespace
+
+LandTiles::LandTiles(const std::string& density, const std::string& buildable, const std::optional<Georef>& grid, const TileSettings& tiles,
                      double reserved_mb)
-    : Land(grid, density.header().cols, density.header().rows), density_(density), buildable_(buildable) {
-  check_same_grid(density.header(), buildable.path(), buildable.header());
+    : LandTiles(open_reader(density), open_reader(buildable), grid, tiles, reserved_mb) {}
+
+LandTiles::LandTiles(std::unique_ptr<DemWindowReader> density, std::unique_ptr<DemWindowReader> buildable, const std::optional<Georef>& grid,
+                     const TileSettings& tiles, double reserved_mb)
+    : Land(grid.value_or(density->header().georef), density->header().cols, density->header().rows), density_(std::move(density)),
+      buildable_(std::move(buildable)) {
+  check_same_grid(density_->header(), buildable_->path(), buildable_->header());
   const double least = 2 * kBandBytes * cols() / kShare;  // a band of two rows
   bytes_ = (tiles.limit_mb() - reserved_mb) * 1e6;
   if (tiles.memory_limit_mb > 0 && bytes_ < least)
@@ -105,12 +114,10 @@ sites::LandView LandTiles::window(int col0, int row0, int cols, int rows) const 
   sites::LandView v;
   v.col0 = col0, v.row0 = row0, v.cols = cols, v.rows = rows;
   v.stride = std::size_t(cols);
-  {
-    const Dem d = density_.read(col0, row0, cols, rows);
-    check_density_values(density_.path(), d.data(), d.size());
-    v.own_density.assign(d.data(), d.data() + d.size());
-  }
-  const Dem b = buildable_.read(col0, row0, cols, rows);
+  Dem d = density_->read(col0, row0, cols, rows);
+  check_density_values(density_->path(), d.data(), d.size());
+  v.own_density = std::move(d.values());
+  const Dem b = buildable_->read(col0, row0, cols, rows);
   v.own_buildable.resize(b.size());
   for (std::size_t i = 0; i < b.size(); ++i) v.own_buildable[i] = b[i] == 1 ? 1 : 0;  // nodata (NaN) is not buildable
   v.density = v.own_density.data();

@@ -4,6 +4,8 @@
 #pragma once
 #include <cstdint>
 #include <functional>
+#include <memory>
+#include <optional>
 #include <string>
 
 #include "core/progress.hpp"
@@ -47,19 +49,23 @@ density::ReadWindowInputs density_windows(const DemWindowReader& dem, const Scen
 
 /// The land of the sites stage read from the density stage's tiles (density.vrt, buildable.vrt):
 /// bands of rows and blocks sized to the memory limit, the disc tests' blocks grown by the largest
-/// disc. Holds references to the two readers.
+/// disc.
 class LandTiles : public sites::Land {
  public:
-  /// The bands and blocks hold what `tiles`' limit leaves once `reserved_mb` is counted (throws
-  /// bad_input when that is less than a band of two rows). `grid`: the run's DEM's georeferencing
-  /// (a VRT's geotransform may differ from it in the last bit).
-  LandTiles(const DemWindowReader& density, const DemWindowReader& buildable, const Georef& grid, const TileSettings& tiles, double reserved_mb);
+  /// Reads the two files (GeoTIFF or VRT) by windows. The bands and blocks hold what `tiles`' limit
+  /// leaves once `reserved_mb` is counted (throws bad_input when that is less than a band of two
+  /// rows). `grid`: the run's DEM's georeferencing (a VRT's geotransform may differ from it in the
+  /// last bit); none: the density file's own.
+  LandTiles(const std::string& density, const std::string& buildable, const std::optional<Georef>& grid, const TileSettings& tiles,
+            double reserved_mb);
   sites::LandView window(int col0, int row0, int cols, int rows) const override;
   int block_side(int margin_cols, int margin_rows) const override;
   int band_rows() const override { return band_rows_; }
 
  private:
-  const DemWindowReader &density_, &buildable_;
+  LandTiles(std::unique_ptr<DemWindowReader> density, std::unique_ptr<DemWindowReader> buildable, const std::optional<Georef>& grid,
+            const TileSettings& tiles, double reserved_mb);
+  std::unique_ptr<DemWindowReader> density_, buildable_;
   int tile_size_ = 0, band_rows_ = 0;
   double bytes_ = 0;
 };

@@ -452,14 +452,11 @@ void sites_run(RunState& s, Progress& progress, const Log& log) {
     options.land_area_km2 = s.summary["density"]["land_area_km2"].get<double>();
   const std::string existing_file = s.scenario.path("/sites/existing");
   // By tiles: the density stage's tiles read by bands and blocks within the memory limit.
-  std::optional<DemWindowReader> density_tiles, buildable_tiles;
   std::unique_ptr<sites::Land> land;
   if (s.by_tiles) {
     s.by_tiles->reserve();
-    density_tiles.emplace(saved(s, "density.vrt"));
-    buildable_tiles.emplace(saved(s, "buildable.vrt"));
     const TiledInput& in = *s.by_tiles;
-    auto tiles = std::make_unique<LandTiles>(*density_tiles, *buildable_tiles, s.grid.georef, in.tiles, in.reserved_mb);
+    auto tiles = std::make_unique<LandTiles>(saved(s, "density.vrt"), saved(s, "buildable.vrt"), s.grid.georef, in.tiles, in.reserved_mb);
     log.detail("sites by tiles: bands of " + std::to_string(tiles->band_rows()) + " rows, " +
                std::to_string(int(in.tiles.limit_mb() - in.reserved_mb)) + " MB for the land's bands and blocks");
     land = std::move(tiles);
