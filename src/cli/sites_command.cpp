@@ -37,7 +37,8 @@ class SitesCommand final : public Command {
 
   void setup(CLI::App& app) override {
     file_kind(app.add_option("DENSITY_DIR_OR_DEM", dir_,
-                   "Folder holding density.tif (float, [0,1]) and buildable.tif (1 = buildable) on the DEM grid, or a DEM "
+                   "Folder holding density.tif (float, [0,1]) and buildable.tif (1 = buildable) on the DEM grid (or the .vrt "
+                   "mosaics of a tiled density, read by tiles), or a DEM "
                    "(the density is then computed as a run's hydro and density stages do, with the scenario's defaults)")
         ->required(), FileKind::folder_in);
     dem_.add_read_options(app, "of a DEM");
@@ -57,22 +58,15 @@ class SitesCommand final : public Command {
     const bool dem = std::filesystem::is_regular_file(dir_);
     if (!dem && dem_.given()) throw bad_input("--band, --assume-crs: only for a DEM, and " + dir_ + " is a density folder");
     const pipeline::TileSettings tiles = schema_.settings([&] { return pipeline::tile_settings(scenario); });
-    // A density folder written by tiles (density.vrt), or a limit given: the land read by bands and blocks.
-    const std::filesystem::path folder(dir_);
-    const bool by_tiles = !dem && (tiles.given() || (!std::filesystem::exists(folder / "density.tif") && std::filesystem::exists(folder / "density.vrt")));
     if (dem && tiles.given())
       throw bad_input("--tile-size, --memory-limit: for a density folder (a DEM by tiles: terrapolis run --until network)");
+    // A density folder written by tiles (density.vrt), or a limit given: the land read by bands and blocks.
+    const std::string density = dem ? "" : pipeline::density_folder_file(dir_, "density");
     pipeline::DensityFolder in;
     std::unique_ptr<sites::Land> land;
-    if (by_tiles) {
-      const auto file = [&](const char* name) {
-        const std::filesystem::path tif = folder / (std::string(name) + ".tif"), vrt = folder / (std::string(name) + ".vrt");
-        if (std::filesystem::exists(tif)) return tif.string();
-        if (std::filesystem::exists(vrt)) return vrt.string();
-        throw bad_input(dir_ + ": no " + name + ".tif or " + name + ".vrt in it");
-      };
+    if (!dem && (tiles.given() || std::filesystem::path(density).extension() == ".vrt")) {
       const double reserved = reserve_reader_memory(tiles.limit_mb());
-      land = std::make_unique<pipeline::LandTiles>(file("density"), file("buildable"), std::nullopt, tiles, reserved);
+      land = std::make_unique<pipeline::LandTiles>(density, pipeline::density_folder_file(dir_, "buildable"), std::nullopt, tiles, reserved);
     } else {
       in = dem ? run_density(scenario, dem_.read(dir_), options, context) : pipeline::read_density_folder(dir_);
       land = std::make_unique<sites::LandRasters>(in.density, in.buildable);

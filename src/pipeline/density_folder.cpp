@@ -28,13 +28,17 @@ void check_same_grid(const RasterHeader& density, const std::string& buildable_p
       throw bad_input(buildable_path + ": not on the grid of the density (different geotransform)");
 }
 
-DensityFolder read_density_folder(const std::string& dir) {
+std::string density_folder_file(const std::string& dir, const std::string& name) {
   namespace fs = std::filesystem;
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) throw bad_input(dir + ": no such folder (expected density.tif and buildable.tif in it)");
-  const std::string density_path = (fs::path(dir) / "density.tif").string();
-  const std::string buildable_path = (fs::path(dir) / "buildable.tif").string();
-  if (!fs::exists(buildable_path, ec)) throw bad_input(buildable_path + ": no such file");
+  for (const char* extension : {".tif", ".vrt"})
+    if (const fs::path file = fs::path(dir) / (name + extension); fs::exists(file, ec)) return file.string();
+  throw bad_input((fs::path(dir) / (name + ".tif")).string() + ": no such file (nor " + name + ".vrt, a tiled density's)");
+}
+
+DensityFolder read_density_folder(const std::string& dir) {
+  const std::string density_path = density_folder_file(dir, "density"), buildable_path = density_folder_file(dir, "buildable");
   DensityFolder in;
   in.density = read_dem(density_path);
   check_density_values(density_path, in.density.data(), in.density.size());

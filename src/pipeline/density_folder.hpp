@@ -16,8 +16,12 @@ struct DensityFolder {
   Raster<std::uint8_t> buildable;
 };
 
-/// Reads density.tif and buildable.tif from `dir`. Throws bad_input naming the file when the
-/// folder or a file is missing, a density lies outside [0,1], or the two are not on one grid.
+/// DIR/NAME.tif, or DIR/NAME.vrt (the mosaic a tiled density writes) when there is no .tif;
+/// throws bad_input naming them when the folder or both files are missing.
+std::string density_folder_file(const std::string& dir, const std::string& name);
+
+/// Reads density and buildable (density_folder_file) from `dir` whole. Throws bad_input naming the
+/// file when the folder or a file is missing, a density lies outside [0,1], or the two are not on one grid.
 DensityFolder read_density_folder(const std::string& dir);
 
 /// Throws bad_input naming `path` at a density value outside [0,1] (NaN is nodata).
