@@ -474,23 +474,21 @@ class Growth {
         for (int j = 0; j < n; ++j)
           if (s.population >= floor_[std::size_t(j)]) spacing[std::size_t(j)].add(s.col, s.row);
     for (const Site& s : out) add(s.col, s.row, n - 1 - s.radius_class);
-    const std::size_t batch = 4096;
-    while (next_ < m && remaining > 0) {
-      const std::size_t begin = next_, end = std::min(m, begin + batch);
-      for (std::size_t k = begin; k < end && remaining > 0; ++k, next_ = k) {
-        const int c = int(pool_[k] % std::uint32_t(cols_)), r = int(pool_[k] / std::uint32_t(cols_));
-        // The largest valid class with quota left, spaced from the larger centres.
-        int j = (covered && (*covered)[k] ? 0 : limit_[k]) - 1;
-        while (j >= 0 && (quota[std::size_t(j)] == 0 || too_close(c, r, j))) --j;
-        if (j < 0) continue;  // supprimer(L_sites, S)
-        --quota[std::size_t(j)];
-        --remaining;
-        ++table.classes[std::size_t(n - 1 - j)].placed;
-        out.push_back(site_at(k, j));
-        add(c, r, j);
-      }
-      step.update(double(next_) / double(m));
+    for (; next_ < m && remaining > 0; ++next_) {
+      const std::size_t k = next_;
+      if (k % 4096 == 0) step.update(double(k) / double(m));
+      const int c = int(pool_[k] % std::uint32_t(cols_)), r = int(pool_[k] / std::uint32_t(cols_));
+      // The largest valid class with quota left, spaced from the larger centres.
+      int j = (covered && (*covered)[k] ? 0 : limit_[k]) - 1;
+      while (j >= 0 && (quota[std::size_t(j)] == 0 || too_close(c, r, j))) --j;
+      if (j < 0) continue;  // supprimer(L_sites, S)
+      --quota[std::size_t(j)];
+      --remaining;
+      ++table.classes[std::size_t(n - 1 - j)].placed;
+      out.push_back(site_at(k, j));
+      add(c, r, j);
     }
+    step.update(double(next_) / double(m));
   }
 
   /// By radius, decreasing; equal radii keep the density order.
