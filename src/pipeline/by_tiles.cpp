@@ -75,8 +75,8 @@ density::ReadWindowInputs density_windows(const DemWindowReader& dem, const Scen
 // the view's density and buildable, 5); a band's 4 more (the catchments' owner), a block's 2 (the
 // disc test's row gaps). Measured, the process grows by about 1.5 times that (the VRT's buffers,
 // freed chunks the allocator keeps): 25 and 21 bytes a cell are counted, and a band or a block
-// holds at most a third of the budget (5.2e7 cells peaked 5 % over a 300 MB limit at 17 and 15
-// bytes and half the budget).
+// holds at most a third of the budget (2.3e7 cells peaked at 311 MB against a 300 MB limit at 17
+// and 15 bytes and half the budget; 288 MB now).
 constexpr double kBandBytes = 25, kBlockBytes = 21, kShare = 1.0 / 3;
 
 namespace {
