@@ -35,7 +35,7 @@ line=$(grep "^density tiles: [0-9]" "$work/tiled.log") || fail "no tile report: 
 # The sites command on the tiled density folder (density.vrt, buildable.vrt): the land read by bands
 # and blocks, the whole folder's settlements byte for byte; and on the whole folder within a limit.
 "$bin" -q sites "$work/whole" "$work/sites_whole" > /dev/null
-"$bin" -v sites "$work/tiled" "$work/sites_tiled" > /dev/null 2> "$work/sites.log"
+"$bin" -q sites "$work/tiled" "$work/sites_tiled" > /dev/null
 limit=100
 [[ -n ${ASAN_OPTIONS:-} ]] && limit=2000  # AddressSanitizer holds 400-700 MB more
 "$bin" -q sites "$work/whole" "$work/sites_limit" --memory-limit $limit > /dev/null

@@ -39,6 +39,8 @@ expect_fail 2 "the saved run used other 'input' parameters; rerun from terrain" 
 # Another limit cuts other tiles of the same cells: a rerun from the sites reuses the saved stages.
 "$TP" -q run "${tiled[@]}" --set input.memory_limit_mb=2000 --set density.r_max_m=4000 --from sites -o tiles
 cmp -s whole4/cities.geojson tiles/cities.geojson || fail "--from sites with another memory limit: other settlements"
+/usr/bin/python3 -c 'import json; r = json.load(open("tiles/run.json"))["rerun"]; assert r["reused"] == ["terrain", "hydro", "density"], r' ||
+  fail "--from sites with another memory limit did not reuse the terrain, hydro and density stages"
 expect_fail 2 "--until: the run made the density stage: a rerun goes on to its last stage" "$TP" run --set sites.population=1000 --until hydro --from hydro -o "$(
   "$TP" -q run --until roads -o full > /dev/null && echo full)"
 
