@@ -137,8 +137,8 @@ class PathSearch {
   }
   std::uint64_t key_of(Cell c, int o) const { return std::uint64_t(t_.index(c.col, c.row)) * O_ + std::uint64_t(o); }
   Cell cell_of(std::uint64_t key) const {
-    const std::uint64_t i = key / O_;
-    return Cell{int(i % std::uint64_t(t_.cols())), int(i / std::uint64_t(t_.cols()))};
+    const std::size_t i = std::size_t(key / O_);
+    return Cell{t_.col_of(i), t_.row_of(i)};
   }
   int orient_of(std::uint64_t key) const { return int(key % O_); }
   void report(double h) {

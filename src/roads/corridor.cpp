@@ -54,13 +54,14 @@ Side cross_section(const TerrainField& t, const EarthworkOptions& o, GridPoint p
   const double mx = t.metres_x(p.row), my = t.metres_y(p.row);
   auto at = [&](double d) { return GridPoint{p.col + n.x * d / mx, p.row + n.y * d / my}; };
   auto slope = [&](GridPoint q) {
-    const int c = std::clamp(int(std::lround(q.col)), 0, t.cols() - 1), rr = std::clamp(int(std::lround(q.row)), 0, t.rows() - 1);
+    const int c = t.clamp_col(int(std::lround(q.col))), rr = t.clamp_row(int(std::lround(q.row)));
     return o.slope_at(t.index(c, rr));
   };
   // On the grid and on land (earthworks() leaves water and nodata alone: the works end at the shore).
   auto on_land = [&](GridPoint q) {
-    if (!(q.col >= -0.5 && q.row >= -0.5 && q.col <= t.cols() - 0.5 && q.row <= t.rows() - 0.5)) return false;
-    return !t.water(std::clamp(int(std::lround(q.col)), 0, t.cols() - 1), std::clamp(int(std::lround(q.row)), 0, t.rows() - 1));
+    if (!(q.col >= t.col0() - 0.5 && q.row >= t.row0() - 0.5 && q.col <= t.col0() + t.cols() - 0.5 && q.row <= t.row0() + t.rows() - 0.5))
+      return false;
+    return !t.water(t.clamp_col(int(std::lround(q.col))), t.clamp_row(int(std::lround(q.row))));
   };
   // How far the ground is beyond the side's reach at d (<= 0: the side has met it).
   auto excess = [&](double d) {
@@ -369,7 +370,7 @@ namespace {
 /// The stretches of a road off the given roads: maximal runs of segments not on them (on_existing).
 std::vector<RoadGeometry> new_stretches(const RoadGeometry& road, const TerrainField& t, const std::vector<std::uint8_t>& existing) {
   auto cell = [&](const GridPoint& p) {
-    const int c = std::clamp(int(std::lround(p.col)), 0, t.cols() - 1), r = std::clamp(int(std::lround(p.row)), 0, t.rows() - 1);
+    const int c = t.clamp_col(int(std::lround(p.col))), r = t.clamp_row(int(std::lround(p.row)));
     return std::uint32_t(t.index(c, r));
   };
   std::vector<RoadGeometry> out;

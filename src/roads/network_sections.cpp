@@ -38,7 +38,7 @@ struct Edge {
 };
 
 GridPoint point_of(const TerrainField& t, std::uint32_t cell) {
-  return {double(cell % std::uint32_t(t.cols())), double(cell / std::uint32_t(t.cols()))};
+  return {double(t.col_of(cell)), double(t.row_of(cell))};
 }
 
 /// Douglas-Peucker in grid units: the staircase of a chain drawn as straight runs, ends kept.
@@ -65,7 +65,7 @@ bool on_existing(const TerrainField& t, const std::vector<std::uint8_t>& existin
   if (existing.empty() || (!existing[a] && !existing[b])) return false;
   auto near = [&](std::uint32_t cell) {
     if (existing[cell]) return true;
-    const int col = int(cell % std::uint32_t(t.cols())), row = int(cell / std::uint32_t(t.cols()));
+    const int col = t.col_of(cell), row = t.row_of(cell);
     for (int dr = -1; dr <= 1; ++dr)
       for (int dc = -1; dc <= 1; ++dc)
         if (t.inside(col + dc, row + dr) && existing[t.index(col + dc, row + dr)]) return true;

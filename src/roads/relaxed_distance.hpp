@@ -27,7 +27,7 @@ constexpr double kDeg = 180.0 / std::numbers::pi;
 /// arcs cost the same from every orientation, so they are computed once (lazily, NaN = not yet).
 class ArcCache {
  public:
-  ArcCache(const RoadGraph& graph) : graph_(graph), n_(graph.surface_arcs()), slot_(graph.terrain().cols() * std::size_t(graph.terrain().rows()), kNone) {}
+  ArcCache(const RoadGraph& graph) : graph_(graph), n_(graph.surface_arcs()), slot_(graph.terrain().size(), kNone) {}
   /// The cached costs of a cell's surface arcs (NaN = not computed yet); valid until the next call.
   float* row(std::size_t cell_index) {
     std::uint32_t& s = slot_[cell_index];
@@ -191,7 +191,7 @@ class RelaxedDistance {
     if (source == source_) return;
     source_ = source;
     heap_.rekey([&](Entry& e) {
-      const Cell c{int(e.cell % std::size_t(t_.cols())), int(e.cell / std::size_t(t_.cols()))};
+      const Cell c{t_.col_of(e.cell), t_.row_of(e.cell)};
       e.f = e.g + guide(c) + (e.ring >= 0 ? ring_offset_[std::size_t(e.ring)] : 0.0);
     });
   }
@@ -216,7 +216,7 @@ class RelaxedDistance {
     if (s.closed[i] || g >= s.g[i]) return;
     if (s.g[i] == kInfinity) s.touched.push_back(i);
     s.g[i] = g;
-    const Cell c{int(i % std::size_t(t_.cols())), int(i / std::size_t(t_.cols()))};
+    const Cell c{t_.col_of(i), t_.row_of(i)};
     push({g + guide(c), g, i, -1});
   }
   void push(const Entry& e) { heap_.push(e); }
@@ -255,7 +255,7 @@ class RelaxedDistance {
   }
   /// Relaxes the arcs into cell i (settled at distance d).
   void expand(std::size_t i, double d) {
-    const Cell v{int(i % std::size_t(t_.cols())), int(i / std::size_t(t_.cols()))};
+    const Cell v{t_.col_of(i), t_.row_of(i)};
     const auto& arcs = graph_.arcs();
     for (std::size_t a = 0; a < graph_.surface_arcs(); ++a) {
       const Cell u{v.col - arcs[a].dcol, v.row - arcs[a].drow};
@@ -281,7 +281,7 @@ class RelaxedDistance {
   }
   /// Relaxes the long arcs of ring e.ring into the settled cell e.cell, then queues its next ring.
   void relax_ring(const Entry& e) {
-    const Cell v{int(e.cell % std::size_t(t_.cols())), int(e.cell / std::size_t(t_.cols()))};
+    const Cell v{t_.col_of(e.cell), t_.row_of(e.cell)};
     const auto& arcs = graph_.arcs();
     const double d = e.g, zv = t_.surface(v.col, v.row);
     const RoadGraph::Ring& ring = graph_.rings()[std::size_t(e.ring)];

@@ -40,11 +40,12 @@ RoadGraph::RoadGraph(const TerrainField& terrain, const CostModel& model, const 
   orientations_ = blocks * m + 1;
   for (const MaskArc& a : segment_mask(options_.k)) arcs_.push_back({a.dcol, a.drow, Structure::road, block[0] * m + sector_of(a.angle_rad, m), a.angle_rad});
   surface_arcs_ = arcs_.size();
-  if (surface_arcs_ * std::size_t(terrain_.rows()) <= kMaxLengthTable) {
+  if (surface_arcs_ * std::size_t(terrain_.rows()) <= kMaxLengthTable) {  // the rows held, from row0
     surface_length_.resize(surface_arcs_ * std::size_t(terrain_.rows()));
-    for (int r = 0; r < terrain_.rows(); ++r)
+    for (int r = terrain_.row0(); r < terrain_.row0() + terrain_.rows(); ++r)
       for (std::size_t a = 0; a < surface_arcs_; ++a)
-        surface_length_[std::size_t(r) * surface_arcs_ + a] = terrain_.length_m({0, double(r)}, {double(arcs_[a].dcol), double(r + arcs_[a].drow)});
+        surface_length_[std::size_t(r - terrain_.row0()) * surface_arcs_ + a] =
+            terrain_.length_m({0, double(r)}, {double(arcs_[a].dcol), double(r + arcs_[a].drow)});
   }
   const double cell = terrain_.typical_cell_m();
   for (Structure s : {Structure::bridge, Structure::tunnel}) {
@@ -220,7 +221,7 @@ void RoadGraph::build_rings() {
   // Sort the long arcs by structure and length, then cut each structure's arcs into bands of
   // equal length range. Lengths use the narrowest cell of the grid, so no arc is shorter.
   double wmin = kInfinity, hmin = kInfinity;
-  for (int r = 0; r < terrain_.rows(); ++r) {
+  for (int r = 0; r < terrain_.grid_rows(); ++r) {  // the whole grid's, so that a window's rings are the grid's
     wmin = std::min(wmin, terrain_.metres_x(r));
     hmin = std::min({hmin, terrain_.metres_y(r - 0.5), terrain_.metres_y(r + 0.5)});
   }
@@ -304,7 +305,7 @@ double RoadGraph::road_slope_cost(double grade) const {
 }
 
 double RoadGraph::surface_length_m(int row, int arc) const {
-  if (!surface_length_.empty()) return surface_length_[std::size_t(row) * surface_arcs_ + std::size_t(arc)];
+  if (!surface_length_.empty()) return surface_length_[std::size_t(row - terrain_.row0()) * surface_arcs_ + std::size_t(arc)];
   const Arc& a = arcs_[std::size_t(arc)];
   return terrain_.length_m({0, double(row)}, {double(a.dcol), double(row + a.drow)});
 }

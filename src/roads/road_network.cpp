@@ -170,7 +170,7 @@ class BuiltRoads {
     }
     return total > 0 ? shared / total : 0;
   }
-  GridPoint point(std::uint32_t cell) const { return {double(cell % std::uint32_t(t_.cols())), double(cell / std::uint32_t(t_.cols()))}; }
+  GridPoint point(std::uint32_t cell) const { return {double(t_.col_of(cell)), double(t_.row_of(cell))}; }
   std::uint32_t find(std::uint32_t x) {
     while (parent_[x] != x) x = parent_[x] = parent_[parent_[x]];
     return x;

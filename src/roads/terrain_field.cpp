@@ -11,24 +11,42 @@
 
 namespace terrapolis::roads {
 
+void WaterCount::add(const Dem& window, double sea_level_m) {
+  for (std::size_t i = 0; i < window.size(); ++i) {
+    if (window.is_nodata(i) || !(window[i] <= sea_level_m)) continue;
+    ++water;
+    if (window[i] < sea_level_m - 1) ++deep;
+  }
+}
+
 TerrainField::TerrainField(const Dem& dem, double sea_level_m, double unknown_depth_m, double road_radius_m,
                            const Raster<std::uint8_t>* inland_water)
-    : cols_(dem.cols()), rows_(dem.rows()), georef_(dem.georef()), metrics_(cell_metrics(dem.georef(), dem.cols(), dem.rows())),
-      sea_level_(sea_level_m) {
+    : cols_(dem.cols()), rows_(dem.rows()), col_end_(dem.cols()), row_end_(dem.rows()), grid_cols_(dem.cols()), grid_rows_(dem.rows()),
+      georef_(dem.georef()), metrics_(cell_metrics(dem.georef(), dem.cols(), dem.rows())), sea_level_(sea_level_m) {
+  WaterCount count;
+  count.add(dem, sea_level_m);
+  bathymetry_ = count.bathymetry();
+  build(dem, unknown_depth_m, road_radius_m, inland_water);
+}
+
+TerrainField::TerrainField(const Dem& window, int col0, int row0, const TerrainGrid& grid, double sea_level_m, double unknown_depth_m,
+                           double road_radius_m, const Raster<std::uint8_t>* inland_water)
+    : cols_(window.cols()), rows_(window.rows()), col0_(col0), row0_(row0), col_end_(col0 + window.cols()), row_end_(row0 + window.rows()),
+      grid_cols_(grid.cols), grid_rows_(grid.rows), origin_(std::size_t(row0) * std::size_t(window.cols()) + std::size_t(col0)),
+      georef_(grid.georef), metrics_(cell_metrics(grid.georef, grid.cols, grid.rows)), sea_level_(sea_level_m), bathymetry_(grid.bathymetry) {
+  if (col0 < 0 || row0 < 0 || col_end_ > grid.cols || row_end_ > grid.rows) throw processing_error("terrain: a window outside its grid");
+  if (inland_water && (inland_water->cols() != cols_ || inland_water->rows() != rows_))
+    throw processing_error("terrain: the inland water window is not the DEM's");
+  build(window, unknown_depth_m, road_radius_m, inland_water);
+}
+
+void TerrainField::build(const Dem& dem, double unknown_depth_m, double road_radius_m, const Raster<std::uint8_t>* inland_water) {
+  const double sea_level_m = sea_level_;
   const std::size_t n = dem.size();
   surface_.resize(n);
   ground_.resize(n);
   depth_.assign(n, 0.f);
   water_.assign(n, 0);
-  std::size_t water_cells = 0, deep_cells = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (dem.is_nodata(i)) continue;
-    if (dem[i] <= sea_level_m) {
-      ++water_cells;
-      if (dem[i] < sea_level_m - 1) ++deep_cells;
-    }
-  }
-  bathymetry_ = water_cells > 0 && 2 * deep_cells > water_cells;
   std::vector<float> raw_depth(n, 0.f);
   for (std::size_t i = 0; i < n; ++i) {
     const bool nodata = dem.is_nodata(i);
@@ -49,17 +67,18 @@ TerrainField::TerrainField(const Dem& dem, double sea_level_m, double unknown_de
       ground_[i] = dem[i];
     }
   }
+  // The grid's cell sizes, whatever part of it is held, so that a window prices as the grid does.
   double lo = 1e300;
-  for (int r = 0; r < rows_; ++r) lo = std::min({lo, metrics_.width_m[r], metrics_.height_m[r]});
+  for (int r = 0; r < grid_rows_; ++r) lo = std::min({lo, metrics_.width_m[r], metrics_.height_m[r]});
   min_cell_m_ = lo;
-  typical_cell_m_ = 0.5 * (metrics_.width_m[rows_ / 2] + metrics_.height_m[rows_ / 2]);
+  typical_cell_m_ = 0.5 * (metrics_.width_m[grid_rows_ / 2] + metrics_.height_m[grid_rows_ / 2]);
   // Water within the road's radius (Peytavie §4.2.1: maximum depth over the disc Omega(p, r)).
   const int rad = int(std::floor(road_radius_m / min_cell_m_));
   if (rad <= 0) {
     depth_ = raw_depth;
   } else {
-    for (int r = 0; r < rows_; ++r)
-      for (int c = 0; c < cols_; ++c) {
+    for (int r = row0_; r < row_end_; ++r)
+      for (int c = col0_; c < col_end_; ++c) {
         float m = 0;
         for (int dr = -rad; dr <= rad; ++dr)
           for (int dc = -rad; dc <= rad; ++dc) {
@@ -81,7 +100,7 @@ TerrainField::TerrainField(const Dem& dem, double sea_level_m, double unknown_de
     while (!stack.empty()) {
       const std::size_t i = stack.back();
       stack.pop_back();
-      const int c = int(i % std::size_t(cols_)), r = int(i / std::size_t(cols_));
+      const int c = col_of(i), r = row_of(i);
       for (int k = 0; k < 8; ++k) {
         const int cc = c + dcol[k], rr = r + drow[k];
         if (!inside(cc, rr)) continue;
@@ -96,10 +115,11 @@ TerrainField::TerrainField(const Dem& dem, double sea_level_m, double unknown_de
 }
 
 namespace {
+/// Bilinear at (col, row) of the window whose first cell is (col0, row0), clamped to it.
 template <class V>
-double bilinear(const V& v, int cols, int rows, double col, double row) {
-  col = std::clamp(col, 0.0, double(cols - 1));
-  row = std::clamp(row, 0.0, double(rows - 1));
+double bilinear(const V& v, int cols, int rows, int col0, int row0, double col, double row) {
+  col = std::clamp(col - col0, 0.0, double(cols - 1));
+  row = std::clamp(row - row0, 0.0, double(rows - 1));
   const int c0 = std::min(int(col), cols - 2 < 0 ? 0 : cols - 2), r0 = std::min(int(row), rows - 2 < 0 ? 0 : rows - 2);
   const double fc = col - c0, fr = row - r0;
   const std::size_t i = std::size_t(r0) * std::size_t(cols) + std::size_t(c0);
@@ -108,8 +128,8 @@ double bilinear(const V& v, int cols, int rows, double col, double row) {
 }
 }  // namespace
 
-double TerrainField::surface_at(double col, double row) const { return bilinear(surface_, cols_, rows_, col, row); }
-double TerrainField::ground_at(double col, double row) const { return bilinear(ground_, cols_, rows_, col, row); }
+double TerrainField::surface_at(double col, double row) const { return bilinear(surface_, cols_, rows_, col0_, row0_, col, row); }
+double TerrainField::ground_at(double col, double row) const { return bilinear(ground_, cols_, rows_, col0_, row0_, col, row); }
 
 void TerrainField::set_vegetation(const Raster<float>& density) {
   if (density.cols() != cols_ || density.rows() != rows_) throw bad_input("vegetation layer: not on the DEM's grid");
@@ -139,13 +159,13 @@ float TerrainField::vegetation_at(double col, double row) const {
 }
 
 double TerrainField::metres_x(double row) const {
-  const int r = std::clamp(nearest_cell(row), 0, rows_ - 1);
+  const int r = std::clamp(nearest_cell(row), 0, grid_rows_ - 1);
   return metrics_.width_m[r];
 }
 
 double TerrainField::metres_y(double row) const {
   // height_m[r] spans rows r-1..r; take the boundary nearest to the position.
-  const int r = std::clamp(nearest_cell(row + 0.5), 0, rows_);
+  const int r = std::clamp(nearest_cell(row + 0.5), 0, grid_rows_);
   return metrics_.height_m[r];
 }
 

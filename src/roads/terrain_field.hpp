@@ -25,6 +25,22 @@ struct GridPoint {
   double col = 0, row = 0;
 };
 
+/// What a window of a grid needs from the whole grid to price its cells as the whole grid does:
+/// the grid's georeferencing and size (cell metrics, sampling by position) and whether it carries
+/// bathymetry (a rule over all its water cells; WaterCount).
+struct TerrainGrid {
+  Georef georef;
+  int cols = 0, rows = 0;
+  bool bathymetry = false;
+};
+
+/// The bathymetry rule's counts (TerrainField), summed over a grid's windows in any order.
+struct WaterCount {
+  std::size_t water = 0, deep = 0;  ///< cells at or below the sea level, and over 1 m below it
+  void add(const Dem& window, double sea_level_m);
+  bool bathymetry() const { return water > 0 && 2 * deep > water; }
+};
+
 /// Ground and water of a DEM for the road search. Water cells are cells at or below the sea level
 /// and nodata cells. Their depth is sea_level - elevation when the DEM carries bathymetry (more
 /// than half of its water cells lie over 1 m below sea level, as in GEBCO), otherwise
@@ -36,22 +52,38 @@ class TerrainField {
   /// water layer or hydro::detect_flat_water), water `unknown_depth_m` deep under their DEM level.
   TerrainField(const Dem& dem, double sea_level_m, double unknown_depth_m, double road_radius_m,
                const Raster<std::uint8_t>* inland_water = nullptr);
+  /// A window of a larger grid: `window` (and `inland_water`) hold its cells [col0, col0 + cols) x
+  /// [row0, row0 + rows). Positions, cells and lengths stay the grid's (its georeferencing and cell
+  /// metrics), so a road found in the window is the grid's road, bit for bit, wherever the window
+  /// holds every cell the road's costs read (roads::route_by_windows). Cells near the window's edge
+  /// see a truncated road radius.
+  TerrainField(const Dem& window, int col0, int row0, const TerrainGrid& grid, double sea_level_m, double unknown_depth_m,
+               double road_radius_m, const Raster<std::uint8_t>* inland_water = nullptr);
 
+  /// The cells held: the window's size (the grid's for a whole grid) and its first cell.
   int cols() const { return cols_; }
   int rows() const { return rows_; }
+  int col0() const { return col0_; }
+  int row0() const { return row0_; }
+  /// The whole grid's size.
+  int grid_cols() const { return grid_cols_; }
+  int grid_rows() const { return grid_rows_; }
   std::size_t size() const { return std::size_t(cols_) * std::size_t(rows_); }
-  bool inside(int col, int row) const { return col >= 0 && row >= 0 && col < cols_ && row < rows_; }
-  std::size_t index(int col, int row) const { return std::size_t(row) * std::size_t(cols_) + std::size_t(col); }
-  /// Index of the cell nearest to a position, clamped to the grid.
-  std::size_t nearest_index(double col, double row) const {
-    return index(std::clamp(nearest_cell(col), 0, cols_ - 1), std::clamp(nearest_cell(row), 0, rows_ - 1));
-  }
+  bool inside(int col, int row) const { return col >= col0_ && row >= row0_ && col < col_end_ && row < row_end_; }
+  /// Index of a held cell (row-major over the window: the order of the grid's own indices).
+  std::size_t index(int col, int row) const { return std::size_t(row) * std::size_t(cols_) + std::size_t(col) - origin_; }
+  int col_of(std::size_t index) const { return col0_ + int(index % std::size_t(cols_)); }
+  int row_of(std::size_t index) const { return row0_ + int(index / std::size_t(cols_)); }
+  int clamp_col(int col) const { return std::clamp(col, col0_, col_end_ - 1); }
+  int clamp_row(int row) const { return std::clamp(row, row0_, row_end_ - 1); }
+  /// Index of the cell nearest to a position, clamped to the cells held.
+  std::size_t nearest_index(double col, double row) const { return index(clamp_col(nearest_cell(col)), clamp_row(nearest_cell(row))); }
 
   /// Ground or water surface height (m) at a cell: max(elevation, sea level); sea level on nodata.
   float surface(int col, int row) const { return surface_[index(col, row)]; }
   /// Terrain height (m) at a cell, the sea floor under water (for tunnels); sea level - depth on nodata.
   float ground(int col, int row) const { return ground_[index(col, row)]; }
-  /// Bilinear surface height (m) at a fractional position, clamped to the grid.
+  /// Bilinear surface height (m) at a fractional position, clamped to the cells held.
   double surface_at(double col, double row) const;
   /// Bilinear terrain height (m) (sea floor under water).
   double ground_at(double col, double row) const;
@@ -59,7 +91,7 @@ class TerrainField {
   float depth_at(double col, double row) const {
     return depth_[nearest_index(col, row)];
   }
-  /// Sets the vegetation / land-cover density layer (same grid as the DEM; NaN counts as 0).
+  /// Sets the vegetation / land-cover density layer (the cells held; NaN counts as 0).
   void set_vegetation(const Raster<float>& density);
   /// Vegetation density at the nearest cell (0 without a layer).
   float vegetation_at(double col, double row) const;
@@ -93,15 +125,17 @@ class TerrainField {
   /// Cell side at the centre row (m), the scale of "cells" in the cost model.
   double typical_cell_m() const { return typical_cell_m_; }
 
-  /// Land component label (8-connected land cells), or -1 on water. Two points on different
-  /// labels cannot be joined by a road on the ground (maritime links).
+  /// Land component label (8-connected land cells held), or -1 on water. Two points on different
+  /// labels cannot be joined by a road on the ground (maritime links) within the cells held.
   const std::vector<std::int32_t>& land_components() const { return land_; }
 
   const Georef& georef() const { return georef_; }
   const CellMetrics& metrics() const { return metrics_; }
 
  private:
-  int cols_ = 0, rows_ = 0;
+  void build(const Dem& dem, double unknown_depth_m, double road_radius_m, const Raster<std::uint8_t>* inland_water);
+  int cols_ = 0, rows_ = 0, col0_ = 0, row0_ = 0, col_end_ = 0, row_end_ = 0, grid_cols_ = 0, grid_rows_ = 0;
+  std::size_t origin_ = 0;  ///< index(col0, row0) before the window's offset: row0 * cols + col0
   Georef georef_;
   CellMetrics metrics_;
   double sea_level_ = 0;
