@@ -1,0 +1,60 @@
+// One road on a grid larger than memory: the search runs on a window of the grid, grown until a
+// bound proves that no road leaving it could cost less, so the road is the whole grid's.
+// SPDX-License-Identifier: MIT
+#pragma once
+#include <cstddef>
+#include <functional>
+#include <optional>
+
+#include "core/progress.hpp"
+#include "roads/road_network.hpp"
+
+namespace terrapolis::roads {
+
+/// The road terrain of the grid's cells [col0, col0 + cols) x [row0, row0 + rows) (TerrainField's
+/// window constructor), with whatever the caller layers on it.
+using ReadTerrainWindow = std::function<TerrainField(int col0, int row0, int cols, int rows)>;
+
+struct WindowOptions {
+  /// The most cells a window may hold: the memory the road may take, at kWindowBytesPerCell
+  /// (0: the whole grid if need be).
+  std::size_t max_cells = 0;
+  /// Cells read beyond the searched area on each side, so that every cost a road inside it reads
+  /// is the grid's: the road radius (water depth), the corridor's reach, and 2 for the bilinear
+  /// samples (window_margin_cells).
+  int margin_cells = 2;
+  /// The first searched area: the two ends' bounding box padded by this many cells, and by a
+  /// quarter of its longer side.
+  int pad_cells = 32;
+};
+
+/// Bytes a window takes per cell while its road is searched: the terrain (surface, ground, depth,
+/// water, land components: 17), its inputs while it is built (DEM, inland water, raw depth: 13), and
+/// the search's per-cell arrays (nodes, arc caches, relaxed distances: about 30). The nodes the
+/// search stores come on top (RoutingOptions::max_nodes, about 80 bytes each).
+inline constexpr double kWindowBytesPerCell = 60;
+
+/// The margin WindowOptions::margin_cells needs: the road radius and a reach (the corridor's:
+/// its platform's half-width plus its tallest side), in the grid's smallest cells, plus 2.
+int window_margin_cells(double road_radius_m, double reach_m, double min_cell_m);
+
+struct WindowedRoad {
+  std::optional<Road> road;             ///< as route_road returns it, in the grid's cells
+  std::optional<TerrainField> terrain;  ///< the last window: its cells, positions and metrics are the grid's
+  int windows = 0;                      ///< windows searched
+  std::size_t largest_cells = 0;        ///< cells of the largest window read
+  bool proved = false;                  ///< the bound proved the road the grid's (false: the window was the grid)
+};
+
+/// Routes a road between two cells of `grid` by windows (route_road on each). A window is accepted
+/// when its road stays in the searched area I (the window less its margin) and costs less than any
+/// road that leaves I could: cheapest cost per metre x 0.995 x the shortest length from one end to
+/// the other through a cell outside I (the straight-line bound of RoadGraph::lower_bound, at the
+/// grid's smallest cell). Then the road's cost is the whole grid's optimum; its cells are the
+/// whole grid's road too unless two roads cost exactly the same. Else the area doubles. A road
+/// that is not found, a ferry (the window's land masses) or a road past max_cells throws
+/// bad_input naming the window's size. The Bézier router is not searched by windows (bad_input).
+WindowedRoad route_by_windows(const TerrainGrid& grid, const ReadTerrainWindow& read, const CostModel& model, const GraphOptions& graph,
+                              Cell from, Cell to, const RoutingOptions& options, const WindowOptions& window, Progress* progress = nullptr);
+
+}  // namespace terrapolis::roads

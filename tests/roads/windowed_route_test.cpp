@@ -1,0 +1,150 @@
+// Roads by windows: a road searched on windows of the grid is the whole grid's road.
+// SPDX-License-Identifier: MIT
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "core/error.hpp"
+#include "roads/windowed_route.hpp"
+#include "support/georefs.hpp"
+
+using namespace terrapolis;
+using namespace terrapolis::roads;
+
+namespace {
+
+/// Random hills, some pits below sea level, and on request a wall across the grid with one gap.
+Dem landscape(std::mt19937_64& rng, int cols, int rows, const Georef& georef, bool wall) {
+  std::uniform_real_distribution<double> u(0, 1);
+  struct Bump { double c, r, h, s; };
+  std::vector<Bump> bumps;
+  for (int i = 0; i < 14; ++i) bumps.push_back({u(rng) * cols, u(rng) * rows, (u(rng) - 0.3) * 60, 3 + 10 * u(rng)});
+  const int wall_col = cols / 2, gap = int(u(rng) * (rows - 6)) + 3;
+  Dem dem(cols, rows, georef);
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c) {
+      double z = 8;
+      for (const auto& b : bumps) z += b.h * std::exp(-((c - b.c) * (c - b.c) + (r - b.r) * (r - b.r)) / (2 * b.s * b.s));
+      if (wall && std::abs(c - wall_col) <= 1 && std::abs(r - gap) > 1) z += 400;  // a cliff the slope threshold closes
+      dem(c, r) = float(z);
+    }
+  if (u(rng) < 0.3) dem(int(u(rng) * cols), int(u(rng) * rows)) = std::numeric_limits<float>::quiet_NaN();
+  return dem;
+}
+
+/// The window [col0, col0 + cols) x [row0, row0 + rows) of a DEM, as a copy of its own cells.
+Dem window_of(const Dem& dem, int col0, int row0, int cols, int rows) {
+  Georef g = dem.georef();
+  g.transform[0] += col0 * g.transform[1];
+  g.transform[3] += row0 * g.transform[5];
+  Dem w(cols, rows, g);
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c) w(c, r) = dem(col0 + c, row0 + r);
+  return w;
+}
+
+CostModel test_model(std::mt19937_64& rng) {
+  CostModel m = default_cost_model();
+  m.road.slope_deg.threshold = 12 + 10 * double(rng() % 100) / 100;
+  m.bridge.enabled = rng() % 2 == 0;
+  m.tunnel.enabled = rng() % 2 == 0;
+  for (StructureCosts* s : {&m.bridge, &m.tunnel}) {
+    s->min_length_cells = 2;
+    s->max_length_cells = 6;
+    s->samples = 12;
+  }
+  m.road_radius_m = rng() % 2 ? 0.0 : 25.0;
+  return m;
+}
+
+}  // namespace
+
+TEST(RoadByWindows, GivesTheWholeGridsRoadOnRandomLandscapes) {
+  std::mt19937_64 rng(2026);
+  int windowed = 0, grown = 0, routed = 0;
+  for (int trial = 0; trial < 24; ++trial) {
+    const bool geographic = trial % 3 == 2;
+    const int cols = 150 + int(rng() % 80), rows = 120 + int(rng() % 60);
+    const Dem dem = landscape(rng, cols, rows, geographic ? test::geographic(62.0, 1.0 / 1200) : test::projected(10.0), trial % 4 == 1);
+    const CostModel model = test_model(rng);
+    const GraphOptions graph{int(1 + rng() % 4), 8, rng()};
+    const TerrainField whole(dem, 0.0, 10.0, model.road_radius_m);
+    const RoadGraph whole_graph(whole, model, graph);
+    const TerrainGrid grid{dem.georef(), cols, rows, whole.has_bathymetry()};
+    std::size_t cells_read = 0;
+    const ReadTerrainWindow read = [&](int c0, int r0, int w, int h) {
+      cells_read += std::size_t(w) * std::size_t(h);
+      return TerrainField(window_of(dem, c0, r0, w, h), c0, r0, grid, 0.0, 10.0, model.road_radius_m);
+    };
+    WindowOptions options;
+    options.margin_cells = window_margin_cells(model.road_radius_m, 0, whole.min_cell_m());
+    options.pad_cells = 8;
+    RoutingOptions routing;
+    for (int k = 0; k < 3; ++k) {
+      const Cell a{int(rng() % std::uint64_t(cols)), int(rng() % std::uint64_t(rows))};
+      const Cell b{int(rng() % std::uint64_t(cols)), int(rng() % std::uint64_t(rows))};
+      if (a == b || !snap_to_land(whole, a, routing.snap_cells) || !snap_to_land(whole, b, routing.snap_cells)) continue;
+      const std::optional<Road> expected = route_road(whole, whole_graph, a, b, routing);
+      WindowedRoad got;
+      try {
+        got = route_by_windows(grid, read, model, graph, a, b, routing, options);
+      } catch (const Error& e) {
+        ADD_FAILURE() << trial << ": " << e.what();
+        continue;
+      }
+      ASSERT_EQ(bool(expected), bool(got.road)) << trial;
+      if (!expected) continue;
+      ASSERT_EQ(expected->ferry, got.road->ferry) << trial;
+      ASSERT_EQ(bool(expected->cost), bool(got.road->cost)) << trial;
+      if (expected->cost) {
+        EXPECT_EQ(*expected->cost, *got.road->cost) << trial << " " << k;  // bit for bit
+      }
+      // The same cells (as grid cells), the same geometry, the same figures.
+      ASSERT_EQ(expected->chain.cells.size(), got.road->chain.cells.size()) << trial;
+      for (std::size_t i = 0; i < expected->chain.cells.size(); ++i) {
+        ASSERT_EQ(whole.col_of(expected->chain.cells[i]), got.terrain->col_of(got.road->chain.cells[i])) << trial;
+        ASSERT_EQ(whole.row_of(expected->chain.cells[i]), got.terrain->row_of(got.road->chain.cells[i])) << trial;
+      }
+      ASSERT_EQ(expected->geometry.points.size(), got.road->geometry.points.size()) << trial;
+      for (std::size_t i = 0; i < expected->geometry.points.size(); ++i) {
+        EXPECT_EQ(expected->geometry.points[i].col, got.road->geometry.points[i].col) << trial;
+        EXPECT_EQ(expected->geometry.points[i].row, got.road->geometry.points[i].row) << trial;
+        EXPECT_EQ(expected->geometry.z[i], got.road->geometry.z[i]) << trial;
+      }
+      EXPECT_EQ(expected->stats.length_m, got.road->stats.length_m) << trial;
+      EXPECT_EQ(expected->stats.bridge_m, got.road->stats.bridge_m) << trial;
+      EXPECT_EQ(expected->stats.tunnel_m, got.road->stats.tunnel_m) << trial;
+      ++routed;
+      windowed += got.largest_cells < std::size_t(cols) * std::size_t(rows);
+      grown += got.windows > 1;
+    }
+  }
+  EXPECT_GE(routed, 40);
+  EXPECT_GE(windowed, 20);  // most roads never read the whole grid
+  EXPECT_GE(grown, 3);      // and some needed a second window (the walls' detours)
+}
+
+TEST(RoadByWindows, ARoadLargerThanTheLimitIsRefusedNamingIt) {
+  std::mt19937_64 rng(5);
+  const Dem dem = landscape(rng, 160, 160, test::projected(10.0), true);
+  const CostModel model = default_cost_model();
+  const TerrainField whole(dem, 0.0, 10.0, 0.0);
+  const TerrainGrid grid{dem.georef(), 160, 160, whole.has_bathymetry()};
+  std::size_t largest = 0;
+  const ReadTerrainWindow read = [&](int c0, int r0, int w, int h) {
+    largest = std::max(largest, std::size_t(w) * std::size_t(h));
+    return TerrainField(window_of(dem, c0, r0, w, h), c0, r0, grid, 0.0, 10.0, 0.0);
+  };
+  WindowOptions options;
+  options.max_cells = 2000;  // 44 x 44: the ends alone are 120 cells apart
+  try {
+    route_by_windows(grid, read, model, GraphOptions{}, {20, 20}, {140, 140}, RoutingOptions{}, options);
+    FAIL() << "a window past the limit was searched";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::bad_input);
+    EXPECT_NE(std::string(e.what()).find("2000 cells"), std::string::npos) << e.what();
+  }
+  EXPECT_LE(largest, options.max_cells);  // nothing past the limit was read
+}
