@@ -25,6 +25,20 @@ run surface_bidir --no-bridges --no-tunnels --search bidir
 run structures_astar
 run structures_astar_distance --search astar-distance
 run structures_bidir --search bidir
+# By windows (path --memory-limit): the tile as a 3 x 3 VRT of its tiles, the road searched on a
+# window around its ends; the same road, byte for byte.
+for i in 0 1 2; do
+  for j in 0 1 2; do
+    gdal_translate -q -srcwin $((j * 400)) $((i * 400)) $((j == 2 ? 401 : 400)) $((i == 2 ? 401 : 400)) "$dem" "$out/tile_${i}_$j.tif"
+  done
+done
+gdalbuildvrt -q "$out/tiles.vrt" "$out"/tile_*.tif
+whole_dem=$dem; dem=$out/tiles.vrt
+run by_windows --memory-limit 200
+dem=$whole_dem
+grep -o 'path by windows:.*' "$out/by_windows.log" | sed "s/^/  /"
+cmp -s "$out/structures_astar.geojson" "$out/by_windows.geojson" && echo "  by_windows: the whole grid's road, byte for byte" ||
+  echo "  by_windows: NOT the whole grid's road"
 
 if command -v grass >/dev/null; then
   # GRASS: r.walk (anisotropic walking cost, Naismith/Langmuir) from the start, r.drain back from the end.

@@ -19,6 +19,8 @@
 #include "io/text_io.hpp"
 #include "io/vector_io.hpp"
 #include "roads/road_network.hpp"
+#include "roads/windowed_route.hpp"
+#include "pipeline/by_tiles.hpp"
 
 namespace terrapolis::cli {
 namespace {
@@ -63,23 +65,41 @@ class PathCommand final : public Command {
         corridor.empty() ? "" : outputs.file(std::filesystem::path(corridor_).replace_extension(".qml").string());
     const roads::CostModel model = options_.cost_model();
     const plugin::PluginSet plugins = options_.plugins.load(context.log);
-    const Dem dem = dem_.read();
-    roads::TerrainField terrain = options_.terrain(dem, plugins, context.progress, context.log);
-    const roads::CorridorOptions corridor_options = options_.corridor_options(dem);
-    const auto a = locate("--from", from_, terrain), b = locate("--to", to_, terrain);
-    if (a == b) throw bad_input("--from/--to: both points fall in the same cell");
-    for (const auto& [opt, c] : {std::pair{"--from", a}, std::pair{"--to", b}}) {
-      if (dem.is_nodata(dem.index(c.col, c.row))) throw bad_input(std::string(opt) + ": the point is on a nodata cell of " + dem_.path);
-      if (!roads::snap_to_land(terrain, c, routing.snap_cells))
-        throw bad_input(std::string(opt) + ": the point is in the sea (no land within " + std::to_string(routing.snap_cells) + " cells)");
+    const pipeline::TileSettings tiles = options_.schema.settings([&] { return pipeline::tile_settings(options_.scenario()); });
+    std::optional<Dem> dem;  // the whole DEM; none by windows
+    std::optional<roads::TerrainField> terrain;
+    std::optional<roads::Road> road;
+    roads::CorridorOptions corridor_options;
+    auto t0 = std::chrono::steady_clock::now();  // the search (by windows: their reads too)
+    if (tiles.given()) {
+      check_windows_allowed(plugins);
+      corridor_options = pipeline::corridor_settings(options_.scenario()).options;
+      // The inland water's tiles, gone before the outputs are committed.
+      const ScratchFolder scratch((std::filesystem::path(out).parent_path() / ".inland_water").string());
+      t0 = std::chrono::steady_clock::now();
+      roads::WindowedRoad w = route_by_windows(routing, model, corridor_options, tiles, scratch.path(), context);
+      terrain = std::move(w.terrain);
+      road = std::move(w.road);
+    } else {
+      dem.emplace(dem_.read());
+      terrain.emplace(options_.terrain(*dem, plugins, context.progress, context.log));
+      corridor_options = options_.corridor_options(*dem);
+      const auto a = locate("--from", from_, terrain->georef(), dem->cols(), dem->rows());
+      const auto b = locate("--to", to_, terrain->georef(), dem->cols(), dem->rows());
+      if (a == b) throw bad_input("--from/--to: both points fall in the same cell");
+      for (const auto& [opt, c] : {std::pair{"--from", a}, std::pair{"--to", b}}) {
+        if (dem->is_nodata(dem->index(c.col, c.row))) throw bad_input(std::string(opt) + ": the point is on a nodata cell of " + dem_.path);
+        if (!roads::snap_to_land(*terrain, c, routing.snap_cells))
+          throw bad_input(std::string(opt) + ": the point is in the sea (no land within " + std::to_string(routing.snap_cells) + " cells)");
+      }
+      const roads::RoadGraph graph(*terrain, model, options_.graph());
+      if (!evaluate_.empty()) {
+        std::printf("cost %.3f\n", evaluate(graph, *terrain, *dem));
+        return;
+      }
+      t0 = std::chrono::steady_clock::now();
+      road = roads::route_road(*terrain, graph, a, b, routing, &context.progress);
     }
-    const roads::RoadGraph graph(terrain, model, options_.graph());
-    if (!evaluate_.empty()) {
-      std::printf("cost %.3f\n", evaluate(graph, terrain, dem));
-      return;
-    }
-    const auto t0 = std::chrono::steady_clock::now();
-    const auto road = roads::route_road(terrain, graph, a, b, routing, &context.progress);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (!road) throw processing_error("path: no road joins the two points under the cost model (slope or water thresholds)");
     if (road->over_budget) {
@@ -90,23 +110,23 @@ class PathCommand final : public Command {
     roads[0].from = 0;
     roads[0].to = 1;
     roads[0].road_class = road->ferry ? roads::RoadClass::maritime : roads::RoadClass::departmental;
-    VectorLayer layer = roads::roads_layer(terrain, roads);
-    const VectorLayer sections_layer = roads::sections_layer(terrain, roads);
+    VectorLayer layer = roads::roads_layer(*terrain, roads);
+    const VectorLayer sections_layer = roads::sections_layer(*terrain, roads);
     roads::Corridors corridors;
     double corridor_seconds = 0;
     if (!corridor.empty()) {
       const auto t1 = std::chrono::steady_clock::now();
-      corridors = roads::road_corridors(terrain, roads, corridor_options);
+      corridors = roads::road_corridors(*terrain, roads, corridor_options);
       corridor_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
       roads::add_corridor_fields(layer, corridors);
     }
     write_vector(out, layer);
     if (!sections.empty()) write_vector(sections, sections_layer);
     if (!corridor.empty()) {
-      write_vector(corridor, roads::corridors_layer(terrain, corridors));
+      write_vector(corridor, roads::corridors_layer(*terrain, corridors));
       write_text_file(corridor_style, roads::corridors_qml(), false);
     }
-    options_.write_earthworks(earthworks, dem, terrain, roads, corridor_options);
+    if (dem) options_.write_earthworks(earthworks, *dem, *terrain, roads, corridor_options);
     outputs.commit();
     const auto& s = road->stats;
     char cost[64] = "none (it breaks a threshold of the cost model)";  // Bézier roads may
@@ -125,17 +145,88 @@ class PathCommand final : public Command {
   }
 
  private:
-  roads::Cell locate(const std::string& option, const std::string& text, const roads::TerrainField& terrain) const {
+  roads::Cell locate(const std::string& option, const std::string& text, const Georef& georef, int cols, int rows) const {
     const auto v = parse_pair(option, text);
     std::array<double, 2> xy = v;
     if (crs_ == "lonlat") {
       if (std::fabs(v[1]) > 90) throw bad_input(option + ": latitude " + std::to_string(v[1]) + " is outside -90..90 (give LON,LAT)");
-      const GridLocator locator(terrain.georef());
+      const GridLocator locator(georef);
       xy = locator.lonlat_to_crs(v[0], v[1]);
     }
-    const auto cell = roads::cell_at(terrain, xy[0], xy[1]);
+    const auto cell = roads::cell_at(georef, cols, rows, xy[0], xy[1]);
     if (!cell) throw bad_input(option + ": the point " + text + " lies outside " + dem_.path);
     return *cell;
+  }
+
+  /// What reads the whole DEM, refused with --memory-limit (naming the option).
+  void check_windows_allowed(const plugin::PluginSet& plugins) const {
+    const auto refuse = [](const std::string& what) { throw bad_input(what + ": reads the whole DEM; not with --memory-limit"); };
+    if (!evaluate_.empty()) refuse("--evaluate");
+    if (options_.routing().router != roads::Router::galin) refuse("--router bezier");
+    if (!options_.earthworks.empty()) refuse("--earthworks");
+    if (!options_.settings().vegetation.empty()) refuse("--vegetation");
+    if (!plugins.empty()) refuse("--plugin");
+    if (!options_.scenario().path("/roads/corridor/side_angles").empty()) refuse("--side-angles");
+    if (!pipeline::inland_water_settings(options_.scenario()).reservoirs.empty()) refuse("water.reservoirs");
+  }
+
+  /// The road by windows of the DEM (roads::route_by_windows): the inland water by tiles into
+  /// `scratch` first (pipeline::inland_water_by_tiles), the bathymetry rule over bands of rows, then
+  /// windows that hold the road's costs and its corridor, within the memory limit.
+  roads::WindowedRoad route_by_windows(const roads::RoutingOptions& routing, const roads::CostModel& model,
+                                       const roads::CorridorOptions& corridor, const pipeline::TileSettings& tiles,
+                                       const std::string& scratch, Context& context) const {
+    const DemWindowReader reader(dem_.path, dem_.options());
+    const RasterHeader& h = reader.header();
+    const pipeline::Scenario& scenario = options_.scenario();
+    const double sea_level = scenario.resolved["water"]["sea_level_m"].get<double>();
+    const roads::Cell a = locate("--from", from_, h.georef, h.cols, h.rows), b = locate("--to", to_, h.georef, h.cols, h.rows);
+    if (a == b) throw bad_input("--from/--to: both points fall in the same cell");
+    for (const auto& [opt, c] : {std::pair{"--from", a}, std::pair{"--to", b}})
+      if (reader.read(c.col, c.row, 1, 1).is_nodata(0)) throw bad_input(std::string(opt) + ": the point is on a nodata cell of " + dem_.path);
+    const MosaicFiles water{scratch, "inland_water"};
+    water.create();
+    const hydro::tiled::TiledFlatWaterReport w = pipeline::inland_water_by_tiles(
+        reader, pipeline::inland_water_settings(scenario), tiles, reserve_reader_memory(tiles.limit_mb()),
+        [&](int t, int across, const Raster<std::uint8_t>& tile) { write_raster(water.tile(t, across), tile, WriteOptions{}); }, context.progress);
+    water.finish(w.tiles, w.across);
+    context.log.detail(pipeline::describe(w));
+    const DemWindowReader lakes(water.vrt(), ReadOptions{});
+    // What the windows and the search's nodes may take: half each of what the limit leaves.
+    const double budget = (tiles.limit_mb() - reserve_reader_memory(tiles.limit_mb())) * 1e6;
+    roads::TerrainGrid grid{h.georef, h.cols, h.rows, false};
+    roads::WaterCount count;
+    const int band = int(std::clamp(budget / 8 / (4.0 * h.cols), 1.0, double(h.rows)));
+    for (int r = 0; r < h.rows; r += band) count.add(reader.read(0, r, h.cols, std::min(band, h.rows - r)), sea_level);
+    grid.bathymetry = count.bathymetry();
+    roads::WindowOptions window;
+    window.max_cells = std::size_t(std::max(0.0, 0.5 * budget / roads::kWindowBytesPerCell));
+    const CellMetrics metrics = cell_metrics(h.georef, h.cols, h.rows);
+    double min_cell = roads::kInfinity;
+    for (int r = 0; r < h.rows; ++r) min_cell = std::min({min_cell, metrics.width_m[std::size_t(r)], metrics.height_m[std::size_t(r)]});
+    window.margin_cells = roads::window_margin_cells(model.road_radius_m, roads::corridor_reach_m(corridor), min_cell);
+    roads::RoutingOptions bounded = routing;
+    bounded.max_nodes = std::min(routing.max_nodes, std::size_t(std::max(0.0, 0.5 * budget / 80)));
+    const roads::ReadTerrainWindow read = [&](int c0, int r0, int cols, int rows) {
+      const Dem window_dem = reader.read(c0, r0, cols, rows);
+      const Dem window_lakes = lakes.read(c0, r0, cols, rows);
+      Raster<std::uint8_t> mask(cols, rows, window_dem.georef());
+      for (std::size_t i = 0; i < mask.size(); ++i) mask[i] = window_lakes[i] == 1;
+      return roads::TerrainField(window_dem, c0, r0, grid, sea_level, model.unknown_water_depth_m, model.road_radius_m, &mask);
+    };
+    roads::WindowedRoad road;
+    try {
+      road = roads::route_by_windows(grid, read, model, options_.graph(), a, b, bounded, window, &context.progress);
+    } catch (const Error& e) {
+      if (e.kind() != ErrorKind::processing) throw;
+      throw Error(e.kind(), std::string(e.what()) + " (--memory-limit " + std::to_string(int(tiles.limit_mb())) + " allows " +
+                                std::to_string(bounded.max_nodes) + ")");
+    }
+    context.log.detail("path by windows: " + std::to_string(road.windows) + " windows searched, the largest " +
+                       std::to_string(road.largest_cells) + " cells of the " + std::to_string(h.cols) + " x " + std::to_string(h.rows) + " DEM");
+    context.log.detail("the memory limit allows windows of " + std::to_string(window.max_cells) + " cells and " +
+                       std::to_string(bounded.max_nodes) + " search nodes");
+    return road;
   }
 
   /// Cost of a polyline walked through 8-neighbour steps (a D8 path such as r.drain's).

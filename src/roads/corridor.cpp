@@ -212,6 +212,12 @@ double repose_angle_deg(const std::string& material) {
   throw bad_input("material: '" + material + "' is none of sand, earth, stones, rock");
 }
 
+double corridor_reach_m(const CorridorOptions& options) {
+  double half = options.half_width_m;
+  for (const ClassWidths& w : options.widths) half = std::max(half, 0.5 * w.platform_m);
+  return half + options.max_height_m / std::tan(std::clamp(options.side_angle_deg, 1.0, 89.0) * kRad);
+}
+
 EarthworkOptions earthwork_options(const CorridorOptions& c, Raster<float>& slopes, RoadClass road_class) {
   const ClassWidths& w = c.widths[std::min(std::size_t(road_class), c.widths.size() - 1)];
   if (!(c.half_width_m >= 0) || !(w.carriageway_m > 0) || !(w.platform_m >= w.carriageway_m) || !(c.side_angle_deg > 0 && c.side_angle_deg < 90) ||

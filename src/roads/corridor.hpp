@@ -79,6 +79,10 @@ struct Corridors {
   bool vegetation = false;  ///< a vegetation layer was given (cleared_ha means something)
 };
 
+/// How far (m) from a road's axis its corridor reads the terrain: the widest half-platform and a side
+/// rising max_height_m at side_angle_deg (a map of side angles is not counted).
+double corridor_reach_m(const CorridorOptions& options);
+
 /// The earthworks options these corridor options imply for a road of class `road_class` (r: the
 /// half-width override or the class's half platform; side slope = 1 / tan(angle), per cell when a
 /// map is given; `slopes` holds the per-cell map and must outlive the result). Throws bad_input

@@ -33,16 +33,21 @@ std::optional<Cell> snap_to_land(const TerrainField& t, Cell c, int radius) {
 }
 
 std::optional<Cell> cell_at(const TerrainField& terrain, double x, double y) {
+  const std::optional<Cell> c = cell_at(terrain.georef(), terrain.grid_cols(), terrain.grid_rows(), x, y);
+  if (c && !terrain.inside(c->col, c->row)) return std::nullopt;
+  return c;
+}
+
+std::optional<Cell> cell_at(const Georef& georef, int cols, int rows, double x, double y) {
   // Inverse of the affine geotransform (no CRS operation needed).
-  const auto& g = terrain.georef().transform;
+  const auto& g = georef.transform;
   const double det = g[1] * g[5] - g[2] * g[4];
   if (det == 0 || !std::isfinite(x) || !std::isfinite(y)) return std::nullopt;
   const double dx = x - g[0], dy = y - g[3];
   const double col = (g[5] * dx - g[2] * dy) / det, row = (-g[4] * dx + g[1] * dy) / det;
   if (!std::isfinite(col) || !std::isfinite(row)) return std::nullopt;
-  const int c = int(std::floor(col)), r = int(std::floor(row));
-  if (!terrain.inside(c, r)) return std::nullopt;
-  return Cell{c, r};
+  if (!(col >= 0 && row >= 0 && col < cols && row < rows)) return std::nullopt;
+  return Cell{int(std::floor(col)), int(std::floor(row))};
 }
 
 std::optional<Road> route_road(const TerrainField& t, const RoadGraph& graph, Cell from, Cell to, const RoutingOptions& options,

@@ -115,7 +115,9 @@ VectorLayer sections_layer(const TerrainField& terrain, const std::vector<Road>&
 /// The nearest land cell within `radius` cells of `cell` (itself when on land), or nullopt.
 std::optional<Cell> snap_to_land(const TerrainField& terrain, Cell cell, int radius);
 
-/// Cell holding a point given in the DEM's CRS, or nullopt when outside the grid.
+/// Cell holding a point given in the DEM's CRS, or nullopt when outside the cells held.
 std::optional<Cell> cell_at(const TerrainField& terrain, double x, double y);
+/// The same on a grid of `cols` x `rows` cells georeferenced by `georef`.
+std::optional<Cell> cell_at(const Georef& georef, int cols, int rows, double x, double y);
 
 }  // namespace terrapolis::roads

@@ -21,17 +21,42 @@ struct Box {
   bool holds(int col, int row) const { return col >= c0 && col <= c1 && row >= r0 && row <= r1; }
 };
 
-/// The shortest a path from a to b can be, in cells, through a cell outside `area`: such a cell lies
+/// A lower bound of the metres per cell across (w) and along (h) every row of the grid: a path
+/// from a to b is at least |(dcol w, drow h)| long.
+struct Scale {
+  double w = 1, h = 1;
+};
+Scale smallest_cells(const TerrainGrid& g) {
+  const CellMetrics m = cell_metrics(g.georef, g.cols, g.rows);
+  return {*std::min_element(m.width_m.begin(), m.width_m.end()), *std::min_element(m.height_m.begin(), m.height_m.end())};
+}
+
+/// The shortest a path from a to b can be (m) through a cell outside `area`: such a cell lies
 /// beyond one of the lines just outside the area's sides, and |a - y| + |y - b| >= |a - b'| for any y
-/// beyond a line, b' the reflection of b across it. Infinity when the area is the whole grid.
-double detour_cells(Cell a, Cell b, const Box& area, const TerrainGrid& g) {
+/// beyond a line, b' the reflection of b across it (in metres, scaled by `s`). Infinity when the
+/// area is the whole grid.
+double detour_m(Cell a, Cell b, const Box& area, const TerrainGrid& g, Scale s) {
   double best = kInfinity;
-  auto through = [&](double dc, double dr) { best = std::min(best, std::hypot(dc, dr)); };
+  auto through = [&](double dc, double dr) { best = std::min(best, std::hypot(dc * s.w, dr * s.h)); };
   if (area.c0 > 0) through(double(a.col) + b.col - 2.0 * (area.c0 - 1), b.row - a.row);
   if (area.c1 < g.cols - 1) through(2.0 * (area.c1 + 1) - a.col - b.col, b.row - a.row);
   if (area.r0 > 0) through(b.col - a.col, double(a.row) + b.row - 2.0 * (area.r0 - 1));
   if (area.r1 < g.rows - 1) through(b.col - a.col, 2.0 * (area.r1 + 1) - a.row - b.row);
   return best;
+}
+
+/// The cells around the ellipse of the points y with |a - y| + |y - b| <= length_m (m, scaled by
+/// `s`), one more on each side: the detour through any cell outside is longer than length_m.
+Box ellipse_box(Cell a, Cell b, double length_m, const TerrainGrid& g, Scale s) {
+  const double ax = a.col * s.w, ay = a.row * s.h, bx = b.col * s.w, by = b.row * s.h;
+  const double focal = 0.5 * std::hypot(bx - ax, by - ay), major = 0.5 * length_m;
+  const double minor = std::sqrt(std::max(0.0, major * major - focal * focal));
+  const double cos_t = focal > 0 ? (bx - ax) / (2 * focal) : 1, sin_t = focal > 0 ? (by - ay) / (2 * focal) : 0;
+  const double hx = std::hypot(major * cos_t, minor * sin_t), hy = std::hypot(major * sin_t, minor * cos_t);
+  const double cx = 0.5 * (ax + bx), cy = 0.5 * (ay + by);
+  const auto cell = [](double v, double size, double grid_max) { return std::clamp(v / size, -1.0, grid_max + 1); };
+  return {std::max(0, int(std::floor(cell(cx - hx, s.w, g.cols))) - 1), std::max(0, int(std::floor(cell(cy - hy, s.h, g.rows))) - 1),
+          std::min(g.cols - 1, int(std::ceil(cell(cx + hx, s.w, g.cols))) + 1), std::min(g.rows - 1, int(std::ceil(cell(cy + hy, s.h, g.rows))) + 1)};
 }
 
 std::string cell_text(Cell c) { return "(" + std::to_string(c.col) + ", " + std::to_string(c.row) + ")"; }
@@ -47,11 +72,14 @@ WindowedRoad route_by_windows(const TerrainGrid& grid, const ReadTerrainWindow& 
   if (options.router != Router::galin) throw bad_input("roads by windows: the Bézier router reads the whole grid; use the Galin router");
   const Box whole{0, 0, grid.cols - 1, grid.rows - 1};
   if (!whole.holds(from.col, from.row) || !whole.holds(to.col, to.row)) throw bad_input("path: an end point lies outside the DEM");
-  const int side = std::max(std::abs(to.col - from.col), std::abs(to.row - from.row));
-  Box area = Box{std::min(from.col, to.col), std::min(from.row, to.row), std::max(from.col, to.col), std::max(from.row, to.row)}
-                 .grown(std::max(window.pad_cells, options.snap_cells) + side / 4, grid);
+  const Scale scale = smallest_cells(grid);
+  const Box ends = Box{std::min(from.col, to.col), std::min(from.row, to.row), std::max(from.col, to.col), std::max(from.row, to.row)}
+                       .grown(std::max(window.pad_cells, options.snap_cells), grid);
+  const Box guess = ellipse_box(from, to, window.first_ratio * std::hypot((to.col - from.col) * scale.w, (to.row - from.row) * scale.h), grid, scale);
+  Box area{std::min(ends.c0, guess.c0), std::min(ends.r0, guess.r0), std::max(ends.c1, guess.c1), std::max(ends.r1, guess.r1)};
   WindowedRoad out;
   for (;;) {
+    std::optional<Box> needed;
     const Box read_box = area.grown(window.margin_cells, grid);
     const bool is_whole = area.c0 == 0 && area.r0 == 0 && area.c1 == whole.c1 && area.r1 == whole.r1;
     const auto refuse = [&](const std::string& why) {
@@ -72,19 +100,21 @@ WindowedRoad route_by_windows(const TerrainGrid& grid, const ReadTerrainWindow& 
       const std::vector<std::uint32_t>& cells = out.road->chain.cells;
       bool inside = true;
       for (std::uint32_t i : cells) inside = inside && area.holds(t.col_of(i), t.row_of(i));
-      if (inside && !cells.empty()) {
-        const Cell a{t.col_of(cells.front()), t.row_of(cells.front())}, b{t.col_of(cells.back()), t.row_of(cells.back())};
-        const double leaving = g.model().cheapest_per_metre() * 0.995 * t.min_cell_m() * detour_cells(a, b, area, grid);
-        if (*out.road->cost < leaving) {
-          out.proved = true;
-          return out;
-        }
+      const Cell a{t.col_of(cells.front()), t.row_of(cells.front())}, b{t.col_of(cells.back()), t.row_of(cells.back())};
+      const double per_metre = 0.995 * g.model().cheapest_per_metre();
+      if (inside && *out.road->cost < per_metre * detour_m(a, b, area, grid, scale)) {
+        out.proved = true;
+        return out;
       }
+      // The area the bound needs for this cost; the road of a larger window costs no more.
+      if (per_metre > 0) needed = ellipse_box(a, b, *out.road->cost / per_metre, grid, scale);
     }
-    // Double the area, or grow it as far as the limit allows.
+    // At least double the area (the next road may leave it again), and hold what the bound needs,
+    // or grow as far as the limit allows.
     int by = std::max(area.c1 - area.c0, area.r1 - area.r0) / 2 + 1;
-    while (by > 1 && window.max_cells > 0 && area.grown(by, grid).grown(window.margin_cells, grid).cells() > window.max_cells) by /= 2;
-    const Box next = area.grown(by, grid);
+    Box next = area.grown(by, grid);
+    if (needed) next = {std::min(next.c0, needed->c0), std::min(next.r0, needed->r0), std::max(next.c1, needed->c1), std::max(next.r1, needed->r1)};
+    while (window.max_cells > 0 && next.grown(window.margin_cells, grid).cells() > window.max_cells && by > 1) next = area.grown(by /= 2, grid);
     if (window.max_cells > 0 && next.grown(window.margin_cells, grid).cells() > window.max_cells)
       throw refuse(out.road && !out.road->ferry ? "was not proved the grid's shortest" : "was not found");
     area = next;
