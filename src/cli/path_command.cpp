@@ -67,7 +67,7 @@ class PathCommand final : public Command {
     const plugin::PluginSet plugins = options_.plugins.load(context.log);
     const pipeline::TileSettings tiles = options_.schema.settings([&] { return pipeline::tile_settings(options_.scenario()); });
     std::optional<Dem> dem;  // the whole DEM; none by windows
-    std::optional<roads::TerrainField> terrain;
+    std::unique_ptr<roads::TerrainField> terrain;
     std::optional<roads::Road> road;
     roads::CorridorOptions corridor_options;
     auto t0 = std::chrono::steady_clock::now();  // the search (by windows: their reads too)
@@ -82,7 +82,7 @@ class PathCommand final : public Command {
       road = std::move(w.road);
     } else {
       dem.emplace(dem_.read());
-      terrain.emplace(options_.terrain(*dem, plugins, context.progress, context.log));
+      terrain = std::make_unique<roads::TerrainField>(options_.terrain(*dem, plugins, context.progress, context.log));
       corridor_options = options_.corridor_options(*dem);
       const auto a = locate("--from", from_, terrain->georef(), dem->cols(), dem->rows());
       const auto b = locate("--to", to_, terrain->georef(), dem->cols(), dem->rows());
@@ -179,52 +179,35 @@ class PathCommand final : public Command {
     const DemWindowReader reader(dem_.path, dem_.options());
     const RasterHeader& h = reader.header();
     const pipeline::Scenario& scenario = options_.scenario();
-    const double sea_level = scenario.resolved["water"]["sea_level_m"].get<double>();
     const roads::Cell a = locate("--from", from_, h.georef, h.cols, h.rows), b = locate("--to", to_, h.georef, h.cols, h.rows);
     if (a == b) throw bad_input("--from/--to: both points fall in the same cell");
     for (const auto& [opt, c] : {std::pair{"--from", a}, std::pair{"--to", b}})
       if (reader.read(c.col, c.row, 1, 1).is_nodata(0)) throw bad_input(std::string(opt) + ": the point is on a nodata cell of " + dem_.path);
     const MosaicFiles water{scratch, "inland_water"};
     water.create();
-    const hydro::tiled::TiledFlatWaterReport w = pipeline::inland_water_by_tiles(
+    const hydro::tiled::TiledFlatWaterReport found = pipeline::inland_water_by_tiles(
         reader, pipeline::inland_water_settings(scenario), tiles, reserve_reader_memory(tiles.limit_mb()),
         [&](int t, int across, const Raster<std::uint8_t>& tile) { write_raster(water.tile(t, across), tile, WriteOptions{}); }, context.progress);
-    water.finish(w.tiles, w.across);
-    context.log.detail(pipeline::describe(w));
+    water.finish(found.tiles, found.across);
+    context.log.detail(pipeline::describe(found));
     const DemWindowReader lakes(water.vrt(), ReadOptions{});
-    // What the windows and the search's nodes may take: half each of what the limit leaves.
-    const double budget = (tiles.limit_mb() - reserve_reader_memory(tiles.limit_mb())) * 1e6;
-    roads::TerrainGrid grid{h.georef, h.cols, h.rows, false};
-    roads::WaterCount count;
-    const int band = int(std::clamp(budget / 8 / (4.0 * h.cols), 1.0, double(h.rows)));
-    for (int r = 0; r < h.rows; r += band) count.add(reader.read(0, r, h.cols, std::min(band, h.rows - r)), sea_level);
-    grid.bathymetry = count.bathymetry();
-    roads::WindowOptions window;
-    window.max_cells = std::size_t(std::max(0.0, 0.5 * budget / roads::kWindowBytesPerCell));
-    const CellMetrics metrics = cell_metrics(h.georef, h.cols, h.rows);
-    double min_cell = roads::kInfinity;
-    for (int r = 0; r < h.rows; ++r) min_cell = std::min({min_cell, metrics.width_m[std::size_t(r)], metrics.height_m[std::size_t(r)]});
-    window.margin_cells = roads::window_margin_cells(model.road_radius_m, roads::corridor_reach_m(corridor), min_cell);
+    const double budget_mb = tiles.limit_mb() - reserve_reader_memory(tiles.limit_mb());
+    const pipeline::RoadWindows w = pipeline::road_windows(reader, lakes, h.georef, scenario, model, roads::corridor_reach_m(corridor), budget_mb, 1);
     roads::RoutingOptions bounded = routing;
-    bounded.max_nodes = std::min(routing.max_nodes, std::size_t(std::max(0.0, 0.5 * budget / 80)));
-    const roads::ReadTerrainWindow read = [&](int c0, int r0, int cols, int rows) {
-      const Dem window_dem = reader.read(c0, r0, cols, rows);
-      const Dem window_lakes = lakes.read(c0, r0, cols, rows);
-      Raster<std::uint8_t> mask(cols, rows, window_dem.georef());
-      for (std::size_t i = 0; i < mask.size(); ++i) mask[i] = window_lakes[i] == 1;
-      return roads::TerrainField(window_dem, c0, r0, grid, sea_level, model.unknown_water_depth_m, model.road_radius_m, &mask);
-    };
+    bounded.max_nodes = std::min(routing.max_nodes, w.max_nodes);
     roads::WindowedRoad road;
     try {
-      road = roads::route_by_windows(grid, read, model, options_.graph(), a, b, bounded, window, &context.progress);
+      road = roads::route_by_windows(w.grid, w.read, model, options_.graph(), a, b, bounded, w.window, &context.progress);
     } catch (const Error& e) {
       if (e.kind() != ErrorKind::processing) throw;
       throw Error(e.kind(), std::string(e.what()) + " (--memory-limit " + std::to_string(int(tiles.limit_mb())) + " allows " +
                                 std::to_string(bounded.max_nodes) + ")");
     }
+    if (road.limited)
+      context.log.warn("path by windows: no window --memory-limit allows proved the road the whole grid's; the largest window's answer is kept");
     context.log.detail("path by windows: " + std::to_string(road.windows) + " windows searched, the largest " +
                        std::to_string(road.largest_cells) + " cells of the " + std::to_string(h.cols) + " x " + std::to_string(h.rows) + " DEM");
-    context.log.detail("the memory limit allows windows of " + std::to_string(window.max_cells) + " cells and " +
+    context.log.detail("the memory limit allows windows of " + std::to_string(w.window.max_cells) + " cells and " +
                        std::to_string(bounded.max_nodes) + " search nodes");
     return road;
   }

@@ -2,6 +2,8 @@
 // SPDX-License-Identifier: MIT
 #include "pipeline/inland_water.hpp"
 
+#include <algorithm>
+
 #include <cmath>
 
 #include "core/error.hpp"
@@ -45,6 +47,39 @@ roads::TerrainField road_terrain(const Dem& dem, const Scenario& scenario, const
                                  const Raster<std::uint8_t>& water) {
   return roads::TerrainField(dem, scenario.resolved["water"]["sea_level_m"].get<double>(), model.unknown_water_depth_m,
                              model.road_radius_m, &water);
+}
+
+namespace {
+/// What the search's node budget (RoutingOptions::max_nodes) counts: node slots of 16 bytes and arc
+/// costs cached 4 to a unit; with their share of the queue, about 32 bytes each.
+constexpr double kBytesPerNode = 32;
+}  // namespace
+
+RoadWindows road_windows(const DemWindowReader& dem, const DemWindowReader& lakes, const Georef& georef, const Scenario& scenario,
+                         const roads::CostModel& model, double reach_m, double budget_mb, std::size_t parallel) {
+  const RasterHeader& h = dem.header();
+  const double sea_level = scenario.resolved["water"]["sea_level_m"].get<double>();
+  const double budget = std::max(0.0, budget_mb) * 1e6 / double(std::max<std::size_t>(1, parallel));
+  RoadWindows out;
+  out.grid = {georef, h.cols, h.rows, false};
+  roads::WaterCount count;  // by bands of an eighth of the budget, at 4 bytes a cell
+  const int band = int(std::clamp(budget / 8 / (4.0 * h.cols), 1.0, double(h.rows)));
+  for (int r = 0; r < h.rows; r += band) count.add(dem.read(0, r, h.cols, std::min(band, h.rows - r)), sea_level);
+  out.grid.bathymetry = count.bathymetry();
+  out.window.max_cells = std::size_t(0.5 * budget / roads::kWindowBytesPerCell);
+  out.max_nodes = std::size_t(0.5 * budget / kBytesPerNode);
+  const CellMetrics metrics = cell_metrics(georef, h.cols, h.rows);
+  const double min_cell = std::min(*std::min_element(metrics.width_m.begin(), metrics.width_m.end()),
+                                   *std::min_element(metrics.height_m.begin(), metrics.height_m.end()));
+  out.window.margin_cells = roads::window_margin_cells(model.road_radius_m, reach_m, min_cell);
+  out.read = [&dem, &lakes, grid = out.grid, sea_level, model](int c0, int r0, int cols, int rows) {
+    const Dem window = dem.read(c0, r0, cols, rows);
+    const Dem water = lakes.read(c0, r0, cols, rows);
+    Raster<std::uint8_t> mask(cols, rows, window.georef());
+    for (std::size_t i = 0; i < mask.size(); ++i) mask[i] = water[i] == 1;
+    return roads::TerrainField(window, c0, r0, grid, sea_level, model.unknown_water_depth_m, model.road_radius_m, &mask);
+  };
+  return out;
 }
 
 void add_road_layers(roads::TerrainField& terrain, const RoadsSettings& settings, const plugin::PluginSet& plugins, const Dem& dem,

@@ -9,7 +9,9 @@
 #include "pipeline/stage_options.hpp"
 #include "plugin/plugin.hpp"
 #include "roads/cost_model.hpp"
+#include "io/raster_io.hpp"
 #include "roads/terrain_field.hpp"
+#include "roads/windowed_route.hpp"
 
 namespace terrapolis::pipeline {
 
@@ -29,6 +31,21 @@ InlandWater inland_water(const Dem& dem, const InlandWaterSettings& settings, Pr
 /// The roads' terrain: the DEM, the sea (below water.sea_level_m, and nodata) and the inland water.
 roads::TerrainField road_terrain(const Dem& dem, const Scenario& scenario, const roads::CostModel& model,
                                  const Raster<std::uint8_t>& water);
+
+/// The roads' terrain by windows of a mosaic (roads::route_by_windows, on a grid larger than memory):
+/// what road_terrain builds on the whole grid, from windows of `dem` and of `lakes` (the inland
+/// water's mosaic: 1 water). Holds references to both readers.
+struct RoadWindows {
+  roads::TerrainGrid grid;          ///< with the bathymetry rule counted over bands of the DEM's rows
+  roads::ReadTerrainWindow read;
+  roads::WindowOptions window;      ///< the windows' limit and margin
+  std::size_t max_nodes = 0;        ///< the search's nodes within the limit
+};
+/// `budget_mb`: what the windows and searches may take together (half each: windows at
+/// roads::kWindowBytesPerCell, nodes at 32 bytes), shared by `parallel` searches at once.
+/// `reach_m`: how far from the road its corridor reads (0 without corridors).
+RoadWindows road_windows(const DemWindowReader& dem, const DemWindowReader& lakes, const Georef& georef, const Scenario& scenario,
+                         const roads::CostModel& model, double reach_m, double budget_mb, std::size_t parallel);
 
 /// Adds the road layers to the roads' terrain: roads.vegetation read onto the DEM's grid (when
 /// given) and the plugins' road cost terms.

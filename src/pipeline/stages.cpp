@@ -2,6 +2,8 @@
 // SPDX-License-Identifier: MIT
 #include "pipeline/stages.hpp"
 
+#include <tbb/global_control.h>
+
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -25,6 +27,7 @@
 #include "roads/existing_roads.hpp"
 #include "roads/road_network.hpp"
 #include "roads/terrain_field.hpp"
+#include "roads/windowed_route.hpp"
 #include "sites/layers.hpp"
 
 namespace terrapolis::pipeline {
@@ -713,30 +716,61 @@ json existing_figures(const roads::ExistingRoads& e, const roads::NetworkResult&
           {"on_existing_km", round_to(on_km, 0.01)}};
 }
 
+/// The network's roads by windows of the DEM's mosaic (roads::route_network_by_windows): each link
+/// searched on a window of the DEM and of inland_water.vrt around it, within the memory limit
+/// shared by the links routed at once. `frame` receives the grid's frame the layers are drawn on.
+roads::NetworkResult roads_by_windows(RunState& s, const std::vector<roads::Link>& links, std::optional<roads::TerrainField>& frame,
+                                      Progress& progress, const Log& log) {
+  const RoadsSettings& settings = s.settings.roads;
+  s.by_tiles->reserve();
+  const TiledInput& in = *s.by_tiles;
+  const DemWindowReader dem(in.dem_path, in.read), lakes(saved(s, "inland_water.vrt"), ReadOptions{});
+  const std::size_t parallel = settings.routing.lookahead > 0
+                                   ? settings.routing.lookahead
+                                   : std::max<std::size_t>(1, tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+  const RoadWindows w = road_windows(dem, lakes, s.grid.georef, s.scenario, settings.model, 0, in.tiles.limit_mb() - in.reserved_mb, parallel);
+  log.detail("roads by windows: windows of at most " + std::to_string(w.window.max_cells) + " cells and " + std::to_string(w.max_nodes) +
+             " search nodes a road, " + std::to_string(parallel) + " roads at once");
+  frame.emplace(roads::TerrainField::frame(w.grid));
+  const roads::RoadGraph graph(*frame, settings.model, settings.routing.graph);
+  roads::RoutingOptions routing = settings.routing;
+  routing.max_nodes = std::min(routing.max_nodes, w.max_nodes);
+  return roads::route_network_by_windows(*frame, graph, links, routing, progress, {w.grid, w.read, w.window});
+}
+
 void roads_run(RunState& s, Progress& progress, const Log& log) {
   const RoadsSettings& settings = s.settings.roads;
-  roads::TerrainField terrain = road_terrain(s);
-  add_road_layers(terrain, settings, s.plugins, s.dem, progress, log);
-  const roads::RoadGraph graph(terrain, settings.model, settings.routing.graph);
   const std::vector<roads::Link> links = network::road_links(*s.network, &*s.cities);
-  const std::optional<roads::ExistingRoads> existing = existing_roads(s, terrain, log);
-  const roads::NetworkResult r = roads::route_network(terrain, graph, links, settings.routing, progress, existing ? &*existing : nullptr);
+  std::optional<roads::TerrainField> terrain;
+  std::optional<roads::ExistingRoads> existing;
+  roads::NetworkResult r;
+  if (s.by_tiles) {
+    r = roads_by_windows(s, links, terrain, progress, log);
+  } else {
+    terrain.emplace(road_terrain(s));
+    add_road_layers(*terrain, settings, s.plugins, s.dem, progress, log);
+    const roads::RoadGraph graph(*terrain, settings.model, settings.routing.graph);
+    existing = existing_roads(s, *terrain, log);
+    r = roads::route_network(*terrain, graph, links, settings.routing, progress, existing ? &*existing : nullptr);
+  }
   // Links routed ahead in parallel are routed again when the roads before them change what they saw.
   log.detail(std::to_string(links.size()) + " links, " + std::to_string(r.searches) + " searches");
   for (const auto& f : r.failed) log.warn("no road: " + f);
   for (const auto& f : r.over_budget) log.warn("not routed: budget (roads.max_seconds): " + f);
+  for (const auto& f : r.limited)
+    log.warn("roads by windows: " + f + " decided on the largest window the memory limit allows (not proved the whole grid's road)");
   if (!r.redundant.empty()) {  // the summary counts them; the list only when asked (-v)
     std::string list;
     for (const auto& f : r.redundant) list += (list.empty() ? "" : ", ") + f;
     log.detail(std::to_string(r.redundant.size()) + " redundant links dropped (roads.redundant_share): " + list);
   }
-  s.write("roads", "roads.geojson", roads::roads_layer(terrain, r.roads, &r.layout), Style::roads);
-  s.write("roads", "sections.geojson", roads::network_sections_layer(terrain, r.layout), Style::sections);
+  s.write("roads", "roads.geojson", roads::roads_layer(*terrain, r.roads, &r.layout), Style::roads);
+  s.write("roads", "sections.geojson", roads::network_sections_layer(*terrain, r.layout), Style::sections);
   // An empty point layer has no geometry type QGIS can style: no junctions, no file.
   if (!r.layout.junctions.empty())
-    s.write("roads", "junctions.geojson", roads::junctions_layer(terrain, r.layout), Style::junctions);
-  s.write("roads", "road_sections.geojson", roads::sections_layer(terrain, r.roads), Style::road_sections);
-  const json corridor = corridor_hook(s, terrain, r.roads, r.existing);
+    s.write("roads", "junctions.geojson", roads::junctions_layer(*terrain, r.layout), Style::junctions);
+  s.write("roads", "road_sections.geojson", roads::sections_layer(*terrain, r.roads), Style::road_sections);
+  const json corridor = s.by_tiles ? json(nullptr) : corridor_hook(s, *terrain, r.roads, r.existing);
   std::map<std::string, double> km;
   double bridge_m = 0, tunnel_m = 0, over_limit_m = 0, water_m = 0, network_km = 0;
   for (const auto& road : r.roads) {
@@ -758,6 +792,8 @@ void roads_run(RunState& s, Progress& progress, const Log& log) {
                         {"network_km_per_km2", land > 0 ? round_to(network_km / land, 0.001) : 0.0},
                         {"over_grade_limit_m", round_to(over_limit_m, 0.1)},
                         {"on_water_m", round_to(water_m, 0.1)}};
+  // By windows: links no window the limit allows proved the grid's (absent when none, as on the whole grid).
+  if (!r.limited.empty()) s.summary["roads"]["limited_by_memory"] = r.limited.size();
   if (existing) s.summary["roads"].update(existing_figures(*existing, r));
   s.summary["roads"].update(new_figures(r));
   if (!corridor.is_null()) s.summary["roads"]["corridor"] = corridor;
@@ -768,6 +804,13 @@ void roads_load(RunState&) {}  // the access stage reads the saved layers
 void roads_prepare(const Scenario& scenario, const RasterHeader& grid, Settings& s) {
   s.roads = roads_settings(scenario);
   s.corridor = corridor_settings(scenario);
+  if (tile_settings(scenario).given()) {  // by windows (roads_by_windows): what reads the whole grid is refused
+    const auto refuse = [](const std::string& what) { throw bad_input(what + ": not computed on tiles yet (input.tile_size, input.memory_limit_mb)"); };
+    if (!s.roads.existing.empty()) refuse("/roads/existing");
+    if (!s.roads.vegetation.empty()) refuse("/roads/vegetation");
+    if (s.corridor.enabled) refuse("/roads/corridor/enabled");
+    if (s.roads.routing.router != roads::Router::galin) refuse("/roads/router");
+  }
   check_file("/roads/corridor/side_angles", s.corridor.side_angles);
   check_file("/roads/vegetation", s.roads.vegetation);
   if (const std::string& lines = s.roads.existing; !lines.empty()) {
@@ -925,7 +968,7 @@ const std::vector<StageDef>& stages() {
       {"density", {"density", "plugins"}, density_prepare, density_run, density_load, density_summary, true},
       {"sites", {"sites", "seed"}, sites_prepare, sites_run, sites_load, sites_summary, true},
       {"network", {"network"}, network_prepare, network_run, network_load, network_summary, true},
-      {"roads", {"roads"}, roads_prepare, roads_run, roads_load, roads_summary},
+      {"roads", {"roads"}, roads_prepare, roads_run, roads_load, roads_summary, true},
       {"access", {"access"}, access_prepare, access_run, access_load, access_summary},
   };
   return list;

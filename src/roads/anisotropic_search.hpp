@@ -57,12 +57,13 @@ struct ArcDiscount {
   std::span<const float> factor;
   double floor = 1;
   /// Optional, for a caller routing roads ahead of the ones they depend on (route_network): the
-  /// search sets read_tiles[(row >> kReadTileShift) * read_tile_cols + (col >> kReadTileShift)] for
-  /// every cell whose arcs' factors it reads, so every factor it read lies within one arc's reach of
-  /// a marked tile. nullptr: nothing recorded.
+  /// search sets read_tiles[((row >> kReadTileShift) - read_tile_row0) * read_tile_cols + (col >> kReadTileShift) -
+  /// read_tile_col0] for every cell whose arcs' factors it reads, so every factor it read lies within
+  /// one arc's reach of a marked tile (the offsets: a window's first tile). nullptr: nothing recorded.
   static constexpr int kReadTileShift = 2;
   std::uint8_t* read_tiles = nullptr;
   std::size_t read_tile_cols = 0;
+  int read_tile_col0 = 0, read_tile_row0 = 0;
 };
 
 /// Shortest path from `from` to `to` (any final orientation). Nodes are stored per touched cell so

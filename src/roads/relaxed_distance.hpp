@@ -94,8 +94,8 @@ class LongArcCache {
 double reuse_factor(const RoadGraph& graph, const ArcDiscount* discount, Cell c, int a) {
   if (!discount) return 1.0;
   if (discount->read_tiles)
-    discount->read_tiles[std::size_t(c.row >> ArcDiscount::kReadTileShift) * discount->read_tile_cols +
-                         std::size_t(c.col >> ArcDiscount::kReadTileShift)] = 1;
+    discount->read_tiles[std::size_t((c.row >> ArcDiscount::kReadTileShift) - discount->read_tile_row0) * discount->read_tile_cols +
+                         std::size_t((c.col >> ArcDiscount::kReadTileShift) - discount->read_tile_col0)] = 1;
   const RoadGraph::Arc& arc = graph.arcs()[std::size_t(a)];
   const auto f = [&](int col, int row) { return discount->factor[graph.terrain().index(col, row)]; };
   return double(std::max({f(c.col, c.row), f(c.col + arc.dcol / 2, c.row + arc.drow / 2), f(c.col + arc.dcol, c.row + arc.drow)}));

@@ -9,9 +9,11 @@
 #include <cmath>
 #include <exception>
 #include <numbers>
+#include <unordered_map>
 
 #include "core/error.hpp"
 #include "core/random.hpp"
+#include "roads/windowed_route.hpp"
 
 namespace terrapolis::roads {
 
@@ -115,21 +117,52 @@ std::optional<Road> route_road(const TerrainField& t, const RoadGraph& graph, Ce
 
 namespace {
 
+/// Values per grid cell: a dense array when the terrain holds the whole grid, else a map of the
+/// cells set (roads by windows: the grid may be far larger than memory, the roads are not).
+template <class T>
+class CellValues {
+ public:
+  CellValues(std::size_t cells, T fill, bool dense) : fill_(fill), dense_(dense) {
+    if (dense) values_.assign(cells, fill);
+  }
+  T get(std::uint32_t cell) const {
+    if (dense_) return values_[cell];
+    const auto it = map_.find(cell);
+    return it == map_.end() ? fill_ : it->second;
+  }
+  void set(std::uint32_t cell, T v) { dense_ ? void(values_[cell] = v) : void(map_[cell] = v); }
+  const std::vector<T>& dense() const { return values_; }
+  const std::unordered_map<std::uint32_t, T>& sparse() const { return map_; }
+
+ private:
+  T fill_;
+  bool dense_;
+  std::vector<T> values_;
+  std::unordered_map<std::uint32_t, T> map_;
+};
+
 /// The roads built so far, as the next searches see them: per cell the most important class on it
 /// and the cost factor it gives (ArcDiscount), and which cells the network joins (union-find).
+/// Cells are the grid's indices (the terrain's; a frame's for roads by windows).
 class BuiltRoads {
  public:
   BuiltRoads(const TerrainField& t, const std::array<double, 4>& discount)
-      : t_(t), discount_(discount), factor_(t.size(), 1.0f), class_(t.size(), kNone), parent_(t.size()) {
-    for (std::size_t i = 0; i < parent_.size(); ++i) parent_[i] = std::uint32_t(i);
-    view_.factor = factor_;  // floor 1: no road yet
+      : t_(t), discount_(discount), factor_(t.size(), 1.0f, t.holds_values()), class_(t.size(), kNone, t.holds_values()),
+        parent_(t.size(), kRoot, t.holds_values()) {
+    view_.factor = factor_.dense();  // floor 1: no road yet
   }
   const ArcDiscount* discount() const { return view_.floor < 1 ? &view_ : nullptr; }
   double floor() const { return view_.floor; }
+  /// The factors over a window's cells (its indices) into `out`, for a search by windows.
+  void factors_over(const TerrainField& window, std::vector<float>& out) const {
+    out.assign(window.size(), 1.0f);
+    for (const auto& [cell, f] : factor_.sparse())
+      if (const int col = t_.col_of(cell), row = t_.row_of(cell); window.inside(col, row)) out[window.index(col, row)] = f;
+  }
   /// The cells whose factor changed, in the order the roads were added (a search routed when the
   /// log held n cells saw every change before n).
   const std::vector<std::uint32_t>& changes() const { return changes_; }
-  bool on_road(std::uint32_t cell) const { return class_[cell] != kNone; }
+  bool on_road(std::uint32_t cell) const { return class_.get(cell) != kNone; }
   bool joined(std::uint32_t a, std::uint32_t b) { return find(a) == find(b); }
   /// Share of the chain's length (m) on cells already carrying a road at both ends of a step, or
   /// on the given roads (on_existing).
@@ -153,18 +186,19 @@ class BuiltRoads {
       unite(chain.cells[i], chain.cells[i + 1]);
       if (chain.structures[i] != Structure::road || c == RoadClass::maritime) continue;
       for (std::uint32_t cell : {chain.cells[i], chain.cells[i + 1]}) {
-        if (class_[cell] <= std::uint8_t(c)) continue;
-        class_[cell] = std::uint8_t(c);
+        if (class_.get(cell) <= std::uint8_t(c)) continue;
+        class_.set(cell, std::uint8_t(c));
         const float f = float(1.0 - discount_[std::size_t(c)]);
-        if (f != factor_[cell]) changes_.push_back(cell);
-        factor_[cell] = f;
-        view_.floor = std::min(view_.floor, double(factor_[cell]));  // the smallest factor on the grid
+        if (f != factor_.get(cell)) changes_.push_back(cell);
+        factor_.set(cell, f);
+        view_.floor = std::min(view_.floor, double(f));  // the smallest factor on the grid
       }
     }
   }
 
  private:
   static constexpr std::uint8_t kNone = 0xff;
+  static constexpr std::uint32_t kRoot = 0xffffffffu;  ///< a cell that is its own parent
   template <class On>
   double share_on(const CellChain& chain, On on) const {
     double shared = 0, total = 0;
@@ -176,19 +210,27 @@ class BuiltRoads {
     return total > 0 ? shared / total : 0;
   }
   GridPoint point(std::uint32_t cell) const { return {double(t_.col_of(cell)), double(t_.row_of(cell))}; }
+  std::uint32_t parent(std::uint32_t x) const {
+    const std::uint32_t p = parent_.get(x);
+    return p == kRoot ? x : p;
+  }
   std::uint32_t find(std::uint32_t x) {
-    while (parent_[x] != x) x = parent_[x] = parent_[parent_[x]];
+    while (parent(x) != x) {
+      const std::uint32_t up = parent(parent(x));
+      parent_.set(x, up);
+      x = up;
+    }
     return x;
   }
   void unite(std::uint32_t a, std::uint32_t b) {
     a = find(a), b = find(b);
-    if (a != b) parent_[std::max(a, b)] = std::min(a, b);
+    if (a != b) parent_.set(std::max(a, b), std::min(a, b));
   }
   const TerrainField& t_;
   std::array<double, 4> discount_;
-  std::vector<float> factor_;
-  std::vector<std::uint8_t> class_;
-  std::vector<std::uint32_t> parent_;
+  CellValues<float> factor_;
+  CellValues<std::uint8_t> class_;
+  CellValues<std::uint32_t> parent_;
   std::vector<std::uint32_t> changes_;
   std::vector<std::uint8_t> existing_;  ///< cells of the given roads (empty: none)
   ArcDiscount view_;
@@ -213,7 +255,12 @@ struct Attempt {
   std::exception_ptr error;  ///< rethrown only if the attempt is the one kept
   std::size_t version = 0;
   double floor = 1;
-  std::vector<std::uint8_t> tiles;
+  std::vector<std::uint8_t> tiles;  ///< over tiles [tile_col0, + tile_cols) x [tile_row0, ...) (a window's, by windows)
+  int tile_col0 = 0, tile_row0 = 0;
+  std::size_t tile_cols = 0;
+  std::vector<float> factor;  ///< by windows: the roads' factors over the last window searched
+  ArcDiscount seen;           ///< by windows: the discount that window's search read
+  bool limited = false;       ///< by windows: decided on the largest window the limit allows
 };
 
 /// The links routed in importance order, each on the roads of every link before it (the
@@ -224,8 +271,8 @@ struct Attempt {
 class NetworkRouter {
  public:
   NetworkRouter(const TerrainField& t, const RoadGraph& base, const std::vector<Link>& links, const RoutingOptions& options,
-                Progress& progress, const ExistingRoads* existing)
-      : t_(t), base_(base), links_(links), options_(options), built_(t, options.reuse_discount),
+                Progress& progress, const ExistingRoads* existing, const NetworkWindows* windows)
+      : t_(t), base_(base), links_(links), options_(options), windows_(windows), built_(t, options.reuse_discount),
         tile_cols_((std::size_t(t.cols()) >> kShift) + 1), tile_rows_((std::size_t(t.rows()) >> kShift) + 1) {
     // One graph per road class, under the class's design standards, built before routing (the
     // searches share them read-only).
@@ -254,6 +301,7 @@ class NetworkRouter {
     });
     out_.resize(edges_.size());
     redundant_.assign(edges_.size(), false);
+    limited_.assign(edges_.size(), false);
     for (std::size_t a = 0; a < base.surface_arcs(); ++a)
       reach_ = std::max({reach_, std::abs(base.arcs()[a].dcol), std::abs(base.arcs()[a].drow)});
     attempts_.resize(order_.size());
@@ -277,6 +325,7 @@ class NetworkRouter {
     step_->update(1.0);
     for (std::size_t i = 0; i < edges_.size(); ++i) {
       const std::string name = std::to_string(links_[i].from) + "-" + std::to_string(links_[i].to);
+      if (limited_[i]) result.limited.push_back(name);
       if (!out_[i]) {
         if (!(edges_[i].a == edges_[i].b)) result.failed.push_back(name);
       } else if (out_[i]->over_budget) {
@@ -328,13 +377,16 @@ class NetworkRouter {
     if (at.floor != built_.floor()) return false;
     const auto& changes = built_.changes();
     if (at.tiles.empty()) return at.version == changes.size();  // routed without reuse
+    const int tile_rows = int(at.tiles.size() / at.tile_cols);
     for (std::size_t j = at.version; j < changes.size(); ++j) {
-      const int col = int(changes[j] % std::uint32_t(t_.cols())), row = int(changes[j] / std::uint32_t(t_.cols()));
-      const int c0 = std::max(0, col - reach_) >> kShift, c1 = std::min(t_.cols() - 1, col + reach_) >> kShift;
-      const int r0 = std::max(0, row - reach_) >> kShift, r1 = std::min(t_.rows() - 1, row + reach_) >> kShift;
+      const int col = t_.col_of(changes[j]), row = t_.row_of(changes[j]);
+      const int c0 = std::max(at.tile_col0, std::max(0, col - reach_) >> kShift);
+      const int c1 = std::min(at.tile_col0 + int(at.tile_cols) - 1, std::min(t_.cols() - 1, col + reach_) >> kShift);
+      const int r0 = std::max(at.tile_row0, std::max(0, row - reach_) >> kShift);
+      const int r1 = std::min(at.tile_row0 + tile_rows - 1, std::min(t_.rows() - 1, row + reach_) >> kShift);
       for (int r = r0; r <= r1; ++r)
         for (int c = c0; c <= c1; ++c)
-          if (at.tiles[std::size_t(r) * tile_cols_ + std::size_t(c)]) return false;
+          if (at.tiles[std::size_t(r - at.tile_row0) * at.tile_cols + std::size_t(c - at.tile_col0)]) return false;
     }
     return true;
   }
@@ -347,20 +399,44 @@ class NetworkRouter {
     at.floor = built_.floor();
     const std::size_t i = order_[k];
     if (edges_[i].a == edges_[i].b) return;
-    std::optional<ArcDiscount> seen;
-    if (const ArcDiscount* d = built_.discount()) {
-      at.tiles.assign(tile_cols_ * tile_rows_, 0);
-      seen = *d;
-      seen->read_tiles = at.tiles.data();
-      seen->read_tile_cols = tile_cols_;
-    }
     RoutingOptions o = options_;
     o.bezier.seed = splitmix64(options_.bezier.seed ^ splitmix64(i));
     try {
+      if (windows_) return route_by_windows(at, i, o);
+      std::optional<ArcDiscount> seen;
+      if (const ArcDiscount* d = built_.discount()) {
+        at.tiles.assign(tile_cols_ * tile_rows_, 0);
+        at.tile_cols = tile_cols_;
+        seen = *d;
+        seen->read_tiles = at.tiles.data();
+        seen->read_tile_cols = tile_cols_;
+      }
       at.road = route_road(t_, graph_of(links_[i].road_class), edges_[i].a, edges_[i].b, o, nullptr, nullptr, seen ? &*seen : nullptr);
     } catch (...) {
       at.error = std::current_exception();
     }
+  }
+
+  /// Link i by windows (roads::route_by_windows): the roads built so far over each window, the
+  /// tiles its last search read; the road's cells turned into the grid's indices.
+  void route_by_windows(Attempt& at, std::size_t i, const RoutingOptions& o) {
+    const WindowDiscount discount = [&](const TerrainField& w) -> const ArcDiscount* {
+      const ArcDiscount* d = built_.discount();
+      if (!d) return nullptr;
+      built_.factors_over(w, at.factor);
+      at.tile_col0 = w.col0() >> kShift, at.tile_row0 = w.row0() >> kShift;
+      at.tile_cols = std::size_t(((w.col0() + w.cols() - 1) >> kShift) - at.tile_col0 + 1);
+      at.tiles.assign(at.tile_cols * std::size_t(((w.row0() + w.rows() - 1) >> kShift) - at.tile_row0 + 1), 0);
+      at.seen = ArcDiscount{at.factor, d->floor, at.tiles.data(), at.tile_cols, at.tile_col0, at.tile_row0};
+      return &at.seen;
+    };
+    const RoadGraph& g = graph_of(links_[i].road_class);
+    WindowedRoad w = roads::route_by_windows(windows_->grid, windows_->read, g.model(), g.options(), edges_[i].a, edges_[i].b, o,
+                                             windows_->window, nullptr, discount);
+    if (w.road)
+      for (std::uint32_t& cell : w.road->chain.cells) cell = std::uint32_t(t_.index(w.terrain->col_of(cell), w.terrain->row_of(cell)));
+    at.road = std::move(w.road);
+    at.limited = w.limited;
   }
 
   void commit(std::size_t k) {
@@ -369,6 +445,7 @@ class NetworkRouter {
     const std::size_t i = order_[k];
     std::optional<Road>& r = out_[i];
     r = std::move(at.road);
+    limited_[i] = at.limited;
     at = Attempt{};
     step_->update(double(k + 1) / double(edges_.size()), std::to_string(k + 1) + " of " + std::to_string(edges_.size()) + " roads");
     if (!r) return;
@@ -387,12 +464,13 @@ class NetworkRouter {
   const RoadGraph& base_;
   const std::vector<Link>& links_;
   const RoutingOptions& options_;
+  const NetworkWindows* windows_;  ///< by windows (route_network_by_windows), or nullptr
   std::array<std::optional<RoadGraph>, 4> graphs_;
   std::vector<Edge> edges_;
   std::vector<std::size_t> order_;
   BuiltRoads built_;
   std::vector<std::optional<Road>> out_;
-  std::vector<bool> redundant_;
+  std::vector<bool> redundant_, limited_;
   std::optional<ProgressStep> step_;  // begun once the links are checked
   const std::size_t tile_cols_, tile_rows_;
   int reach_ = 0;  // cells a surface arc's factors lie from the cell the search marks
@@ -403,7 +481,16 @@ class NetworkRouter {
 
 NetworkResult route_network(const TerrainField& t, const RoadGraph& base, const std::vector<Link>& links, const RoutingOptions& options,
                             Progress& progress, const ExistingRoads* existing) {
-  NetworkRouter router(t, base, links, options, progress, existing);
+  NetworkRouter router(t, base, links, options, progress, existing, nullptr);
+  return router.run();
+}
+
+NetworkResult route_network_by_windows(const TerrainField& frame, const RoadGraph& base, const std::vector<Link>& links,
+                                       const RoutingOptions& options, Progress& progress, const NetworkWindows& windows) {
+  if (frame.holds_values()) throw processing_error("roads by windows: a frame (TerrainField::frame) is expected");
+  if (double(frame.grid_cols()) * double(frame.grid_rows()) >= 4294967295.0)
+    throw bad_input("roads by windows: grids of 2^32 cells or more are not supported");
+  NetworkRouter router(frame, base, links, options, progress, nullptr, &windows);
   return router.run();
 }
 

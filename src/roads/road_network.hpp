@@ -99,6 +99,9 @@ struct NetworkResult {
   std::vector<std::string> failed;
   std::vector<std::string> over_budget;  ///< links not routed within roads.max_seconds ("from-to")
   std::vector<std::string> redundant;    ///< links dropped: their route ran on earlier roads ("from-to")
+  /// By windows (route_network_by_windows): links no window the memory limit allows proved, kept as
+  /// the largest window's answer ("from-to"; WindowedRoad::limited).
+  std::vector<std::string> limited;
   RoadNetworkLayout layout;              ///< the roads' shared sections and junctions
   std::vector<std::uint8_t> existing;    ///< per cell 1 on a given road (empty without roads.existing)
   std::size_t searches = 0;              ///< links routed, attempts routed again included (depends on the threads)

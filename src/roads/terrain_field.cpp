@@ -40,6 +40,26 @@ TerrainField::TerrainField(const Dem& window, int col0, int row0, const TerrainG
   build(window, unknown_depth_m, road_radius_m, inland_water);
 }
 
+TerrainField TerrainField::frame(const TerrainGrid& grid) {
+  TerrainField t;
+  t.cols_ = t.col_end_ = t.grid_cols_ = grid.cols;
+  t.rows_ = t.row_end_ = t.grid_rows_ = grid.rows;
+  t.georef_ = grid.georef;
+  t.metrics_ = cell_metrics(grid.georef, grid.cols, grid.rows);
+  t.bathymetry_ = grid.bathymetry;
+  t.frame_ = true;
+  t.set_cell_sizes();
+  return t;
+}
+
+void TerrainField::set_cell_sizes() {
+  // The grid's cell sizes, whatever part of it is held, so that a window prices as the grid does.
+  double lo = 1e300;
+  for (int r = 0; r < grid_rows_; ++r) lo = std::min({lo, metrics_.width_m[r], metrics_.height_m[r]});
+  min_cell_m_ = lo;
+  typical_cell_m_ = 0.5 * (metrics_.width_m[grid_rows_ / 2] + metrics_.height_m[grid_rows_ / 2]);
+}
+
 void TerrainField::build(const Dem& dem, double unknown_depth_m, double road_radius_m, const Raster<std::uint8_t>* inland_water) {
   const double sea_level_m = sea_level_;
   const std::size_t n = dem.size();
@@ -67,11 +87,7 @@ void TerrainField::build(const Dem& dem, double unknown_depth_m, double road_rad
       ground_[i] = dem[i];
     }
   }
-  // The grid's cell sizes, whatever part of it is held, so that a window prices as the grid does.
-  double lo = 1e300;
-  for (int r = 0; r < grid_rows_; ++r) lo = std::min({lo, metrics_.width_m[r], metrics_.height_m[r]});
-  min_cell_m_ = lo;
-  typical_cell_m_ = 0.5 * (metrics_.width_m[grid_rows_ / 2] + metrics_.height_m[grid_rows_ / 2]);
+  set_cell_sizes();
   // Water within the road's radius (Peytavie §4.2.1: maximum depth over the disc Omega(p, r)).
   const int rad = int(std::floor(road_radius_m / min_cell_m_));
   if (rad <= 0) {

@@ -60,6 +60,12 @@ class TerrainField {
   TerrainField(const Dem& window, int col0, int row0, const TerrainGrid& grid, double sea_level_m, double unknown_depth_m,
                double road_radius_m, const Raster<std::uint8_t>* inland_water = nullptr);
 
+  /// The grid's frame alone: its cells, positions and metrics, no values (surface, water... are not
+  /// held: asking for them is an error). For what is drawn from roads found by windows (layers,
+  /// sections, the cells roads share), in the grid's own cell indices.
+  static TerrainField frame(const TerrainGrid& grid);
+  bool holds_values() const { return !frame_; }
+
   /// The cells held: the window's size (the grid's for a whole grid) and its first cell.
   int cols() const { return cols_; }
   int rows() const { return rows_; }
@@ -133,7 +139,10 @@ class TerrainField {
   const CellMetrics& metrics() const { return metrics_; }
 
  private:
+  TerrainField() = default;
   void build(const Dem& dem, double unknown_depth_m, double road_radius_m, const Raster<std::uint8_t>* inland_water);
+  void set_cell_sizes();
+  bool frame_ = false;
   int cols_ = 0, rows_ = 0, col0_ = 0, row0_ = 0, col_end_ = 0, row_end_ = 0, grid_cols_ = 0, grid_rows_ = 0;
   std::size_t origin_ = 0;  ///< index(col0, row0) before the window's offset: row0 * cols + col0
   Georef georef_;

@@ -68,7 +68,8 @@ int window_margin_cells(double road_radius_m, double reach_m, double min_cell_m)
 }
 
 WindowedRoad route_by_windows(const TerrainGrid& grid, const ReadTerrainWindow& read, const CostModel& model, const GraphOptions& graph,
-                              Cell from, Cell to, const RoutingOptions& options, const WindowOptions& window, Progress* progress) {
+                              Cell from, Cell to, const RoutingOptions& options, const WindowOptions& window, Progress* progress,
+                              const WindowDiscount& discount) {
   if (options.router != Router::galin) throw bad_input("roads by windows: the Bézier router reads the whole grid; use the Galin router");
   const Box whole{0, 0, grid.cols - 1, grid.rows - 1};
   if (!whole.holds(from.col, from.row) || !whole.holds(to.col, to.row)) throw bad_input("path: an end point lies outside the DEM");
@@ -77,6 +78,8 @@ WindowedRoad route_by_windows(const TerrainGrid& grid, const ReadTerrainWindow& 
                        .grown(std::max(window.pad_cells, options.snap_cells), grid);
   const Box guess = ellipse_box(from, to, window.first_ratio * std::hypot((to.col - from.col) * scale.w, (to.row - from.row) * scale.h), grid, scale);
   Box area{std::min(ends.c0, guess.c0), std::min(ends.r0, guess.r0), std::max(ends.c1, guess.c1), std::max(ends.r1, guess.r1)};
+  const auto too_large = [&](const Box& b) { return window.max_cells > 0 && b.grown(window.margin_cells, grid).cells() > window.max_cells; };
+  if (too_large(area)) area = ends;
   WindowedRoad out;
   for (;;) {
     std::optional<Box> needed;
@@ -87,21 +90,33 @@ WindowedRoad route_by_windows(const TerrainGrid& grid, const ReadTerrainWindow& 
                        std::to_string(read_box.c1 - read_box.c0 + 1) + " x " + std::to_string(read_box.r1 - read_box.r0 + 1) +
                        " cells; the memory limit allows windows of " + std::to_string(window.max_cells) + " cells");
     };
-    if (window.max_cells > 0 && read_box.cells() > window.max_cells) throw refuse("cannot be searched");
-    out.terrain.reset();
-    out.terrain.emplace(read(read_box.c0, read_box.r0, read_box.c1 - read_box.c0 + 1, read_box.r1 - read_box.r0 + 1));
+    if (too_large(area)) throw refuse("cannot be searched");
+    // The previous window's answer stands until this one's search ends: past the nodes the limit
+    // allows (processing_error), the previous is the largest window's answer.
+    std::optional<Road> road;
+    double per_metre = 0;  // the bound's cost per metre: the cheapest, times the reuse floor
+    auto terrain = std::make_unique<TerrainField>(read(read_box.c0, read_box.r0, read_box.c1 - read_box.c0 + 1, read_box.r1 - read_box.r0 + 1));
+    try {
+      const RoadGraph g(*terrain, model, graph);
+      const ArcDiscount* reuse = discount ? discount(*terrain) : nullptr;
+      per_metre = 0.995 * g.model().cheapest_per_metre() * (reuse ? reuse->floor : 1.0);
+      road = route_road(*terrain, g, from, to, options, progress, nullptr, reuse);
+    } catch (const Error& e) {
+      if (e.kind() != ErrorKind::processing || out.windows == 0) throw;
+      out.limited = true;
+      return out;
+    }
     ++out.windows;
     out.largest_cells = std::max(out.largest_cells, read_box.cells());
+    out.road = std::move(road);
+    out.terrain = std::move(terrain);
     const TerrainField& t = *out.terrain;
-    const RoadGraph g(t, model, graph);
-    out.road = route_road(t, g, from, to, options, progress);
     if (is_whole || (out.road && out.road->over_budget)) return out;
     if (out.road && !out.road->ferry && out.road->cost) {
       const std::vector<std::uint32_t>& cells = out.road->chain.cells;
       bool inside = true;
       for (std::uint32_t i : cells) inside = inside && area.holds(t.col_of(i), t.row_of(i));
       const Cell a{t.col_of(cells.front()), t.row_of(cells.front())}, b{t.col_of(cells.back()), t.row_of(cells.back())};
-      const double per_metre = 0.995 * g.model().cheapest_per_metre();
       if (inside && *out.road->cost < per_metre * detour_m(a, b, area, grid, scale)) {
         out.proved = true;
         return out;
@@ -110,13 +125,15 @@ WindowedRoad route_by_windows(const TerrainGrid& grid, const ReadTerrainWindow& 
       if (per_metre > 0) needed = ellipse_box(a, b, *out.road->cost / per_metre, grid, scale);
     }
     // At least double the area (the next road may leave it again), and hold what the bound needs,
-    // or grow as far as the limit allows.
+    // or grow as far as the limit allows; past it, the largest window's answer stands (limited).
     int by = std::max(area.c1 - area.c0, area.r1 - area.r0) / 2 + 1;
     Box next = area.grown(by, grid);
     if (needed) next = {std::min(next.c0, needed->c0), std::min(next.r0, needed->r0), std::max(next.c1, needed->c1), std::max(next.r1, needed->r1)};
-    while (window.max_cells > 0 && next.grown(window.margin_cells, grid).cells() > window.max_cells && by > 1) next = area.grown(by /= 2, grid);
-    if (window.max_cells > 0 && next.grown(window.margin_cells, grid).cells() > window.max_cells)
-      throw refuse(out.road && !out.road->ferry ? "was not proved the grid's shortest" : "was not found");
+    while (too_large(next) && by > 1) next = area.grown(by /= 2, grid);
+    if (too_large(next)) {
+      out.limited = true;
+      return out;
+    }
     area = next;
   }
 }

@@ -4,6 +4,7 @@
 #pragma once
 #include <cstddef>
 #include <functional>
+#include <memory>
 #include <optional>
 
 #include "core/progress.hpp"
@@ -42,10 +43,13 @@ int window_margin_cells(double road_radius_m, double reach_m, double min_cell_m)
 
 struct WindowedRoad {
   std::optional<Road> road;             ///< as route_road returns it, in the grid's cells
-  std::optional<TerrainField> terrain;  ///< the last window: its cells, positions and metrics are the grid's
+  std::unique_ptr<TerrainField> terrain;  ///< the last window: its cells, positions and metrics are the grid's
   int windows = 0;                      ///< windows searched
   std::size_t largest_cells = 0;        ///< cells of the largest window read
-  bool proved = false;                  ///< the bound proved the road the grid's (false: the window was the grid)
+  bool proved = false;                  ///< the bound proved the road the grid's (false: the window was the grid, or limited)
+  /// No window the limit allows proved the road (or found one): `road` is the largest window's
+  /// answer, the best road within it, a ferry between its land masses, or none.
+  bool limited = false;
 };
 
 /// Routes a road between two cells of `grid` by windows (route_road on each). A window is accepted
@@ -53,10 +57,31 @@ struct WindowedRoad {
 /// road that leaves I could: cheapest cost per metre x 0.995 x the shortest length from one end to
 /// the other through a cell outside I (the straight-line bound of RoadGraph::lower_bound, at the
 /// grid's smallest cell). Then the road's cost is the whole grid's optimum; its cells are the
-/// whole grid's road too unless two roads cost exactly the same. Else the area doubles. A road
-/// that is not found, a ferry (the window's land masses) or a road past max_cells throws
-/// bad_input naming the window's size. The Bézier router is not searched by windows (bad_input).
+/// whole grid's road too unless two roads cost exactly the same. Else the area grows (at least
+/// doubles) up to what max_cells allows; a road still not proved, not found, or a ferry (the
+/// window's land masses) is then the largest window's answer (WindowedRoad::limited). A first
+/// window (the ends and pad_cells) past max_cells throws bad_input naming it. The Bézier router is
+/// not searched by windows (bad_input).
+/// Road reuse (route_network by windows): the roads built so far over a window's cells (ArcDiscount
+/// on the window's indices), or nullptr for none; called for each window searched. The bound is
+/// then scaled by the discount's floor, as the search's heuristic is.
+using WindowDiscount = std::function<const ArcDiscount*(const TerrainField& window)>;
 WindowedRoad route_by_windows(const TerrainGrid& grid, const ReadTerrainWindow& read, const CostModel& model, const GraphOptions& graph,
-                              Cell from, Cell to, const RoutingOptions& options, const WindowOptions& window, Progress* progress = nullptr);
+                              Cell from, Cell to, const RoutingOptions& options, const WindowOptions& window, Progress* progress = nullptr,
+                              const WindowDiscount& discount = {});
+
+/// The network by windows: route_network with each link routed by route_by_windows on `read`'s
+/// windows (the grid and the windows' limit in `window`), on the roads built before it.
+struct NetworkWindows {
+  TerrainGrid grid;
+  ReadTerrainWindow read;
+  WindowOptions window;
+};
+/// route_network by windows: `frame` is TerrainField::frame(windows.grid) (the roads' cells are its
+/// indices, the layers are drawn on it), `base` a graph on it (its model and options; the searches
+/// build theirs on each window). The same roads as route_network on the whole grid. Given roads
+/// (roads.existing) are not taken.
+NetworkResult route_network_by_windows(const TerrainField& frame, const RoadGraph& base, const std::vector<Link>& links,
+                                       const RoutingOptions& options, Progress& progress, const NetworkWindows& windows);
 
 }  // namespace terrapolis::roads
