@@ -148,3 +148,83 @@ TEST(RoadByWindows, ARoadLargerThanTheLimitIsRefusedNamingIt) {
   }
   EXPECT_LE(largest, options.max_cells);  // nothing past the limit was read
 }
+
+namespace {
+/// The layers of a network's roads, as text, for a comparison byte for byte.
+std::string layers_text(const TerrainField& t, const NetworkResult& r) {
+  std::string s;
+  for (const VectorLayer& l : {roads_layer(t, r.roads, &r.layout), sections_layer(t, r.roads), network_sections_layer(t, r.layout),
+                               junctions_layer(t, r.layout)})
+    for (const auto& f : l.features) {
+      char buf[64];
+      for (const auto& p : f.parts[0]) s += (std::snprintf(buf, sizeof buf, "%.17g %.17g;", p[0], p[1]), buf);
+      for (const auto& v : f.values) {
+        if (const auto* i = std::get_if<std::int64_t>(&v)) s += std::to_string(*i);
+        if (const auto* d = std::get_if<double>(&v)) s += (std::snprintf(buf, sizeof buf, "%.17g", *d), buf);
+        if (const auto* x = std::get_if<std::string>(&v)) s += *x;
+        s += "|";
+      }
+      s += "\n";
+    }
+  for (const auto& list : {r.failed, r.redundant, r.limited})
+    for (const std::string& name : list) s += name + ";";
+  return s;
+}
+}  // namespace
+
+TEST(RoadByWindows, ANetworkByWindowsIsTheWholeGridsNetwork) {
+  // Links routed by importance, each reusing the roads before it, two at once ahead: by windows
+  // (the roads built so far kept per road cell, each window's factors copied from them) the layers
+  // are the whole grid's, byte for byte; under a limit no window read exceeds it (a counter).
+  std::mt19937_64 rng(11);
+  int limited_runs = 0;
+  for (int trial = 0; trial < 6; ++trial) {
+    const int cols = 220, rows = 170;
+    const Dem dem = landscape(rng, cols, rows, trial % 2 ? test::geographic(45.0, 1.0 / 1200) : test::projected(10.0), trial % 3 == 0);
+    CostModel model = default_cost_model();
+    model.bridge.max_length_cells = model.tunnel.max_length_cells = 6;
+    model.bridge.samples = model.tunnel.samples = 12;
+    const TerrainField whole(dem, 0.0, 10.0, model.road_radius_m);
+    const RoadGraph whole_graph(whole, model, GraphOptions{});
+    std::vector<Link> links;
+    for (int k = 0; k < 7; ++k) {
+      const Cell a{int(rng() % cols), int(rng() % rows)}, b{int(rng() % cols), int(rng() % rows)};
+      links.push_back({k, k + 1, dem.georef().cell_centre(a.col, a.row), dem.georef().cell_centre(b.col, b.row),
+                       k < 2 ? RoadClass::national : RoadClass::departmental});
+    }
+    RoutingOptions options;
+    options.lookahead = 2;
+    SilentProgress silent;
+    const NetworkResult expected = route_network(whole, whole_graph, links, options, silent);
+    const TerrainGrid grid{dem.georef(), cols, rows, whole.has_bathymetry()};
+    const TerrainField frame = TerrainField::frame(grid);
+    const RoadGraph frame_graph(frame, model, GraphOptions{});
+    std::size_t largest = 0;
+    const ReadTerrainWindow read = [&](int c0, int r0, int w, int h) {
+      largest = std::max(largest, std::size_t(w) * std::size_t(h));
+      return TerrainField(window_of(dem, c0, r0, w, h), c0, r0, grid, 0.0, 10.0, model.road_radius_m);
+    };
+    WindowOptions window;
+    window.margin_cells = window_margin_cells(model.road_radius_m, 0, whole.min_cell_m());
+    const NetworkResult got = route_network_by_windows(frame, frame_graph, links, options, silent, {grid, read, window});
+    EXPECT_TRUE(got.limited.empty()) << trial;
+    EXPECT_EQ(layers_text(whole, expected), layers_text(frame, got)) << trial;
+    // Under a limit of a fifth of the grid: no window past it; what was not proved is listed, a
+    // link whose first window is past the limit refused.
+    largest = 0;
+    window.max_cells = std::size_t(cols) * std::size_t(rows) / 5;
+    try {
+      const NetworkResult bounded = route_network_by_windows(frame, frame_graph, links, options, silent, {grid, read, window});
+      limited_runs += !bounded.limited.empty();
+      if (bounded.limited.empty()) {
+        EXPECT_EQ(layers_text(whole, expected), layers_text(frame, bounded)) << trial;
+      }
+    } catch (const Error& e) {
+      EXPECT_EQ(e.kind(), ErrorKind::bad_input) << e.what();
+      EXPECT_NE(std::string(e.what()).find("the memory limit allows windows of"), std::string::npos) << e.what();
+      ++limited_runs;
+    }
+    EXPECT_LE(largest, window.max_cells) << trial;
+  }
+  EXPECT_GE(limited_runs, 1);  // the limit bit somewhere: the counter was tested at its bound
+}
