@@ -78,6 +78,8 @@ class PathCommand final : public Command {
       const ScratchFolder scratch((std::filesystem::path(out).parent_path() / ".inland_water").string());
       t0 = std::chrono::steady_clock::now();
       roads::WindowedRoad w = route_by_windows(routing, model, corridor_options, tiles, scratch.path(), context);
+      if (w.limited && !w.road)
+        throw processing_error("path: no road found within the windows --memory-limit allows (raise it, or route on the whole DEM)");
       terrain = std::move(w.terrain);
       road = std::move(w.road);
     } else {

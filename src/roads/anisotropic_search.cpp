@@ -90,15 +90,16 @@ struct Frontier {
 }  // namespace
 
 struct TargetSearch::State {
-  State(const RoadGraph& graph, Cell target)
-      : target(target), arcs(graph), long_arcs(graph.terrain().size(), graph.rings().size(), std::size_t(1) << 25) {}  // at most 128 MB
+  State(const RoadGraph& graph, Cell target, std::size_t long_arc_floats)
+      : target(target), arcs(graph), long_arcs(graph.terrain().size(), graph.rings().size(), long_arc_floats) {}
   Cell target;
   ArcCache arcs;            ///< surface arc costs: a function of the graph alone
   LongArcCache long_arcs;   ///< long arc costs, likewise
   std::optional<RelaxedDistance> relaxed;  ///< the relaxed reverse search from the target, resumed by each road
 };
 
-TargetSearch::TargetSearch(const RoadGraph& graph, Cell target) : state_(std::make_unique<State>(graph, target)) {}
+TargetSearch::TargetSearch(const RoadGraph& graph, Cell target, std::size_t max_nodes)
+    : state_(std::make_unique<State>(graph, target, std::min(kLongArcFloats, 4 * max_nodes))) {}
 TargetSearch::~TargetSearch() = default;
 
 namespace {
@@ -385,7 +386,7 @@ SearchResult shortest_path(const RoadGraph& graph, Cell from, Cell to, SearchMet
   }
   if (shared && !(shared->state().target == to)) throw processing_error("path: a shared target search used for another target");
   std::optional<TargetSearch> own;
-  TargetSearch::State& state = (shared ? *shared : own.emplace(graph, to)).state();
+  TargetSearch::State& state = (shared ? *shared : own.emplace(graph, to, max_nodes)).state();
   return PathSearch(graph, from, to, method, max_nodes, progress, max_seconds, state, shared != nullptr, discount).run();
 }
 

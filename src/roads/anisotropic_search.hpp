@@ -37,7 +37,10 @@ struct SearchResult {
 /// thread at a time, created and destroyed on the same thread.
 class TargetSearch {
  public:
-  TargetSearch(const RoadGraph& graph, Cell target);
+  /// The long arcs' cost cache holds at most min(kLongArcFloats, 4 x max_nodes) floats (past it the
+  /// costs are recomputed: the same results), so a search's memory follows its node budget.
+  TargetSearch(const RoadGraph& graph, Cell target, std::size_t max_nodes = kLongArcFloats);
+  static constexpr std::size_t kLongArcFloats = std::size_t(1) << 25;  ///< 128 MB
   ~TargetSearch();
   TargetSearch(const TargetSearch&) = delete;
   TargetSearch& operator=(const TargetSearch&) = delete;

@@ -92,7 +92,7 @@ WindowedRoad route_by_windows(const TerrainGrid& grid, const ReadTerrainWindow& 
     };
     if (too_large(area)) throw refuse("cannot be searched");
     // The previous window's answer stands until this one's search ends: past the nodes the limit
-    // allows (processing_error), the previous is the largest window's answer.
+    // allows (processing_error), the previous is the largest window's answer (none on the first).
     std::optional<Road> road;
     double per_metre = 0;  // the bound's cost per metre: the cheapest, times the reuse floor
     auto terrain = std::make_unique<TerrainField>(read(read_box.c0, read_box.r0, read_box.c1 - read_box.c0 + 1, read_box.r1 - read_box.r0 + 1));
@@ -102,8 +102,8 @@ WindowedRoad route_by_windows(const TerrainGrid& grid, const ReadTerrainWindow& 
       per_metre = 0.995 * g.model().cheapest_per_metre() * (reuse ? reuse->floor : 1.0);
       road = route_road(*terrain, g, from, to, options, progress, nullptr, reuse);
     } catch (const Error& e) {
-      if (e.kind() != ErrorKind::processing || out.windows == 0) throw;
-      out.limited = true;
+      if (e.kind() != ErrorKind::processing) throw;
+      out.limited = true;  // the previous window's answer, or none
       return out;
     }
     ++out.windows;
@@ -112,7 +112,7 @@ WindowedRoad route_by_windows(const TerrainGrid& grid, const ReadTerrainWindow& 
     out.terrain = std::move(terrain);
     const TerrainField& t = *out.terrain;
     if (is_whole || (out.road && out.road->over_budget)) return out;
-    if (out.road && !out.road->ferry && out.road->cost) {
+    if (out.road && !out.road->ferry && out.road->cost && !out.road->chain.cells.empty()) {
       const std::vector<std::uint32_t>& cells = out.road->chain.cells;
       bool inside = true;
       for (std::uint32_t i : cells) inside = inside && area.holds(t.col_of(i), t.row_of(i));

@@ -59,7 +59,8 @@ struct WindowedRoad {
 /// grid's smallest cell). Then the road's cost is the whole grid's optimum; its cells are the
 /// whole grid's road too unless two roads cost exactly the same. Else the area grows (at least
 /// doubles) up to what max_cells allows; a road still not proved, not found, or a ferry (the
-/// window's land masses) is then the largest window's answer (WindowedRoad::limited). A first
+/// window's land masses) is then the largest window's answer (WindowedRoad::limited), as is the
+/// previous window's when a search stores more than RoutingOptions::max_nodes (no road on the first). A first
 /// window (the ends and pad_cells) past max_cells throws bad_input naming it. The Bézier router is
 /// not searched by windows (bad_input).
 /// Road reuse (route_network by windows): the roads built so far over a window's cells (ArcDiscount
