@@ -51,8 +51,9 @@ roads::TerrainField road_terrain(const Dem& dem, const Scenario& scenario, const
 
 namespace {
 /// What the search's node budget (RoutingOptions::max_nodes) counts: node slots of 16 bytes and arc
-/// costs cached 4 to a unit; with their share of the queue, about 32 bytes each.
-constexpr double kBytesPerNode = 32;
+/// costs cached 4 to a unit; with their share of the queue about 32 bytes each, and 16 more for the
+/// long arcs' cost cache that follows it (4 floats a unit, TargetSearch).
+constexpr double kBytesPerNode = 48;
 }  // namespace
 
 RoadWindows road_windows(const DemWindowReader& dem, const DemWindowReader& lakes, const Georef& georef, const Scenario& scenario,

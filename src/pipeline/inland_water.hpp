@@ -42,7 +42,7 @@ struct RoadWindows {
   std::size_t max_nodes = 0;        ///< the search's nodes within the limit
 };
 /// `budget_mb`: what the windows and searches may take together (half each: windows at
-/// roads::kWindowBytesPerCell, nodes at 32 bytes), shared by `parallel` searches at once.
+/// roads::kWindowBytesPerCell, nodes at 48 bytes with their long-arc cache), shared by `parallel` searches at once.
 /// `reach_m`: how far from the road its corridor reads (0 without corridors).
 RoadWindows road_windows(const DemWindowReader& dem, const DemWindowReader& lakes, const Georef& georef, const Scenario& scenario,
                          const roads::CostModel& model, double reach_m, double budget_mb, std::size_t parallel);
