@@ -196,13 +196,9 @@ class DensityCommand final : public Command {
     // What the whole-grid command computes on the whole DEM (pipeline::hydro_for_density), computed
     // by tiles into the staging folder first, then read by windows: the inland water, Belhadj's hydrometry.
     std::optional<ScratchFolder> computed(std::in_place, (dir / ".computed").string());  // gone before the outputs are committed
-    const MosaicFiles water{computed->path(), "inland_water"}, belhadj{computed->path(), "hydrometry"};
-    water.create();
-    const hydro::tiled::TiledFlatWaterReport w = pipeline::inland_water_by_tiles(
-        reader, pipeline::inland_water_settings(scenario), tiles, reserve_reader_memory(tiles.limit_mb()),
-        [&](int t, int across, const Raster<std::uint8_t>& tile) { write_raster(water.tile(t, across), tile, WriteOptions{}); }, context.progress);
-    water.finish(w.tiles, w.across);
-    context.log.detail(pipeline::describe(w));
+    const MosaicFiles belhadj{computed->path(), "hydrometry"};
+    const std::string water =
+        pipeline::inland_water_mosaic(reader, pipeline::inland_water_settings(scenario), tiles, computed->path(), context.progress, context.log);
     std::optional<DemWindowReader> hydrometry_tiles;
     if (compute_hydrometry) {
       belhadj.create();
@@ -218,7 +214,7 @@ class DensityCommand final : public Command {
       read_hydro = [&](const Dem& window, int c0, int r0) { return hydrometry_tiles->read(c0, r0, window.cols(), window.rows()); };
     else if (hydrometry)
       read_hydro = [&](const Dem& window, int, int) { return read_hydrometry(hydrometry_path_, window.georef(), window.cols(), window.rows()); };
-    const density::ReadWindowInputs read = pipeline::density_windows(reader, scenario, options, water.vrt(), read_hydro);
+    const density::ReadWindowInputs read = pipeline::density_windows(reader, scenario, options, water, read_hydro);
     const double reserved_mb = reserve_reader_memory(tiles.limit_mb());
     const char* layers[] = {"coast", "plateau", "plain", "hydrometry", "buildable", "density"};
     for (const char* l : layers)

@@ -185,14 +185,9 @@ class PathCommand final : public Command {
     if (a == b) throw bad_input("--from/--to: both points fall in the same cell");
     for (const auto& [opt, c] : {std::pair{"--from", a}, std::pair{"--to", b}})
       if (reader.read(c.col, c.row, 1, 1).is_nodata(0)) throw bad_input(std::string(opt) + ": the point is on a nodata cell of " + dem_.path);
-    const MosaicFiles water{scratch, "inland_water"};
-    water.create();
-    const hydro::tiled::TiledFlatWaterReport found = pipeline::inland_water_by_tiles(
-        reader, pipeline::inland_water_settings(scenario), tiles, reserve_reader_memory(tiles.limit_mb()),
-        [&](int t, int across, const Raster<std::uint8_t>& tile) { write_raster(water.tile(t, across), tile, WriteOptions{}); }, context.progress);
-    water.finish(found.tiles, found.across);
-    context.log.detail(pipeline::describe(found));
-    const DemWindowReader lakes(water.vrt(), ReadOptions{});
+    const DemWindowReader lakes(
+        pipeline::inland_water_mosaic(reader, pipeline::inland_water_settings(scenario), tiles, scratch, context.progress, context.log),
+        ReadOptions{});
     const double budget_mb = tiles.limit_mb() - reserve_reader_memory(tiles.limit_mb());
     const pipeline::RoadWindows w = pipeline::road_windows(reader, lakes, h.georef, scenario, model, roads::corridor_reach_m(corridor), budget_mb, 1);
     roads::RoutingOptions bounded = routing;

@@ -36,6 +36,18 @@ std::string describe(const hydro::tiled::TiledFlatWaterReport& r) {
   return line;
 }
 
+std::string inland_water_mosaic(const DemWindowReader& dem, const InlandWaterSettings& water, const TileSettings& tiles,
+                                const std::string& dir, Progress& progress, const Log& log) {
+  const MosaicFiles mosaic{dir, "inland_water"};
+  mosaic.create();
+  const hydro::tiled::TiledFlatWaterReport report = inland_water_by_tiles(
+      dem, water, tiles, reserve_reader_memory(tiles.limit_mb()),
+      [&](int t, int across, const Raster<std::uint8_t>& tile) { write_raster(mosaic.tile(t, across), tile, WriteOptions{}); }, progress);
+  mosaic.finish(report.tiles, report.across);
+  log.detail(describe(report));
+  return mosaic.vrt();
+}
+
 hydro::tiled::TiledBelhadjReport hydrometry_by_tiles(const DemWindowReader& dem, const hydro::HydroOptions& hydro, const TileSettings& tiles,
                                                      double reserved_mb, const std::string& scratch_dir, const WriteTile<float>& write,
                                                      Progress& progress) {

@@ -30,6 +30,10 @@ hydro::tiled::TiledFlatWaterReport inland_water_by_tiles(const DemWindowReader& 
                                        double reserved_mb, const WriteTile<std::uint8_t>& write, Progress& progress);
 /// The log line of inland_water_by_tiles.
 std::string describe(const hydro::tiled::TiledFlatWaterReport& report);
+/// inland_water_by_tiles written into `dir` (a scratch or staging folder) as inland_water.vrt over
+/// one GeoTIFF a tile, its log line given to `log`; returns the VRT's path (the commands on a mosaic).
+std::string inland_water_mosaic(const DemWindowReader& dem, const InlandWaterSettings& water, const TileSettings& tiles,
+                                const std::string& dir, Progress& progress, const Log& log);
 
 /// The hydrometry of run_hydro by tiles: Belhadj's (the accumulation method is refused, bad_input),
 /// keeping its Acc in `scratch_dir` meanwhile.
