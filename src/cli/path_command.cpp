@@ -192,6 +192,12 @@ class PathCommand final : public Command {
     const pipeline::RoadWindows w = pipeline::road_windows(reader, lakes, h.georef, scenario, model, roads::corridor_reach_m(corridor), budget_mb, 1);
     roads::RoutingOptions bounded = routing;
     bounded.max_nodes = std::min(routing.max_nodes, w.max_nodes);
+    for (const auto& [opt, c] : {std::pair{"--from", a}, std::pair{"--to", b}}) {  // as on the whole DEM: an end in the sea refused
+      const int s = routing.snap_cells, c0 = std::max(0, c.col - s), r0 = std::max(0, c.row - s);
+      const roads::TerrainField near = w.read(c0, r0, std::min(h.cols, c.col + s + 1) - c0, std::min(h.rows, c.row + s + 1) - r0);
+      if (!roads::snap_to_land(near, c, s))
+        throw bad_input(std::string(opt) + ": the point is in the sea (no land within " + std::to_string(s) + " cells)");
+    }
     roads::WindowedRoad road;
     try {
       road = roads::route_by_windows(w.grid, w.read, model, options_.graph(), a, b, bounded, w.window, &context.progress);

@@ -59,6 +59,7 @@ constexpr double kBytesPerNode = 48;
 RoadWindows road_windows(const DemWindowReader& dem, const DemWindowReader& lakes, const Georef& georef, const Scenario& scenario,
                          const roads::CostModel& model, double reach_m, double budget_mb, std::size_t parallel) {
   const RasterHeader& h = dem.header();
+  if (!(budget_mb > 0)) throw bad_input("the memory limit leaves nothing for the roads' windows once the process is counted");
   const double sea_level = scenario.resolved["water"]["sea_level_m"].get<double>();
   const double budget = std::max(0.0, budget_mb) * 1e6 / double(std::max<std::size_t>(1, parallel));
   RoadWindows out;

@@ -40,7 +40,8 @@ RoadGraph::RoadGraph(const TerrainField& terrain, const CostModel& model, const 
   orientations_ = blocks * m + 1;
   for (const MaskArc& a : segment_mask(options_.k)) arcs_.push_back({a.dcol, a.drow, Structure::road, block[0] * m + sector_of(a.angle_rad, m), a.angle_rad});
   surface_arcs_ = arcs_.size();
-  if (surface_arcs_ * std::size_t(terrain_.rows()) <= kMaxLengthTable) {  // the rows held, from row0
+  // The rows held, from row0 (a frame's graph prices nothing: no table).
+  if (terrain_.holds_values() && surface_arcs_ * std::size_t(terrain_.rows()) <= kMaxLengthTable) {
     surface_length_.resize(surface_arcs_ * std::size_t(terrain_.rows()));
     for (int r = terrain_.row0(); r < terrain_.row0() + terrain_.rows(); ++r)
       for (std::size_t a = 0; a < surface_arcs_; ++a)

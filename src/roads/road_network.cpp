@@ -424,15 +424,22 @@ class NetworkRouter {
       const ArcDiscount* d = built_.discount();
       if (!d) return nullptr;
       built_.factors_over(w, at.factor);
-      at.tile_col0 = w.col0() >> kShift, at.tile_row0 = w.row0() >> kShift;
-      at.tile_cols = std::size_t(((w.col0() + w.cols() - 1) >> kShift) - at.tile_col0 + 1);
-      at.tiles.assign(at.tile_cols * std::size_t(((w.row0() + w.rows() - 1) >> kShift) - at.tile_row0 + 1), 0);
+      // The tiles every window's search read (which windows are searched depends on the earlier
+      // ones' roads): the earlier marks carried into this window's tiles, which hold them.
+      const int c0 = w.col0() >> kShift, r0 = w.row0() >> kShift;
+      const std::size_t cols = std::size_t(((w.col0() + w.cols() - 1) >> kShift) - c0 + 1);
+      std::vector<std::uint8_t> tiles(cols * std::size_t(((w.row0() + w.rows() - 1) >> kShift) - r0 + 1), 0);
+      for (std::size_t k = 0; k < at.tiles.size(); ++k)
+        if (at.tiles[k])
+          tiles[std::size_t(at.tile_row0 + int(k / at.tile_cols) - r0) * cols + std::size_t(at.tile_col0 + int(k % at.tile_cols) - c0)] = 1;
+      at.tiles = std::move(tiles), at.tile_col0 = c0, at.tile_row0 = r0, at.tile_cols = cols;
       at.seen = ArcDiscount{at.factor, d->floor, at.tiles.data(), at.tile_cols, at.tile_col0, at.tile_row0};
       return &at.seen;
     };
     const RoadGraph& g = graph_of(links_[i].road_class);
     WindowedRoad w = roads::route_by_windows(windows_->grid, windows_->read, g.model(), g.options(), edges_[i].a, edges_[i].b, o,
                                              windows_->window, nullptr, discount);
+    std::vector<float>().swap(at.factor);  // held by the links routed ahead until they are committed
     if (w.road)
       for (std::uint32_t& cell : w.road->chain.cells) cell = std::uint32_t(t_.index(w.terrain->col_of(cell), w.terrain->row_of(cell)));
     at.road = std::move(w.road);

@@ -48,6 +48,7 @@ TerrainField TerrainField::frame(const TerrainGrid& grid) {
   t.metrics_ = cell_metrics(grid.georef, grid.cols, grid.rows);
   t.bathymetry_ = grid.bathymetry;
   t.frame_ = true;
+  t.in_c1_ = grid.cols, t.in_r1_ = grid.rows;
   t.set_cell_sizes();
   return t;
 }
@@ -61,6 +62,7 @@ void TerrainField::set_cell_sizes() {
 }
 
 void TerrainField::build(const Dem& dem, double unknown_depth_m, double road_radius_m, const Raster<std::uint8_t>* inland_water) {
+  in_c0_ = col0_, in_r0_ = row0_, in_c1_ = col_end_, in_r1_ = row_end_;
   const double sea_level_m = sea_level_;
   const std::size_t n = dem.size();
   surface_.resize(n);

@@ -61,7 +61,7 @@ class TerrainField {
                double road_radius_m, const Raster<std::uint8_t>* inland_water = nullptr);
 
   /// The grid's frame alone: its cells, positions and metrics, no values (surface, water... are not
-  /// held: asking for them is an error). For what is drawn from roads found by windows (layers,
+  /// held and must not be asked for). For what is drawn from roads found by windows (layers,
   /// sections, the cells roads share), in the grid's own cell indices.
   static TerrainField frame(const TerrainGrid& grid);
   bool holds_values() const { return !frame_; }
@@ -75,7 +75,14 @@ class TerrainField {
   int grid_cols() const { return grid_cols_; }
   int grid_rows() const { return grid_rows_; }
   std::size_t size() const { return std::size_t(cols_) * std::size_t(rows_); }
-  bool inside(int col, int row) const { return col >= col0_ && row >= row0_ && col < col_end_ && row < row_end_; }
+  /// Whether the search may use a cell: held, and within the area set by restrict_search.
+  bool inside(int col, int row) const { return col >= in_c0_ && row >= in_r0_ && col < in_c1_ && row < in_r1_; }
+  /// Limits inside() to the cells [col0, col_end) x [row0, row_end) of those held: a window's
+  /// margin then only feeds the costs (water depth within the road radius, bilinear heights) of
+  /// the cells within, which the search uses alone, so every cost it reads is the grid's.
+  void restrict_search(int col0, int row0, int col_end, int row_end) {
+    in_c0_ = std::max(col0, col0_), in_r0_ = std::max(row0, row0_), in_c1_ = std::min(col_end, col_end_), in_r1_ = std::min(row_end, row_end_);
+  }
   /// Index of a held cell (row-major over the window: the order of the grid's own indices).
   std::size_t index(int col, int row) const { return std::size_t(row) * std::size_t(cols_) + std::size_t(col) - origin_; }
   int col_of(std::size_t index) const { return col0_ + int(index % std::size_t(cols_)); }
@@ -144,6 +151,7 @@ class TerrainField {
   void set_cell_sizes();
   bool frame_ = false;
   int cols_ = 0, rows_ = 0, col0_ = 0, row0_ = 0, col_end_ = 0, row_end_ = 0, grid_cols_ = 0, grid_rows_ = 0;
+  int in_c0_ = 0, in_r0_ = 0, in_c1_ = 0, in_r1_ = 0;  ///< where inside() holds (restrict_search; the cells held by default)
   std::size_t origin_ = 0;  ///< index(col0, row0) before the window's offset: row0 * cols + col0
   Georef georef_;
   CellMetrics metrics_;

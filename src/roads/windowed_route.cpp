@@ -19,6 +19,7 @@ struct Box {
     return {std::max(0, c0 - by), std::max(0, r0 - by), std::min(g.cols - 1, c1 + by), std::min(g.rows - 1, r1 + by)};
   }
   bool holds(int col, int row) const { return col >= c0 && col <= c1 && row >= r0 && row <= r1; }
+  Box united(const Box& o) const { return {std::min(c0, o.c0), std::min(r0, o.r0), std::max(c1, o.c1), std::max(r1, o.r1)}; }
 };
 
 /// A lower bound of the metres per cell across (w) and along (h) every row of the grid: a path
@@ -77,7 +78,7 @@ WindowedRoad route_by_windows(const TerrainGrid& grid, const ReadTerrainWindow& 
   const Box ends = Box{std::min(from.col, to.col), std::min(from.row, to.row), std::max(from.col, to.col), std::max(from.row, to.row)}
                        .grown(std::max(window.pad_cells, options.snap_cells), grid);
   const Box guess = ellipse_box(from, to, window.first_ratio * std::hypot((to.col - from.col) * scale.w, (to.row - from.row) * scale.h), grid, scale);
-  Box area{std::min(ends.c0, guess.c0), std::min(ends.r0, guess.r0), std::max(ends.c1, guess.c1), std::max(ends.r1, guess.r1)};
+  Box area = ends.united(guess);
   const auto too_large = [&](const Box& b) { return window.max_cells > 0 && b.grown(window.margin_cells, grid).cells() > window.max_cells; };
   if (too_large(area)) area = ends;
   WindowedRoad out;
@@ -96,6 +97,7 @@ WindowedRoad route_by_windows(const TerrainGrid& grid, const ReadTerrainWindow& 
     std::optional<Road> road;
     double per_metre = 0;  // the bound's cost per metre: the cheapest, times the reuse floor
     auto terrain = std::make_unique<TerrainField>(read(read_box.c0, read_box.r0, read_box.c1 - read_box.c0 + 1, read_box.r1 - read_box.r0 + 1));
+    terrain->restrict_search(area.c0, area.r0, area.c1 + 1, area.r1 + 1);  // the margin feeds the costs only
     try {
       const RoadGraph g(*terrain, model, graph);
       const ArcDiscount* reuse = discount ? discount(*terrain) : nullptr;
@@ -113,11 +115,9 @@ WindowedRoad route_by_windows(const TerrainGrid& grid, const ReadTerrainWindow& 
     const TerrainField& t = *out.terrain;
     if (is_whole || (out.road && out.road->over_budget)) return out;
     if (out.road && !out.road->ferry && out.road->cost && !out.road->chain.cells.empty()) {
-      const std::vector<std::uint32_t>& cells = out.road->chain.cells;
-      bool inside = true;
-      for (std::uint32_t i : cells) inside = inside && area.holds(t.col_of(i), t.row_of(i));
+      const std::vector<std::uint32_t>& cells = out.road->chain.cells;  // all within the area (restrict_search)
       const Cell a{t.col_of(cells.front()), t.row_of(cells.front())}, b{t.col_of(cells.back()), t.row_of(cells.back())};
-      if (inside && *out.road->cost < per_metre * detour_m(a, b, area, grid, scale)) {
+      if (*out.road->cost < per_metre * detour_m(a, b, area, grid, scale)) {
         out.proved = true;
         return out;
       }
@@ -128,7 +128,7 @@ WindowedRoad route_by_windows(const TerrainGrid& grid, const ReadTerrainWindow& 
     // or grow as far as the limit allows; past it, the largest window's answer stands (limited).
     int by = std::max(area.c1 - area.c0, area.r1 - area.r0) / 2 + 1;
     Box next = area.grown(by, grid);
-    if (needed) next = {std::min(next.c0, needed->c0), std::min(next.r0, needed->r0), std::max(next.c1, needed->c1), std::max(next.r1, needed->r1)};
+    if (needed) next = next.united(*needed);
     while (too_large(next) && by > 1) next = area.grown(by /= 2, grid);
     if (too_large(next)) {
       out.limited = true;

@@ -8,9 +8,11 @@ source "$(dirname "$0")/lib.sh" "$@"
 cd "$WORK"
 corsica=$SAMPLES/gebco2022_15s_north_corsica_capcorse.asc zion=$SAMPLES/spDataLarge_srtm_zion.tif
 ends=(--from 9.30,42.68 --to 9.42,42.70)
+limit=300
+[[ -n ${ASAN_OPTIONS:-} ]] && limit=2000  # AddressSanitizer holds 400-700 MB more (shadow memory, quarantine)
 
 "$TP" -q path "$corsica" "${ends[@]}" whole.geojson --sections whole_s.geojson --corridor whole_c.geojson
-"$TP" -v path "$corsica" "${ends[@]}" win.geojson --sections win_s.geojson --corridor win_c.geojson --memory-limit 300 2> win.log
+"$TP" -v path "$corsica" "${ends[@]}" win.geojson --sections win_s.geojson --corridor win_c.geojson --memory-limit $limit 2> win.log
 grep -q "path by windows: 1 windows searched" win.log || fail "the road was not searched on a window: $(cat win.log)"
 for f in "" _s _c; do cmp -s "whole$f.geojson" "win$f.geojson" || fail "win$f.geojson differs from the whole grid's"; done
 
@@ -23,17 +25,19 @@ done
 gdalbuildvrt -q zion.vrt z_*.tif
 zends=(--from -113.15,37.45 --to -112.93,37.2)
 "$TP" -q path "$zion" "${zends[@]}" zwhole.geojson --corridor zwhole_c.geojson
-"$TP" -q path zion.vrt "${zends[@]}" zwin.geojson --corridor zwin_c.geojson --memory-limit 300
+"$TP" -q path zion.vrt "${zends[@]}" zwin.geojson --corridor zwin_c.geojson --memory-limit $limit
 cmp -s zwhole.geojson zwin.geojson || fail "the road on the VRT's windows differs from the whole grid's"
 cmp -s zwhole_c.geojson zwin_c.geojson || fail "the corridor on the VRT's windows differs from the whole grid's"
 no_leftovers .
 [[ ! -e .inland_water ]] || fail "the inland water's tiles were left behind"
 
-refuse() { expect_refused bad.geojson "$1" "$TP" -q path zion.vrt "${zends[@]}" bad.geojson --memory-limit 300 "${@:2}"; }
+refuse() { expect_refused bad.geojson "$1" "$TP" -q path zion.vrt "${zends[@]}" bad.geojson --memory-limit $limit "${@:2}"; }
 refuse "--earthworks: reads the whole DEM" --earthworks bad.tif
 refuse "--evaluate: reads the whole DEM" --evaluate zwhole.geojson
 refuse "--vegetation: reads the whole DEM" --vegetation "$zion"
 refuse "--router bezier: reads the whole DEM" --router bezier
-expect_refused bad.geojson "cannot be searched within .* the memory limit allows windows of" \
+expect_refused bad.geojson "--from: the point is in the sea" \
+  "$TP" -q path "$corsica" --from 9.0,43.15 --to 9.42,42.70 bad.geojson --memory-limit $limit
+expect_refused bad.geojson "cannot be searched within .* the memory limit allows windows of|leaves nothing for the roads' windows" \
   "$TP" -q path zion.vrt "${zends[@]}" bad.geojson --memory-limit 90
 no_leftovers .

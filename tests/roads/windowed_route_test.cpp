@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <limits>
+#include <mutex>
 #include <random>
 
 #include "core/error.hpp"
@@ -200,8 +201,12 @@ TEST(RoadByWindows, ANetworkByWindowsIsTheWholeGridsNetwork) {
     const TerrainField frame = TerrainField::frame(grid);
     const RoadGraph frame_graph(frame, model, GraphOptions{});
     std::size_t largest = 0;
+    std::mutex largest_mutex;  // two links are routed at once
     const ReadTerrainWindow read = [&](int c0, int r0, int w, int h) {
-      largest = std::max(largest, std::size_t(w) * std::size_t(h));
+      {
+        const std::lock_guard<std::mutex> lock(largest_mutex);
+        largest = std::max(largest, std::size_t(w) * std::size_t(h));
+      }
       return TerrainField(window_of(dem, c0, r0, w, h), c0, r0, grid, 0.0, 10.0, model.road_radius_m);
     };
     WindowOptions window;
