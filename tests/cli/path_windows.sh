@@ -38,6 +38,8 @@ refuse "--vegetation: reads the whole DEM" --vegetation "$zion"
 refuse "--router bezier: reads the whole DEM" --router bezier
 expect_refused bad.geojson "--from: the point is in the sea" \
   "$TP" -q path "$corsica" --from 9.0,43.15 --to 9.42,42.70 bad.geojson --memory-limit $limit
-expect_refused bad.geojson "cannot be searched within .* the memory limit allows windows of|leaves nothing for the roads' windows" \
-  "$TP" -q path zion.vrt "${zends[@]}" bad.geojson --memory-limit 90
+# (Under AddressSanitizer the process alone holds more than 90 MB: the inland water's tiles are refused first.)
+[[ -n ${ASAN_OPTIONS:-} ]] ||
+  expect_refused bad.geojson "cannot be searched within .* the memory limit allows windows of" \
+    "$TP" -q path zion.vrt "${zends[@]}" bad.geojson --memory-limit 90
 no_leftovers .
