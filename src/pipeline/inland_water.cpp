@@ -43,6 +43,12 @@ InlandWater inland_water(const Dem& dem, const InlandWaterSettings& settings, Pr
   return out;
 }
 
+Raster<std::uint8_t> saved_water_mask(const Raster<float>& saved) {
+  Raster<std::uint8_t> mask(saved.cols(), saved.rows(), saved.georef());
+  for (std::size_t i = 0; i < mask.size(); ++i) mask[i] = saved[i] == 1;
+  return mask;
+}
+
 roads::TerrainField road_terrain(const Dem& dem, const Scenario& scenario, const roads::CostModel& model,
                                  const Raster<std::uint8_t>& water) {
   return roads::TerrainField(dem, scenario.resolved["water"]["sea_level_m"].get<double>(), model.unknown_water_depth_m,
@@ -70,15 +76,11 @@ RoadWindows road_windows(const DemWindowReader& dem, const DemWindowReader& lake
   out.grid.bathymetry = count.bathymetry();
   out.window.max_cells = std::size_t(0.5 * budget / roads::kWindowBytesPerCell);
   out.max_nodes = std::size_t(0.5 * budget / kBytesPerNode);
-  const CellMetrics metrics = cell_metrics(georef, h.cols, h.rows);
-  const double min_cell = std::min(*std::min_element(metrics.width_m.begin(), metrics.width_m.end()),
-                                   *std::min_element(metrics.height_m.begin(), metrics.height_m.end()));
-  out.window.margin_cells = roads::window_margin_cells(model.road_radius_m, reach_m, min_cell);
+  // The road radius in the grid's smallest cells, as a TerrainField of the grid counts it.
+  out.window.margin_cells = roads::window_margin_cells(model.road_radius_m, reach_m, roads::TerrainField::frame(out.grid).min_cell_m());
   out.read = [&dem, &lakes, grid = out.grid, sea_level, model](int c0, int r0, int cols, int rows) {
     const Dem window = dem.read(c0, r0, cols, rows);
-    const Dem water = lakes.read(c0, r0, cols, rows);
-    Raster<std::uint8_t> mask(cols, rows, window.georef());
-    for (std::size_t i = 0; i < mask.size(); ++i) mask[i] = water[i] == 1;
+    const Raster<std::uint8_t> mask = saved_water_mask(lakes.read(c0, r0, cols, rows));
     return roads::TerrainField(window, c0, r0, grid, sea_level, model.unknown_water_depth_m, model.road_radius_m, &mask);
   };
   return out;

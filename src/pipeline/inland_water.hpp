@@ -28,6 +28,10 @@ struct InlandWater {
 /// roads (bridged or avoided) and the access (impassable) read alike.
 InlandWater inland_water(const Dem& dem, const InlandWaterSettings& settings, Progress& progress, const Log& log);
 
+/// The water cells of a saved inland water raster read back as floats (inland_water.tif or .vrt):
+/// 1 where it holds 1, else 0.
+Raster<std::uint8_t> saved_water_mask(const Raster<float>& saved);
+
 /// The roads' terrain: the DEM, the sea (below water.sea_level_m, and nodata) and the inland water.
 roads::TerrainField road_terrain(const Dem& dem, const Scenario& scenario, const roads::CostModel& model,
                                  const Raster<std::uint8_t>& water);

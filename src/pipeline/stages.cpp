@@ -665,9 +665,7 @@ json corridor_hook(RunState& s, const roads::TerrainField& terrain, const std::v
 /// The roads' terrain (pipeline::road_terrain) on the run's inland water (inland_water.tif).
 roads::TerrainField road_terrain(const RunState& s) {
   const Raster<float> water = read_resampled(saved(s, kInlandWater), s.dem.georef(), s.dem.cols(), s.dem.rows(), Resampling::nearest);
-  Raster<std::uint8_t> lakes = s.dem.like<std::uint8_t>(0);
-  for (std::size_t i = 0; i < water.size(); ++i) lakes[i] = water[i] == 1;
-  return pipeline::road_terrain(s.dem, s.scenario, s.settings.roads.model, lakes);
+  return pipeline::road_terrain(s.dem, s.scenario, s.settings.roads.model, saved_water_mask(water));
 }
 
 /// roads.existing read onto the grid (nullopt when not given); its errors name the option.

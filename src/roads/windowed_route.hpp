@@ -34,7 +34,7 @@ struct WindowOptions {
 /// Bytes a window takes per cell while its road is searched: the terrain (surface, ground, depth,
 /// water, land components: 17), its inputs while it is built (DEM, inland water, raw depth: 13), and
 /// the search's per-cell arrays (nodes, arc caches, relaxed distances: about 30). The nodes the
-/// search stores come on top (RoutingOptions::max_nodes, about 80 bytes each).
+/// search stores come on top (RoutingOptions::max_nodes; pipeline::road_windows counts 48 bytes each).
 inline constexpr double kWindowBytesPerCell = 60;
 
 /// The margin WindowOptions::margin_cells needs: the road radius and a reach (the corridor's:
