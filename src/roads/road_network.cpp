@@ -159,6 +159,14 @@ class BuiltRoads {
     for (const auto& [cell, f] : factor_.sparse())
       if (const int col = t_.col_of(cell), row = t_.row_of(cell); window.inside(col, row)) out[window.index(col, row)] = f;
   }
+  /// The factors over the grid's cells [c0, c1] x [r0, r1] into `out` (row-major), for the reach bound.
+  void factors_over(int c0, int r0, int c1, int r1, std::vector<float>& out) const {
+    const std::size_t cols = std::size_t(c1 - c0 + 1);
+    out.assign(cols * std::size_t(r1 - r0 + 1), 1.0f);
+    for (const auto& [cell, f] : factor_.sparse())
+      if (const int col = t_.col_of(cell), row = t_.row_of(cell); col >= c0 && col <= c1 && row >= r0 && row <= r1)
+        out[std::size_t(row - r0) * cols + std::size_t(col - c0)] = f;
+  }
   /// The cells whose factor changed, in the order the roads were added (a search routed when the
   /// log held n cells saw every change before n).
   const std::vector<std::uint32_t>& changes() const { return changes_; }
@@ -261,6 +269,21 @@ struct Attempt {
   std::vector<float> factor;  ///< by windows: the roads' factors over the last window searched
   ArcDiscount seen;           ///< by windows: the discount that window's search read
   bool limited = false;       ///< by windows: decided on the largest window the limit allows
+
+  /// Makes `tiles` cover tiles [c0, c1] x [r0, r1] too, keeping its marks.
+  void cover(int c0, int r0, int c1, int r1) {
+    if (!tiles.empty()) {
+      const int rows = int(tiles.size() / tile_cols);
+      if (c0 >= tile_col0 && r0 >= tile_row0 && c1 < tile_col0 + int(tile_cols) && r1 < tile_row0 + rows) return;
+      c0 = std::min(c0, tile_col0), r0 = std::min(r0, tile_row0);
+      c1 = std::max(c1, tile_col0 + int(tile_cols) - 1), r1 = std::max(r1, tile_row0 + rows - 1);
+    }
+    const std::size_t cols = std::size_t(c1 - c0 + 1);
+    std::vector<std::uint8_t> grown(cols * std::size_t(r1 - r0 + 1), 0);
+    for (std::size_t k = 0; k < tiles.size(); ++k)
+      if (tiles[k]) grown[std::size_t(tile_row0 + int(k / tile_cols) - r0) * cols + std::size_t(tile_col0 + int(k % tile_cols) - c0)] = 1;
+    tiles = std::move(grown), tile_col0 = c0, tile_row0 = r0, tile_cols = cols;
+  }
 };
 
 /// The links routed in importance order, each on the roads of every link before it (the
@@ -420,25 +443,29 @@ class NetworkRouter {
   /// Link i by windows (roads::route_by_windows): the roads built so far over each window, the
   /// tiles its last search read; the road's cells turned into the grid's indices.
   void route_by_windows(Attempt& at, std::size_t i, const RoutingOptions& o) {
-    const WindowDiscount discount = [&](const TerrainField& w) -> const ArcDiscount* {
+    WindowReuse reuse;
+    reuse.over_window = [&](const TerrainField& w) -> const ArcDiscount* {
       const ArcDiscount* d = built_.discount();
       if (!d) return nullptr;
       built_.factors_over(w, at.factor);
       // The tiles every window's search read (which windows are searched depends on the earlier
-      // ones' roads): the earlier marks carried into this window's tiles, which hold them.
-      const int c0 = w.col0() >> kShift, r0 = w.row0() >> kShift;
-      const std::size_t cols = std::size_t(((w.col0() + w.cols() - 1) >> kShift) - c0 + 1);
-      std::vector<std::uint8_t> tiles(cols * std::size_t(((w.row0() + w.rows() - 1) >> kShift) - r0 + 1), 0);
-      for (std::size_t k = 0; k < at.tiles.size(); ++k)
-        if (at.tiles[k])
-          tiles[std::size_t(at.tile_row0 + int(k / at.tile_cols) - r0) * cols + std::size_t(at.tile_col0 + int(k % at.tile_cols) - c0)] = 1;
-      at.tiles = std::move(tiles), at.tile_col0 = c0, at.tile_row0 = r0, at.tile_cols = cols;
+      // ones' roads and bounds): the earlier marks kept, the window's tiles covered.
+      at.cover(w.col0() >> kShift, w.row0() >> kShift, (w.col0() + w.cols() - 1) >> kShift, (w.row0() + w.rows() - 1) >> kShift);
       at.seen = ArcDiscount{at.factor, d->floor, at.tiles.data(), at.tile_cols, at.tile_col0, at.tile_row0};
       return &at.seen;
     };
+    reuse.over_box = [&](int c0, int r0, int c1, int r1, std::vector<float>& out) { built_.factors_over(c0, r0, c1, r1, out); };
+    reuse.read = [&](int c0, int r0, int c1, int r1, const std::vector<std::uint8_t>& cells) {
+      at.cover(c0 >> kShift, r0 >> kShift, c1 >> kShift, r1 >> kShift);
+      const std::size_t cols = std::size_t(c1 - c0 + 1);
+      for (std::size_t k = 0; k < cells.size(); ++k)
+        if (cells[k])
+          at.tiles[std::size_t(((r0 + int(k / cols)) >> kShift) - at.tile_row0) * at.tile_cols +
+                   std::size_t(((c0 + int(k % cols)) >> kShift) - at.tile_col0)] = 1;
+    };
     const RoadGraph& g = graph_of(links_[i].road_class);
     WindowedRoad w = roads::route_by_windows(windows_->grid, windows_->read, g.model(), g.options(), edges_[i].a, edges_[i].b, o,
-                                             windows_->window, nullptr, discount);
+                                             windows_->window, nullptr, &reuse);
     std::vector<float>().swap(at.factor);  // held by the links routed ahead until they are committed
     if (w.road)
       for (std::uint32_t& cell : w.road->chain.cells) cell = std::uint32_t(t_.index(w.terrain->col_of(cell), w.terrain->row_of(cell)));

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "roads/radix_heap.hpp"
 
 namespace terrapolis::roads {
 namespace {
@@ -27,8 +28,7 @@ struct Box {
 struct Scale {
   double w = 1, h = 1;
 };
-Scale smallest_cells(const TerrainGrid& g) {
-  const CellMetrics m = cell_metrics(g.georef, g.cols, g.rows);
+Scale smallest_cells(const CellMetrics& m) {
   return {*std::min_element(m.width_m.begin(), m.width_m.end()), *std::min_element(m.height_m.begin(), m.height_m.end())};
 }
 
@@ -60,7 +60,103 @@ Box ellipse_box(Cell a, Cell b, double length_m, const TerrainGrid& g, Scale s) 
           std::min(g.cols - 1, int(std::ceil(cell(cx + hx, s.w, g.cols))) + 1), std::min(g.rows - 1, int(std::ceil(cell(cy + hy, s.h, g.rows))) + 1)};
 }
 
+/// Each factor becomes the least within `reach` cells of it (a square), so that every arc starting
+/// at a cell is priced at no more than its own discount.
+void least_within(std::vector<float>& factor, const Box& box, int reach) {
+  const int cols = box.c1 - box.c0 + 1, rows = box.r1 - box.r0 + 1;
+  std::vector<float> line;
+  for (int pass = 0; pass < 2; ++pass) {  // along rows, then along columns
+    const int n = pass == 0 ? cols : rows, lines = pass == 0 ? rows : cols;
+    const std::size_t step = pass == 0 ? 1 : std::size_t(cols), next = pass == 0 ? std::size_t(cols) : 1;
+    line.resize(std::size_t(n));
+    for (int l = 0; l < lines; ++l) {
+      float* v = factor.data() + std::size_t(l) * next;
+      for (int i = 0; i < n; ++i) line[std::size_t(i)] = v[std::size_t(i) * step];
+      bool any = false;
+      for (float f : line) any = any || f < 1;
+      if (!any) continue;
+      for (int i = 0; i < n; ++i) {
+        float least = 1;
+        for (int j = std::max(0, i - reach); j <= std::min(n - 1, i + reach); ++j) least = std::min(least, line[std::size_t(j)]);
+        v[std::size_t(i) * step] = least;
+      }
+    }
+  }
+}
+
 std::string cell_text(Cell c) { return "(" + std::to_string(c.col) + ", " + std::to_string(c.row) + ")"; }
+
+/// An arc of the search graph is at most this many times shorter than the 8-connected steps along
+/// it (1.0824 at 22.5 degrees; the rest covers the rows' different cell sizes).
+constexpr double kOctileSlack = 1.09;
+
+/// A road is proved when it costs less than this times the bound: a margin for the costs' rounding.
+constexpr double kMargin = 0.995;
+
+/// The reach bound under road reuse: what a road must pay to pass through each cell of `region`,
+/// read from no terrain. A metre costs at least the cheapest cost per metre times the factor of
+/// the roads built within an arc's reach of it (`factor`: the region's cells, the least factor
+/// within `reach` cells, 1 off the roads), and an arc costs at least its 8-connected steps over
+/// kOctileSlack; so the two Dijkstra distances D_a(x) + D_b(x) bound every road through x within
+/// the region, far above the straight line times the smallest factor when most of the way is off
+/// the roads.
+struct Reach {
+  double outside = kInfinity;  ///< the least bound over the region's cells outside `area`; the others' are at least the limit
+  Box needed;                  ///< `area` and every cell whose bound is below the limit
+};
+Reach reach_bound(const CellMetrics& m, const Box& region, const Box& area, Cell a, Cell b, double per_metre, double limit,
+                  const std::vector<float>& factor, std::vector<std::uint8_t>& read) {
+  const int cols = region.c1 - region.c0 + 1, rows = region.r1 - region.r0 + 1;
+  const std::size_t n = std::size_t(cols) * std::size_t(rows);
+  const auto at = [&](int col, int row) { return std::size_t(row - region.r0) * std::size_t(cols) + std::size_t(col - region.c0); };
+  struct Entry {
+    double f;
+    std::uint32_t i;
+  };
+  std::vector<float> from_a(n, float(kInfinity)), from_b(n, float(kInfinity));
+  Reach out;
+  out.needed = area;
+  read.assign(n, 0);  // bits: settled from a, from b, reached
+  for (const bool second : {false, true}) {
+    std::vector<float>& g = second ? from_b : from_a;
+    const Cell start = second ? b : a;
+    RadixHeap<Entry> heap;
+    g[at(start.col, start.row)] = 0;
+    heap.push({0.0, std::uint32_t(at(start.col, start.row))});
+    while (!heap.empty()) {
+      const Entry e = heap.pop();
+      if (e.f >= limit) break;  // every cell left costs at least the limit
+      if (e.f > double(g[e.i]) || (read[e.i] & (second ? 2 : 1))) continue;
+      read[e.i] |= second ? 2 : 1;
+      const int col = region.c0 + int(e.i % std::size_t(cols)), row = region.r0 + int(e.i / std::size_t(cols));
+      if (second && from_a[e.i] < limit) {
+        const double through = double(from_a[e.i]) + e.f;
+        if (through < limit) out.needed = out.needed.united({col, row, col, row});
+        if (!area.holds(col, row)) out.outside = std::min(out.outside, through);
+      }
+      for (int dr = -1; dr <= 1; ++dr)
+        for (int dc = -1; dc <= 1; ++dc) {
+          if ((dc == 0 && dr == 0) || !region.holds(col + dc, row + dr)) continue;
+          // height_m[r] and diagonal_m[r] join rows r - 1 and r.
+          const std::size_t lower = std::size_t(std::max(row, row + dr));
+          const double length = dr == 0 ? std::min(m.width_m[std::size_t(row)], m.width_m[std::size_t(row + dr)])
+                                : dc == 0 ? m.height_m[lower]
+                                          : m.diagonal_m[lower];
+          const std::size_t j = at(col + dc, row + dr);
+          const double d = e.f + length / kOctileSlack * per_metre * std::min(factor[e.i], factor[j]);
+          // Stored as floats rounded down: still lower bounds.
+          float stored = float(d);
+          if (double(stored) > d) stored = std::nextafter(stored, 0.0f);
+          if (stored < g[j]) {
+            g[j] = stored;
+            read[j] |= 4;  // its factor was read
+            heap.push({double(stored), std::uint32_t(j)});
+          }
+        }
+    }
+  }
+  return out;
+}
 
 }  // namespace
 
@@ -70,11 +166,12 @@ int window_margin_cells(double road_radius_m, double reach_m, double min_cell_m)
 
 WindowedRoad route_by_windows(const TerrainGrid& grid, const ReadTerrainWindow& read, const CostModel& model, const GraphOptions& graph,
                               Cell from, Cell to, const RoutingOptions& options, const WindowOptions& window, Progress* progress,
-                              const WindowDiscount& discount) {
+                              const WindowReuse* reuse) {
   if (options.router != Router::galin) throw bad_input("roads by windows: the Bézier router reads the whole grid; use the Galin router");
   const Box whole{0, 0, grid.cols - 1, grid.rows - 1};
   if (!whole.holds(from.col, from.row) || !whole.holds(to.col, to.row)) throw bad_input("path: an end point lies outside the DEM");
-  const Scale scale = smallest_cells(grid);
+  const CellMetrics metrics = cell_metrics(grid.georef, grid.cols, grid.rows);
+  const Scale scale = smallest_cells(metrics);
   const Box ends = Box{std::min(from.col, to.col), std::min(from.row, to.row), std::max(from.col, to.col), std::max(from.row, to.row)}
                        .grown(std::max(window.pad_cells, options.snap_cells), grid);
   const Box guess = ellipse_box(from, to, window.first_ratio * std::hypot((to.col - from.col) * scale.w, (to.row - from.row) * scale.h), grid, scale);
@@ -83,7 +180,7 @@ WindowedRoad route_by_windows(const TerrainGrid& grid, const ReadTerrainWindow& 
   if (too_large(area)) area = ends;
   WindowedRoad out;
   for (;;) {
-    std::optional<Box> needed;
+    std::optional<Box> needed, reached;
     const Box read_box = area.grown(window.margin_cells, grid);
     const bool is_whole = area.c0 == 0 && area.r0 == 0 && area.c1 == whole.c1 && area.r1 == whole.r1;
     const auto refuse = [&](const std::string& why) {
@@ -95,14 +192,18 @@ WindowedRoad route_by_windows(const TerrainGrid& grid, const ReadTerrainWindow& 
     // The previous window's answer stands until this one's search ends: past the nodes the limit
     // allows (processing_error), the previous is the largest window's answer (none on the first).
     std::optional<Road> road;
-    double per_metre = 0;  // the bound's cost per metre: the cheapest, times the reuse floor
+    double cheapest = 0, floor = 1;  // the bound's cost per metre: the cheapest, times the reuse floor
+    int reach_cells = 1;             // the surface arcs' reach
     auto terrain = std::make_unique<TerrainField>(read(read_box.c0, read_box.r0, read_box.c1 - read_box.c0 + 1, read_box.r1 - read_box.r0 + 1));
     terrain->restrict_search(area.c0, area.r0, area.c1 + 1, area.r1 + 1);  // the margin feeds the costs only
     try {
       const RoadGraph g(*terrain, model, graph);
-      const ArcDiscount* reuse = discount ? discount(*terrain) : nullptr;
-      per_metre = 0.995 * g.model().cheapest_per_metre() * (reuse ? reuse->floor : 1.0);
-      road = route_road(*terrain, g, from, to, options, progress, nullptr, reuse);
+      const ArcDiscount* discount = reuse ? reuse->over_window(*terrain) : nullptr;
+      cheapest = g.model().cheapest_per_metre();
+      for (std::size_t k = 0; k < g.surface_arcs(); ++k)
+        reach_cells = std::max({reach_cells, std::abs(g.arcs()[k].dcol), std::abs(g.arcs()[k].drow)});
+      floor = discount ? discount->floor : 1.0;
+      road = route_road(*terrain, g, from, to, options, progress, nullptr, discount);
     } catch (const Error& e) {
       if (e.kind() != ErrorKind::processing) throw;
       out.limited = true;  // the previous window's answer, or none
@@ -117,18 +218,43 @@ WindowedRoad route_by_windows(const TerrainGrid& grid, const ReadTerrainWindow& 
     if (out.road && !out.road->ferry && out.road->cost && !out.road->chain.cells.empty()) {
       const std::vector<std::uint32_t>& cells = out.road->chain.cells;  // all within the area (restrict_search)
       const Cell a{t.col_of(cells.front()), t.row_of(cells.front())}, b{t.col_of(cells.back()), t.row_of(cells.back())};
-      if (*out.road->cost < per_metre * detour_m(a, b, area, grid, scale)) {
+      const double cost = *out.road->cost, per_metre = kMargin * cheapest * floor;
+      if (cost < per_metre * detour_m(a, b, area, grid, scale)) {
         out.proved = true;
         return out;
       }
       // The area the bound needs for this cost; the road of a larger window costs no more.
-      if (per_metre > 0) needed = ellipse_box(a, b, *out.road->cost / per_metre, grid, scale);
+      if (per_metre > 0) needed = ellipse_box(a, b, cost / per_metre, grid, scale);
+      // Under reuse the straight line prices every metre as a road built: the reach bound knows
+      // where the roads are. Its region: the area three times as wide, within the memory the
+      // search's nodes freed.
+      if (floor < 1 && cheapest > 0) {
+        Box region = area;
+        for (int by = std::max(area.c1 - area.c0, area.r1 - area.r0) + 1; by > 0 && region.cells() == area.cells(); by /= 2)
+          if (const Box r = area.grown(by, grid); r.cells() <= 3 * options.max_nodes) region = r;
+        if (region.cells() > area.cells()) {
+          std::vector<float> factor;
+          reuse->over_box(region.c0, region.r0, region.c1, region.r1, factor);
+          least_within(factor, region, reach_cells);
+          std::vector<std::uint8_t> read_cells;
+          const Reach r = reach_bound(metrics, region, area, a, b, cheapest, cost / kMargin, factor, read_cells);
+          reuse->read(region.c0, region.r0, region.c1, region.r1, read_cells);
+          const double beyond = per_metre * detour_m(a, b, region, grid, scale);  // a road leaving the region
+          if (cost <= kMargin * r.outside && cost < beyond) {
+            out.proved = out.proved_by_reach = true;
+            return out;
+          }
+          if (cost < beyond) reached = r.needed.grown(1, grid);  // no cheaper road leaves it
+        }
+      }
     }
-    // At least double the area (the next road may leave it again), and hold what the bound needs,
-    // or grow as far as the limit allows; past it, the largest window's answer stands (limited).
+    // Hold what the reach bound needs, or at least double the area (the next road may leave it
+    // again) and hold what the straight-line bound needs, or grow as far as the limit allows; past
+    // it, the largest window's answer stands (limited).
     int by = std::max(area.c1 - area.c0, area.r1 - area.r0) / 2 + 1;
-    Box next = area.grown(by, grid);
-    if (needed) next = next.united(*needed);
+    if (reached && area.united(*reached).cells() == area.cells()) reached.reset();  // nothing new to hold
+    Box next = reached ? area.united(*reached) : area.grown(by, grid);
+    if (needed && !reached) next = next.united(*needed);
     while (too_large(next) && by > 1) next = area.grown(by /= 2, grid);
     if (too_large(next)) {
       out.limited = true;

@@ -6,6 +6,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <vector>
 
 #include "core/progress.hpp"
 #include "roads/road_network.hpp"
@@ -47,6 +48,7 @@ struct WindowedRoad {
   int windows = 0;                      ///< windows searched
   std::size_t largest_cells = 0;        ///< cells of the largest window read
   bool proved = false;                  ///< the bound proved the road the grid's (false: the window was the grid, or limited)
+  bool proved_by_reach = false;         ///< proved by the reach bound (road reuse), the straight line could not
   /// No window the limit allows proved the road (or found one): `road` is the largest window's
   /// answer, the best road within it, a ferry between its land masses, or none.
   bool limited = false;
@@ -63,13 +65,25 @@ struct WindowedRoad {
 /// previous window's when a search stores more than RoutingOptions::max_nodes (no road on the first). A first
 /// window (the ends and pad_cells) past max_cells throws bad_input naming it. The Bézier router is
 /// not searched by windows (bad_input).
-/// Road reuse (route_network by windows): the roads built so far over a window's cells (ArcDiscount
-/// on the window's indices), or nullptr for none; called for each window searched. The bound is
-/// then scaled by the discount's floor, as the search's heuristic is.
-using WindowDiscount = std::function<const ArcDiscount*(const TerrainField& window)>;
+/// With road reuse the straight-line bound is scaled by the smallest factor; when that cannot tell,
+/// the reach bound (Dijkstra over a larger region of the grid, on the cheapest cost per metre times
+/// the factors of the roads nearby, read from no terrain) proves the road or names the area a cheaper
+/// road could use, which the next window holds. Its region takes the memory the search's nodes
+/// freed (16 bytes a cell against RoutingOptions::max_nodes' 48 a node).
+/// Road reuse (route_network by windows): the roads built so far.
+struct WindowReuse {
+  /// Their discount over a window's cells (ArcDiscount on the window's indices), or nullptr for
+  /// none; called for each window searched.
+  std::function<const ArcDiscount*(const TerrainField& window)> over_window;
+  /// Their factors over the grid's cells [c0, c1] x [r0, r1] into `out`, row-major, 1 off the roads.
+  std::function<void(int c0, int r0, int c1, int r1, std::vector<float>& out)> over_box;
+  /// The reach bound read the factors within an arc's reach of the cells marked in `cells` (over
+  /// [c0, c1] x [r0, r1], row-major; nonzero: read).
+  std::function<void(int c0, int r0, int c1, int r1, const std::vector<std::uint8_t>& cells)> read;
+};
 WindowedRoad route_by_windows(const TerrainGrid& grid, const ReadTerrainWindow& read, const CostModel& model, const GraphOptions& graph,
                               Cell from, Cell to, const RoutingOptions& options, const WindowOptions& window, Progress* progress = nullptr,
-                              const WindowDiscount& discount = {});
+                              const WindowReuse* reuse = nullptr);
 
 /// The network by windows: route_network with each link routed by route_by_windows on `read`'s
 /// windows (the grid and the windows' limit in `window`), on the roads built before it.

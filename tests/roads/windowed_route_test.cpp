@@ -127,6 +127,78 @@ TEST(RoadByWindows, GivesTheWholeGridsRoadOnRandomLandscapes) {
   EXPECT_GE(grown, 3);      // and some needed a second window (the walls' detours)
 }
 
+TEST(RoadByWindows, UnderRoadReuseTheReachBoundProvesTheWholeGridsRoad) {
+  // Roads already built (factor 0.5 along random lines): the straight-line bound at half the
+  // cheapest cost per metre rarely proves a road; the reach bound (the roads' factors only where
+  // they are) does, and the road is still the whole grid's. With the bound made 4 times too large
+  // (an invalid proof) the roads differ.
+  std::mt19937_64 rng(7);
+  int routed = 0, by_reach = 0;
+  for (int trial = 0; trial < 12; ++trial) {
+    const int cols = 160 + int(rng() % 60), rows = 130 + int(rng() % 50);
+    const Dem dem = landscape(rng, cols, rows, trial % 3 == 2 ? test::geographic(50.0, 1.0 / 1200) : test::projected(10.0), trial % 2 == 1);
+    const CostModel model = test_model(rng);
+    const GraphOptions graph{int(1 + rng() % 4), 8, rng()};
+    const TerrainField whole(dem, 0.0, 10.0, model.road_radius_m);
+    const RoadGraph whole_graph(whole, model, graph);
+    const TerrainGrid grid{dem.georef(), cols, rows, whole.has_bathymetry()};
+    std::vector<float> factor(std::size_t(cols) * std::size_t(rows), 1.0f);
+    for (int line = 0; line < 3; ++line) {  // a straight road across the grid, 8-connected
+      const int c0 = int(rng() % std::uint64_t(cols)), r0 = int(rng() % std::uint64_t(rows));
+      const int c1 = int(rng() % std::uint64_t(cols)), r1 = int(rng() % std::uint64_t(rows));
+      const int n = std::max(std::abs(c1 - c0), std::abs(r1 - r0));
+      for (int k = 0; k <= n; ++k)
+        factor[std::size_t(r0 + (r1 - r0) * k / std::max(n, 1)) * std::size_t(cols) + std::size_t(c0 + (c1 - c0) * k / std::max(n, 1))] = 0.5f;
+    }
+    const ArcDiscount whole_discount{factor, 0.5};
+    std::vector<float> window_factor;
+    ArcDiscount window_discount;
+    WindowReuse reuse;
+    reuse.over_window = [&](const TerrainField& w) -> const ArcDiscount* {
+      window_factor.assign(w.size(), 1.0f);
+      for (int r = 0; r < rows; ++r)
+        for (int c = 0; c < cols; ++c)
+          if (w.inside(c, r)) window_factor[w.index(c, r)] = factor[std::size_t(r) * std::size_t(cols) + std::size_t(c)];
+      window_discount = ArcDiscount{window_factor, 0.5};
+      return &window_discount;
+    };
+    reuse.over_box = [&](int c0, int r0, int c1, int r1, std::vector<float>& out) {
+      out.clear();
+      for (int r = r0; r <= r1; ++r)
+        for (int c = c0; c <= c1; ++c) out.push_back(factor[std::size_t(r) * std::size_t(cols) + std::size_t(c)]);
+    };
+    reuse.read = [](int, int, int, int, const std::vector<std::uint8_t>&) {};
+    const ReadTerrainWindow read = [&](int c0, int r0, int w, int h) {
+      return TerrainField(window_of(dem, c0, r0, w, h), c0, r0, grid, 0.0, 10.0, model.road_radius_m);
+    };
+    WindowOptions options;
+    options.margin_cells = window_margin_cells(model.road_radius_m, 0, whole.min_cell_m());
+    options.pad_cells = 2;
+    options.first_ratio = 1.0;  // tight first windows: a wrong proof would keep a road the grid beats
+    RoutingOptions routing;
+    for (int k = 0; k < 4; ++k) {
+      const Cell a{int(rng() % std::uint64_t(cols / 2)) + cols / 4, int(rng() % std::uint64_t(rows / 2)) + rows / 4};
+      const Cell b{int(rng() % std::uint64_t(cols / 2)) + cols / 4, int(rng() % std::uint64_t(rows / 2)) + rows / 4};
+      if (a == b || !snap_to_land(whole, a, routing.snap_cells) || !snap_to_land(whole, b, routing.snap_cells)) continue;
+      const std::optional<Road> expected = route_road(whole, whole_graph, a, b, routing, nullptr, nullptr, &whole_discount);
+      const WindowedRoad got = route_by_windows(grid, read, model, graph, a, b, routing, options, nullptr, &reuse);
+      ASSERT_EQ(bool(expected), bool(got.road)) << trial;
+      if (!expected || !expected->cost) continue;
+      ASSERT_TRUE(got.road->cost) << trial;
+      EXPECT_EQ(*expected->cost, *got.road->cost) << trial << " " << k;  // bit for bit
+      ASSERT_EQ(expected->chain.cells.size(), got.road->chain.cells.size()) << trial;
+      for (std::size_t i = 0; i < expected->chain.cells.size(); ++i) {
+        ASSERT_EQ(whole.col_of(expected->chain.cells[i]), got.terrain->col_of(got.road->chain.cells[i])) << trial;
+        ASSERT_EQ(whole.row_of(expected->chain.cells[i]), got.terrain->row_of(got.road->chain.cells[i])) << trial;
+      }
+      ++routed;
+      by_reach += got.proved_by_reach;
+    }
+  }
+  EXPECT_GE(routed, 30);
+  EXPECT_GE(by_reach, 5);  // the reach bound decided some, and rightly
+}
+
 TEST(RoadByWindows, ARoadLargerThanTheLimitIsRefusedNamingIt) {
   std::mt19937_64 rng(5);
   const Dem dem = landscape(rng, 160, 160, test::projected(10.0), true);
