@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <queue>
 #include <string>
 
 #include "core/error.hpp"
@@ -90,54 +91,67 @@ RoadCells road_cells(const VectorLayer& roads, const Raster<float>& like, const 
   return out;
 }
 
-AccessResult travel_time(const Raster<float>& dem, const Raster<std::uint8_t>& passable, const RoadCells& roads,
-                         const std::vector<Destination>& destinations, const AccessOptions& options, Progress& progress) {
+namespace {
+
+/// A cell reached before the search starts: a destination (0 minutes) or, by tiles, a cell of a
+/// neighbouring tile with its time so far.
+struct Seed {
+  std::size_t cell;  ///< in the window
+  double minutes;
+  std::int32_t id;
+};
+
+/// The cells [c0, c1) x [r0, r1) of a window.
+struct Area {
+  int c0 = 0, r0 = 0, c1 = 0, r1 = 0;
+  bool holds(int c, int r) const { return c >= c0 && r >= r0 && c < c1 && r < r1; }
+};
+
+/// One Dijkstra from `seeds`, outward along reversed moves (a move u -> v is timed from u's side:
+/// the slope is z_v - z_u over the move's geodesic length) into the cells of `area` only; `w` is the
+/// window of the grid whose first cell is the grid's row `row0` (the move lengths are the grid's,
+/// per row). A cell's nearest destination is its predecessor's; of two predecessors reaching it at
+/// exactly the same time, the smaller id: the same answer whatever the order cells are met in, so
+/// a grid searched by tiles gives the whole grid's ids.
+void settle(const Raster<float>& dem, const Raster<std::uint8_t>& passable, const RoadCells& roads, int row0, const Area& area, const std::vector<Seed>& seeds, const std::vector<double>& length,
+            const AccessOptions& options, std::vector<double>& best, std::vector<std::int32_t>& nearest, std::vector<std::uint8_t>& done,
+            ProgressStep* step) {
   const Raster<float>& road_kmh = roads.kmh;
-  const int cols = dem.cols(), rows = dem.rows();
-  if (passable.cols() != cols || passable.rows() != rows || road_kmh.cols() != cols || road_kmh.rows() != rows ||
-      roads.tunnel.cols() != cols || roads.tunnel.rows() != rows)
-    throw bad_input("access: the water mask or the roads are not on the DEM's grid");
-  if (!(options.walk_factor > 0) || !std::isfinite(options.walk_factor)) throw bad_input("/access/walk_factor: must be a positive number");
-  for (double v : options.road_kmh)
-    if (!(v > 0) || !std::isfinite(v)) throw bad_input("/access/road_kmh: every speed must be a positive number of km/h");
-  const std::vector<double> length = move_lengths(dem.georef(), cols, rows);
+  const int cols = dem.cols();
   const std::size_t moves = options.knight_moves ? 16 : 8;
   auto open = [&](int c, int r) {
     const std::size_t i = dem.index(c, r);
     return road_kmh[i] > 0 || (passable[i] == 1 && !std::isnan(dem[i]));
   };
-
-  AccessResult out{dem.like<float>(NAN), dem.like<std::int32_t>(-1), 0};
-  out.nearest.nodata = -1;
-  std::vector<std::uint8_t> done(dem.size(), 0);
+  best.assign(dem.size(), INFINITY);
+  nearest.assign(dem.size(), -1);
+  done.assign(dem.size(), 0);
   struct Entry {
     double f;  ///< minutes
     std::size_t cell;
   };
-  roads::RadixHeap<Entry> queue;  // Dijkstra's keys only grow; equal keys pop in a fixed order
-  std::vector<double> best(dem.size(), INFINITY);
-  for (const auto& d : destinations) {
-    if (!dem.inside(d.col, d.row) || !open(d.col, d.row)) continue;
-    const std::size_t i = dem.index(d.col, d.row);
-    if (best[i] == 0) continue;  // two destinations on one cell: the first keeps it
-    best[i] = 0;
-    out.nearest[i] = d.id;
-    queue.push({0.0, i});
+  roads::RadixHeap<Entry> queue;  // Dijkstra's keys only grow
+  for (const Seed& s : seeds) {
+    const int c = int(s.cell % std::size_t(cols)), r = int(s.cell / std::size_t(cols));
+    if (!open(c, r)) continue;
+    if (s.minutes < best[s.cell] || (s.minutes == best[s.cell] && s.id < nearest[s.cell])) {
+      if (s.minutes < best[s.cell]) queue.push({s.minutes, s.cell});
+      best[s.cell] = s.minutes;
+      nearest[s.cell] = s.id;
+    }
   }
-  ProgressStep step(progress, "access");
   std::size_t settled = 0;
   while (!queue.empty()) {
     const auto [t, v] = queue.pop();
     if (done[v] || t > best[v]) continue;
     done[v] = 1;
-    out.minutes[v] = float(t);
-    if ((++settled & 0x3ffff) == 0) step.update(std::min(0.99, double(settled) / double(dem.size())));
+    if (step && (++settled & 0x3ffff) == 0) step->update(std::min(0.99, double(settled) / double(dem.size())));
     const int vc = int(v % std::size_t(cols)), vr = int(v / std::size_t(cols));
     const double zv = dem[v];
     for (std::size_t k = 0; k < moves; ++k) {
       // The move u -> v (towards the destination), from u = v - move.
       const int uc = vc - kMoves[k][0], ur = vr - kMoves[k][1];
-      if (!dem.inside(uc, ur) || !open(uc, ur)) continue;
+      if (!area.holds(uc, ur) || !open(uc, ur)) continue;
       const std::size_t u = dem.index(uc, ur);
       if (done[u]) continue;
       // A knight's move crosses the two cells beside its line: both must be open (no corner cut across water).
@@ -148,7 +162,7 @@ AccessResult travel_time(const Raster<float>& dem, const Raster<std::uint8_t>& p
         const int c2 = wide ? uc + dc / 2 : uc + dc, r2 = wide ? ur + dr : ur + dr / 2;
         if (!open(c1, r1) || !open(c2, r2)) continue;
       }
-      const double metres = length[std::size_t(ur) * kMoves.size() + k];
+      const double metres = length[std::size_t(row0 + ur) * kMoves.size() + k];
       double kmh;
       if (road_kmh[u] > 0 && road_kmh[v] > 0) {
         kmh = std::min(road_kmh[u], road_kmh[v]);
@@ -161,16 +175,202 @@ AccessResult travel_time(const Raster<float>& dem, const Raster<std::uint8_t>& p
       const double arrive = t + metres / (kmh / 0.06);  // km/h -> metres per minute: x 1000 / 60
       if (arrive < best[u]) {
         best[u] = arrive;
-        out.nearest[u] = out.nearest[v];
+        nearest[u] = nearest[v];
         queue.push({arrive, u});
+      } else if (arrive == best[u] && nearest[v] < nearest[u]) {
+        nearest[u] = nearest[v];
       }
     }
   }
-  for (std::size_t i = 0; i < dem.size(); ++i) {
-    if (!done[i]) out.nearest[i] = -1;
-    if (!done[i] && passable[i] == 1 && !std::isnan(dem[i])) ++out.unreachable_land;
-  }
+}
+
+void check_options(const AccessOptions& options) {
+  if (!(options.walk_factor > 0) || !std::isfinite(options.walk_factor)) throw bad_input("/access/walk_factor: must be a positive number");
+  for (double v : options.road_kmh)
+    if (!(v > 0) || !std::isfinite(v)) throw bad_input("/access/road_kmh: every speed must be a positive number of km/h");
+}
+
+/// The area's times and ids as an AccessResult on the area's own grid (`georef`), and its land
+/// cells that reach no destination.
+AccessResult area_result(const Raster<float>& dem, const Raster<std::uint8_t>& passable, const Area& a, const Georef& georef, const std::vector<double>& best,
+                         const std::vector<std::int32_t>& nearest, const std::vector<std::uint8_t>& done) {
+  const int cols = a.c1 - a.c0, rows = a.r1 - a.r0;
+  AccessResult out{Raster<float>(cols, rows, georef, NAN), Raster<std::int32_t>(cols, rows, georef, -1), 0};
+  out.nearest.nodata = -1;
+  for (int r = a.r0; r < a.r1; ++r)
+    for (int c = a.c0; c < a.c1; ++c) {
+      const std::size_t i = dem.index(c, r);
+      if (done[i]) {
+        out.minutes(c - a.c0, r - a.r0) = float(best[i]);
+        out.nearest(c - a.c0, r - a.r0) = nearest[i];
+      } else if (passable[i] == 1 && !std::isnan(dem[i])) {
+        ++out.unreachable_land;
+      }
+    }
   return out;
+}
+
+}  // namespace
+
+AccessResult travel_time(const Raster<float>& dem, const Raster<std::uint8_t>& passable, const RoadCells& roads,
+                         const std::vector<Destination>& destinations, const AccessOptions& options, Progress& progress) {
+  const int cols = dem.cols(), rows = dem.rows();
+  if (passable.cols() != cols || passable.rows() != rows || roads.kmh.cols() != cols || roads.kmh.rows() != rows ||
+      roads.tunnel.cols() != cols || roads.tunnel.rows() != rows)
+    throw bad_input("access: the water mask or the roads are not on the DEM's grid");
+  check_options(options);
+  const std::vector<double> length = move_lengths(dem.georef(), cols, rows);
+  std::vector<Seed> seeds;
+  for (const auto& d : destinations)
+    if (dem.inside(d.col, d.row)) seeds.push_back({dem.index(d.col, d.row), 0.0, d.id});
+  std::vector<double> best;
+  std::vector<std::int32_t> nearest;
+  std::vector<std::uint8_t> done;
+  ProgressStep step(progress, "access");
+  const Area whole{0, 0, cols, rows};
+  settle(dem, passable, roads, 0, whole, seeds, length, options, best, nearest, done, &step);
+  return area_result(dem, passable, whole, dem.georef(), best, nearest, done);
+}
+
+namespace {
+
+/// Where a tile keeps the cells its neighbours' searches start from: the two outer rows and columns
+/// (a knight's move reaches two cells), all of a tile of 4 or fewer rows or columns.
+struct Frame {
+  int w = 0, h = 0;
+  std::vector<double> minutes;  ///< empty until the tile is searched
+  std::vector<std::int32_t> id;
+  bool all() const { return w <= 4 || h <= 4; }
+  std::size_t size() const { return all() ? std::size_t(w) * std::size_t(h) : std::size_t(4 * w + 4 * (h - 4)); }
+  /// The slot of the tile's cell (c, r), or -1 when it is not on the frame.
+  int slot(int c, int r) const {
+    if (all() || r < 2) return r * w + c;
+    if (r >= h - 2) return (r - h + 4) * w + c;
+    const int base = 4 * w + (r - 2) * 4;
+    if (c < 2) return base + c;
+    if (c >= w - 2) return base + 2 + c - (w - 2);
+    return -1;
+  }
+};
+
+}  // namespace
+
+TiledAccess travel_time_by_tiles(const Georef& georef, int cols, int rows, int tile_size, const ReadAccessWindow& read,
+                                 const std::vector<Destination>& destinations, const AccessOptions& options, const WriteAccessTile& write,
+                                 Progress& progress) {
+  check_options(options);
+  if (tile_size < 1) throw bad_input("access by tiles: the tile size must be at least 1 cell");
+  const std::vector<double> length = move_lengths(georef, cols, rows);
+  const int across = (cols + tile_size - 1) / tile_size, down = (rows + tile_size - 1) / tile_size;
+  const std::size_t tiles = std::size_t(across) * std::size_t(down);
+  std::vector<Frame> frames(tiles);
+  std::vector<std::vector<Destination>> in_tile(tiles);
+  for (std::size_t t = 0; t < tiles; ++t) {
+    const int tx = int(t % std::size_t(across)), ty = int(t / std::size_t(across));
+    frames[t].w = std::min(tile_size, cols - tx * tile_size);
+    frames[t].h = std::min(tile_size, rows - ty * tile_size);
+  }
+  for (const Destination& d : destinations)
+    if (d.col >= 0 && d.row >= 0 && d.col < cols && d.row < rows)
+      in_tile[std::size_t(d.row / tile_size) * std::size_t(across) + std::size_t(d.col / tile_size)].push_back(d);
+
+  TiledAccess report;
+  report.tiles = tiles;
+  std::vector<double> best;
+  std::vector<std::int32_t> nearest;
+  std::vector<std::uint8_t> done;
+  // Searches tile t on its frames' times so far: its window (the tile and two cells around) read,
+  // the neighbours' frame cells in it as seeds, its destinations at 0.
+  auto search = [&](std::size_t t, AccessWindow& w, Area& area, int& wc0, int& wr0) {
+    const int tx = int(t % std::size_t(across)), ty = int(t / std::size_t(across));
+    const int x0 = tx * tile_size, y0 = ty * tile_size, x1 = x0 + frames[t].w, y1 = y0 + frames[t].h;
+    wc0 = std::max(0, x0 - 2), wr0 = std::max(0, y0 - 2);
+    const int wc1 = std::min(cols, x1 + 2), wr1 = std::min(rows, y1 + 2);
+    w = read(wc0, wr0, wc1 - wc0, wr1 - wr0);
+    area = {x0 - wc0, y0 - wr0, x1 - wc0, y1 - wr0};
+    std::vector<Seed> seeds;
+    for (const Destination& d : in_tile[t]) seeds.push_back({w.dem.index(d.col - wc0, d.row - wr0), 0.0, d.id});
+    for (int r = wr0; r < wr1; ++r)
+      for (int c = wc0; c < wc1; ++c) {
+        if (c >= x0 && c < x1 && r >= y0 && r < y1) continue;
+        const std::size_t u = std::size_t(r / tile_size) * std::size_t(across) + std::size_t(c / tile_size);
+        const Frame& f = frames[u];
+        if (f.minutes.empty()) continue;
+        const int k = f.slot(c % tile_size, r % tile_size);
+        if (k >= 0 && f.minutes[std::size_t(k)] < INFINITY)
+          seeds.push_back({w.dem.index(c - wc0, r - wr0), f.minutes[std::size_t(k)], f.id[std::size_t(k)]});
+      }
+    settle(w.dem, w.passable, w.roads, wr0, area, seeds, length, options, best, nearest, done, nullptr);
+    ++report.tile_runs;
+  };
+
+  // Tiles by the earliest time a change reached them (a Dijkstra over tiles): a tile is searched
+  // again whenever a neighbour's frame improves, until no frame changes; times only fall, so it ends.
+  std::vector<double> pending(tiles, INFINITY);
+  struct Item {
+    double key;
+    std::size_t tile;
+    bool operator>(const Item& o) const { return key > o.key || (key == o.key && tile > o.tile); }
+  };
+  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
+  for (std::size_t t = 0; t < tiles; ++t)
+    if (!in_tile[t].empty()) pending[t] = 0, queue.push({0.0, t});
+  ProgressStep step(progress, "access");
+  AccessWindow w;
+  Area area;
+  while (!queue.empty()) {
+    const Item item = queue.top();
+    queue.pop();
+    if (item.key != pending[item.tile]) continue;
+    pending[item.tile] = INFINITY;
+    const std::size_t t = item.tile;
+    int wc0 = 0, wr0 = 0;
+    search(t, w, area, wc0, wr0);
+    Frame& f = frames[t];
+    if (f.minutes.empty()) f.minutes.assign(f.size(), INFINITY), f.id.assign(f.size(), -1);
+    const int tx = int(t % std::size_t(across)), ty = int(t / std::size_t(across));
+    double changed[3][3];
+    for (auto& row : changed) std::fill(std::begin(row), std::end(row), double(INFINITY));
+    for (int r = 0; r < f.h; ++r)
+      for (int c = 0; c < f.w; ++c) {
+        const int k = f.slot(c, r);
+        if (k < 0) continue;
+        const std::size_t i = w.dem.index(area.c0 + c, area.r0 + r);
+        const double m = done[i] ? best[i] : INFINITY;
+        const std::int32_t id = done[i] ? nearest[i] : -1;
+        if (m == f.minutes[std::size_t(k)] && id == f.id[std::size_t(k)]) continue;
+        f.minutes[std::size_t(k)] = m, f.id[std::size_t(k)] = id;
+        // The neighbours whose windows hold this cell.
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            if ((dx < 0 && c >= 2) || (dx > 0 && c < f.w - 2) || (dy < 0 && r >= 2) || (dy > 0 && r < f.h - 2)) continue;
+            changed[dy + 1][dx + 1] = std::min(changed[dy + 1][dx + 1], m);
+          }
+      }
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        const int nx = tx + dx, ny = ty + dy;
+        if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= across || ny >= down || changed[dy + 1][dx + 1] == INFINITY) continue;
+        const std::size_t n = std::size_t(ny) * std::size_t(across) + std::size_t(nx);
+        if (changed[dy + 1][dx + 1] < pending[n]) pending[n] = changed[dy + 1][dx + 1], queue.push({pending[n], n});
+      }
+    step.update(0.5 * double(report.tile_runs) / double(report.tile_runs + queue.size() + 1));
+  }
+  // Every frame holds its final times: each tile searched once more, in order, and written.
+  for (std::size_t t = 0; t < tiles; ++t) {
+    int wc0 = 0, wr0 = 0;
+    search(t, w, area, wc0, wr0);
+    const int tx = int(t % std::size_t(across)), ty = int(t / std::size_t(across));
+    Georef g = georef;
+    g.transform[0] += tx * tile_size * g.transform[1] + ty * tile_size * g.transform[2];
+    g.transform[3] += tx * tile_size * g.transform[4] + ty * tile_size * g.transform[5];
+    AccessResult tile = area_result(w.dem, w.passable, area, g, best, nearest, done);
+    report.unreachable_land += tile.unreachable_land;
+    write(tx * tile_size, ty * tile_size, std::move(tile));
+    step.update(0.5 + 0.5 * double(t + 1) / double(tiles));
+  }
+  for (const Frame& f : frames) report.frame_bytes += f.minutes.size() * (sizeof(double) + sizeof(std::int32_t));
+  return report;
 }
 
 Coverage coverage(const Raster<float>& minutes, const Raster<float>& people, const std::vector<double>& thresholds_minutes) {

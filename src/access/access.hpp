@@ -60,9 +60,39 @@ RoadCells road_cells(const VectorLayer& roads, const Raster<float>& like, const 
 /// slope is z_v - z_u over the move's geodesic length). `dem`: metres, NaN nodata (impassable);
 /// `passable`: 1 where one may walk (land), 0 water; a road cell is passable whatever the water
 /// (bridges, ferries) and a move between two road cells runs at the slower of their speeds; any
-/// other move walks, and never into or out of a tunnel. Deterministic (equal times pop in a fixed order).
+/// other move walks, and never into or out of a tunnel. A cell reached at exactly the same time from
+/// two destinations goes to the smaller id (whatever order the search meets them in).
 AccessResult travel_time(const Raster<float>& dem, const Raster<std::uint8_t>& passable, const RoadCells& roads,
                          const std::vector<Destination>& destinations, const AccessOptions& options, Progress& progress);
+
+/// What travel_time reads of the grid's cells [col0, col0 + cols) x [row0, row0 + rows): the DEM,
+/// where one may walk, the roads (each on the window's own grid).
+struct AccessWindow {
+  Raster<float> dem;
+  Raster<std::uint8_t> passable;
+  RoadCells roads;
+};
+using ReadAccessWindow = std::function<AccessWindow(int col0, int row0, int cols, int rows)>;
+/// A tile's times (AccessResult on the tile's own grid, whose first cell is the grid's (col0, row0)).
+using WriteAccessTile = std::function<void(int col0, int row0, AccessResult&& tile)>;
+
+struct TiledAccess {
+  std::size_t tiles = 0;
+  std::size_t tile_runs = 0;         ///< searches of a tile (each tile at least once, the last to write it)
+  std::size_t unreachable_land = 0;  ///< as AccessResult's
+  std::size_t frame_bytes = 0;       ///< what the tiles' frames hold between searches
+};
+
+/// travel_time by tiles of `tile_size` cells of a grid of cols x rows (`georef`): each tile is
+/// searched on a window of two more cells around it (a knight's move), from its destinations and
+/// the times its neighbours' searches gave their two outer rows and columns (each tile's frame,
+/// the only state kept between searches); a tile whose neighbours' frames improve is searched
+/// again, the earliest change first, until no frame changes. Times only fall, and each tile's
+/// search is exact on its frame's times, so they end as the whole grid's, bit for bit; the ids
+/// too (ties go to the smaller id). Then each tile is searched once more and written, in order.
+TiledAccess travel_time_by_tiles(const Georef& georef, int cols, int rows, int tile_size, const ReadAccessWindow& read,
+                                 const std::vector<Destination>& destinations, const AccessOptions& options, const WriteAccessTile& write,
+                                 Progress& progress);
 
 /// Who lives how far: `people` per cell (NaN or <= 0: nobody) against `minutes`.
 struct Coverage {

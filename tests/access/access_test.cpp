@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 
 #include "access/access.hpp"
 #include "io/crs.hpp"
@@ -136,4 +137,95 @@ TEST(Access, CoverageCountsPeopleWithinEachThreshold) {
   EXPECT_DOUBLE_EQ(c.unreachable_people, 50);
   EXPECT_DOUBLE_EQ(c.mean_minutes, (5 * 100 + 20 * 300 + 45 * 600) / 1000.0);
   EXPECT_DOUBLE_EQ(c.p90_minutes, 45);
+}
+
+TEST(Access, ByTilesTheWholeGridsTimesAndIds) {
+  // Random hills, lakes, nodata, roads of every class (some tunnels), destinations: by tiles of 1
+  // to 37 cells (a knight's move crosses tiles of 1), the times and ids are the whole grid's, bit for
+  // bit, and so is the count of land that reaches nothing. A flat grid makes exact ties, where the
+  // smaller id must win on both sides.
+  std::mt19937_64 rng(34);
+  std::uniform_real_distribution<double> u(0, 1);
+  for (int trial = 0; trial < 14; ++trial) {
+    const int cols = 30 + int(rng() % 50), rows = 25 + int(rng() % 45);
+    const bool flat = trial % 5 == 0;
+    std::vector<std::array<double, 4>> hills;
+    for (int k = 0; k < 6; ++k) hills.push_back({u(rng) * cols, u(rng) * rows, 50 + 300 * u(rng), 3 + 8 * u(rng)});
+    const Dem dem = grid(cols, rows, [&](int c, int r) {
+      if (flat) return 10.0;
+      double z = 20;
+      for (const auto& h : hills) z += h[2] * std::exp(-((c - h[0]) * (c - h[0]) + (r - h[1]) * (r - h[1])) / (2 * h[3] * h[3]));
+      return z;
+    });
+    Dem holed = dem;
+    Raster<std::uint8_t> land = all_land(dem);
+    for (int k = 0; k < 3; ++k) {  // lakes
+      const int c0 = int(rng() % std::uint64_t(cols)), r0 = int(rng() % std::uint64_t(rows)), rad = 1 + int(rng() % 5);
+      for (int r = std::max(0, r0 - rad); r < std::min(rows, r0 + rad); ++r)
+        for (int c = std::max(0, c0 - rad); c < std::min(cols, c0 + rad); ++c) land(c, r) = 0;
+    }
+    if (trial % 3 == 1) holed(int(rng() % std::uint64_t(cols)), int(rng() % std::uint64_t(rows))) = NAN;
+    VectorLayer roads;
+    roads.geometry = GeometryType::line_string;
+    roads.crs = dem.georef().crs;
+    roads.fields = {{"class", FieldType::string}, {"structure", FieldType::string}};
+    const char* classes[] = {"motorway", "national", "departmental", "local"};
+    for (int k = 0; k < 4; ++k) {
+      const auto a = dem.georef().cell_centre(double(rng() % std::uint64_t(cols)), double(rng() % std::uint64_t(rows)));
+      const auto b = dem.georef().cell_centre(double(rng() % std::uint64_t(cols)), double(rng() % std::uint64_t(rows)));
+      roads.features.push_back({{{a, b}}, {std::string(classes[k]), std::string(k == 3 && trial % 2 ? "tunnel" : "road")}});
+    }
+    AccessOptions options;
+    options.knight_moves = trial % 4 != 3;
+    std::vector<Destination> towns;
+    for (int k = 0; k < 2 + trial % 5; ++k) towns.push_back({int(rng() % std::uint64_t(cols)), int(rng() % std::uint64_t(rows)), 10 - k});
+    if (flat) {  // mirror images: a whole column equally far from both; and two on one cell
+      towns = {{cols / 2 - 9, rows / 2, 7}, {cols / 2 + 9, rows / 2, 4}, {cols / 2 - 9, rows / 2 - 9, 5}, {cols / 2 - 9, rows / 2, 2}};
+      roads.features.clear();
+    }
+    if (flat) land = all_land(dem);
+    const RoadCells cells = road_cells(roads, dem, options);
+    const AccessResult whole = travel_time(holed, land, cells, towns, options, quiet);
+
+    const int tile = trial == 0 ? 1 : 1 + int(rng() % 37);
+    const ReadAccessWindow read = [&](int c0, int r0, int w, int h) {
+      Georef g = dem.georef();
+      g.transform[0] += c0 * g.transform[1];
+      g.transform[3] += r0 * g.transform[5];
+      AccessWindow out{Raster<float>(w, h, g), Raster<std::uint8_t>(w, h, g), {Raster<float>(w, h, g), Raster<std::uint8_t>(w, h, g)}};
+      for (int r = 0; r < h; ++r)
+        for (int c = 0; c < w; ++c) {
+          out.dem(c, r) = holed(c0 + c, r0 + r);
+          out.passable(c, r) = land(c0 + c, r0 + r);
+          out.roads.kmh(c, r) = cells.kmh(c0 + c, r0 + r);
+          out.roads.tunnel(c, r) = cells.tunnel(c0 + c, r0 + r);
+        }
+      return out;
+    };
+    Raster<float> minutes = dem.like<float>(-7.0f);
+    Raster<std::int32_t> nearest = dem.like<std::int32_t>(-7);
+    int written = 0;
+    const WriteAccessTile write = [&](int c0, int r0, AccessResult&& t) {
+      ++written;
+      EXPECT_EQ(t.minutes.georef().transform[0], dem.georef().transform[0] + c0 * kCell);
+      for (int r = 0; r < t.minutes.rows(); ++r)
+        for (int c = 0; c < t.minutes.cols(); ++c) {
+          minutes(c0 + c, r0 + r) = t.minutes(c, r);
+          nearest(c0 + c, r0 + r) = t.nearest(c, r);
+        }
+    };
+    const TiledAccess tiled = travel_time_by_tiles(dem.georef(), cols, rows, tile, read, towns, options, write, quiet);
+    EXPECT_EQ(std::size_t(written), tiled.tiles) << trial;
+    EXPECT_EQ(tiled.unreachable_land, whole.unreachable_land) << trial;
+    for (std::size_t i = 0; i < dem.size(); ++i) {
+      ASSERT_EQ(std::isnan(whole.minutes[i]), std::isnan(minutes[i])) << trial << " cell " << i << " tile " << tile;
+      if (!std::isnan(whole.minutes[i])) {
+        ASSERT_EQ(whole.minutes[i], minutes[i]) << trial << " cell " << i << " tile " << tile;
+      }
+      ASSERT_EQ(whole.nearest[i], nearest[i]) << trial << " cell " << i << " tile " << tile;
+    }
+    if (tile < std::max(cols, rows)) {
+      EXPECT_GT(tiled.tile_runs, tiled.tiles) << trial;  // frames improved: searched again
+    }
+  }
 }
