@@ -2,6 +2,7 @@
 #include "access/access.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <map>
 #include <queue>
@@ -373,72 +374,110 @@ TiledAccess travel_time_by_tiles(const Georef& georef, int cols, int rows, int t
   return report;
 }
 
+CoverageCount::CoverageCount(std::vector<double> thresholds_minutes) : thresholds_(std::move(thresholds_minutes)) {
+  c_.within_people.assign(thresholds_.size(), 0.0);
+}
+
+std::uint32_t CoverageCount::bucket(float minutes) { return std::bit_cast<std::uint32_t>(minutes) >> 12; }  // times are >= 0
+
+void CoverageCount::count(const float* minutes, const float* people, std::size_t cells) {
+  for (std::size_t i = 0; i < cells; ++i) {
+    const double p = people[i];
+    if (!(p > 0)) continue;
+    c_.total_people += p;
+    if (std::isnan(minutes[i])) {
+      c_.unreachable_people += p;
+      continue;
+    }
+    for (std::size_t k = 0; k < thresholds_.size(); ++k)
+      if (minutes[i] <= thresholds_[k]) c_.within_people[k] += p;
+    sum_ += double(minutes[i]) * p, weight_ += p;
+    const std::uint32_t b = bucket(minutes[i]);
+    if (b >= people_by_bucket_.size()) people_by_bucket_.resize(std::size_t(b) + 1, 0.0);
+    people_by_bucket_[b] += p;
+  }
+}
+
+bool CoverageCount::percentile_pass() {
+  if (!(weight_ > 0)) return false;
+  double seen = 0;
+  for (std::size_t b = 0; b < people_by_bucket_.size(); ++b) {
+    bucket_ = std::uint32_t(b);
+    if (seen + people_by_bucket_[b] >= 0.9 * weight_ && people_by_bucket_[b] > 0) break;
+    seen += people_by_bucket_[b];
+  }
+  before_ = seen;
+  std::vector<double>().swap(people_by_bucket_);
+  return true;
+}
+
+void CoverageCount::collect(const float* minutes, const float* people, std::size_t cells) {
+  for (std::size_t i = 0; i < cells; ++i)
+    if (people[i] > 0 && !std::isnan(minutes[i]) && bucket(minutes[i]) == bucket_) in_bucket_.push_back({minutes[i], double(people[i])});
+}
+
+Coverage CoverageCount::finish() {
+  if (weight_ > 0) {
+    c_.mean_minutes = sum_ / weight_;
+    std::sort(in_bucket_.begin(), in_bucket_.end());
+    double seen = before_;
+    for (const auto& [m, p] : in_bucket_) {
+      c_.p90_minutes = m;  // the bucket's last time if the sums' rounding never reaches the share
+      if ((seen += p) >= 0.9 * weight_) break;
+    }
+  }
+  return c_;
+}
+
 Coverage coverage(const Raster<float>& minutes, const Raster<float>& people, const std::vector<double>& thresholds_minutes) {
   if (minutes.cols() != people.cols() || minutes.rows() != people.rows())
     throw bad_input("access: the population raster is not on the DEM's grid");
-  Coverage c;
-  c.within_people.assign(thresholds_minutes.size(), 0.0);
-  std::vector<std::pair<float, double>> reached;  // (minutes, people)
-  for (std::size_t i = 0; i < minutes.size(); ++i) {
-    const double p = people[i];
-    if (!(p > 0)) continue;
-    c.total_people += p;
-    if (std::isnan(minutes[i])) {
-      c.unreachable_people += p;
-      continue;
-    }
-    reached.push_back({minutes[i], p});
-    for (std::size_t k = 0; k < thresholds_minutes.size(); ++k)
-      if (minutes[i] <= thresholds_minutes[k]) c.within_people[k] += p;
-  }
-  std::sort(reached.begin(), reached.end());
-  double sum = 0, weight = 0;
-  for (const auto& [m, p] : reached) sum += double(m) * p, weight += p;
-  if (weight > 0) {
-    c.mean_minutes = sum / weight;
-    double seen = 0;
-    for (const auto& [m, p] : reached)
-      if ((seen += p) >= 0.9 * weight) {
-        c.p90_minutes = m;
-        break;
-      }
-  }
-  return c;
+  CoverageCount count(thresholds_minutes);
+  count.count(minutes.data(), people.data(), minutes.size());
+  if (count.percentile_pass()) count.collect(minutes.data(), people.data(), minutes.size());
+  return count.finish();
 }
 
-VectorLayer catchments_layer(const AccessResult& times, const Raster<float>& weight, const std::string& counted,
-                             const std::vector<Settlement>& settlements) {
-  struct Figures {
-    double people = 0, area_m2 = 0, minutes_people = 0;
-  };
-  std::map<std::int32_t, Figures> by_id;
-  const Raster<std::int32_t>& nearest = times.nearest;
-  const CellMetrics metrics = cell_metrics(nearest.georef(), nearest.cols(), nearest.rows());
+void CatchmentSums::add(const Raster<std::int32_t>& nearest, const Raster<float>& minutes, const Raster<float>& weight,
+                        const std::vector<double>& area_m2, int row0) {
   for (int r = 0; r < nearest.rows(); ++r)
     for (int c = 0; c < nearest.cols(); ++c) {
       const std::int32_t id = nearest(c, r);
       if (id < 0) continue;
-      Figures& f = by_id[id];
-      f.area_m2 += metrics.area_m2[std::size_t(r)];
+      Figures& f = by_id_[id];
+      f.area_m2 += area_m2[std::size_t(row0 + r)];
       const double p = weight(c, r);
-      if (p > 0) f.people += p, f.minutes_people += p * double(times.minutes(c, r));
+      if (p > 0) f.people += p, f.minutes_people += p * double(minutes(c, r));
     }
+}
+
+VectorLayer CatchmentSums::layer(std::vector<std::pair<std::int32_t, Feature>> polygons, const std::string& counted,
+                                 const std::vector<Settlement>& settlements, const Crs& crs) const {
   std::map<std::int32_t, double> population;
   for (const Settlement& s : settlements) population[s.at.id] = s.population;
   VectorLayer layer;
   layer.name = "access_catchments";
   layer.geometry = GeometryType::polygon;
-  layer.crs = nearest.georef().crs;
+  layer.crs = crs;
   layer.fields = {{"id", FieldType::integer}, {"population", FieldType::integer}, {counted, FieldType::real},
                   {"area_km2", FieldType::real}, {"mean_minutes", FieldType::real}};
-  for (auto& [id, feature] : hydro::polygonize_labels(nearest)) {
-    const Figures& f = by_id[id];
+  for (auto& [id, feature] : polygons) {
+    const auto it = by_id_.find(id);
+    const Figures f = it == by_id_.end() ? Figures{} : it->second;
     feature.values = {std::int64_t(id), std::int64_t(std::llround(population[id])), std::round(f.people * 100) / 100,
                       std::round(f.area_m2 / 1e4) / 100,
                       f.people > 0 ? FieldValue(std::round(f.minutes_people / f.people * 10) / 10) : FieldValue(std::monostate{})};
     layer.features.push_back(std::move(feature));
   }
   return layer;
+}
+
+VectorLayer catchments_layer(const AccessResult& times, const Raster<float>& weight, const std::string& counted,
+                             const std::vector<Settlement>& settlements) {
+  const Raster<std::int32_t>& nearest = times.nearest;
+  CatchmentSums sums;
+  sums.add(nearest, times.minutes, weight, cell_metrics(nearest.georef(), nearest.cols(), nearest.rows()).area_m2, 0);
+  return sums.layer(hydro::polygonize_labels(nearest), counted, settlements, nearest.georef().crs);
 }
 
 void for_each_level(const Raster<float>& dem, const Raster<std::uint8_t>& passable, const RoadCells& roads,

@@ -5,6 +5,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -104,6 +105,28 @@ struct Coverage {
 };
 Coverage coverage(const Raster<float>& minutes, const Raster<float>& people, const std::vector<double>& thresholds_minutes);
 
+/// coverage() over a grid read by bands of whole rows, in order: count() every band, then, if
+/// percentile_pass(), collect() every band again; finish() gives coverage()'s figures bit for bit
+/// (coverage() is this on one band). The 90th percentile is found in two passes: the people per
+/// bucket of times (the float's top 20 bits), then the times of the one bucket it falls in, sorted.
+class CoverageCount {
+ public:
+  explicit CoverageCount(std::vector<double> thresholds_minutes);
+  void count(const float* minutes, const float* people, std::size_t cells);
+  bool percentile_pass();
+  void collect(const float* minutes, const float* people, std::size_t cells);
+  Coverage finish();
+
+ private:
+  static std::uint32_t bucket(float minutes);
+  std::vector<double> thresholds_;
+  Coverage c_;
+  double sum_ = 0, weight_ = 0, before_ = 0;
+  std::vector<double> people_by_bucket_;
+  std::uint32_t bucket_ = 0;
+  std::vector<std::pair<float, double>> in_bucket_;
+};
+
 /// A settlement as a destination of a size level: its cell, id and people.
 struct Settlement {
   Destination at;
@@ -118,6 +141,24 @@ struct Settlement {
 /// catchment's figures.
 VectorLayer catchments_layer(const AccessResult& times, const Raster<float>& weight, const std::string& counted,
                              const std::vector<Settlement>& settlements);
+
+/// catchments_layer's figures summed by bands of whole rows (in order, so the same bits), and the
+/// layer from them and the catchments' polygons (hydro::polygonize_labels of the ids).
+class CatchmentSums {
+ public:
+  /// The band's ids, times and weights (one raster's rows [row0, row0 + rows)), `area_m2` the
+  /// whole grid's cell areas per row (CellMetrics::area_m2).
+  void add(const Raster<std::int32_t>& nearest, const Raster<float>& minutes, const Raster<float>& weight, const std::vector<double>& area_m2,
+           int row0);
+  VectorLayer layer(std::vector<std::pair<std::int32_t, Feature>> polygons, const std::string& counted, const std::vector<Settlement>& settlements,
+                    const Crs& crs) const;
+
+ private:
+  struct Figures {
+    double people = 0, area_m2 = 0, minutes_people = 0;
+  };
+  std::map<std::int32_t, Figures> by_id_;
+};
 
 /// What one size level gives: the settlements of at least `level` people as destinations.
 struct LevelFigures {

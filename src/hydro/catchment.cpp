@@ -5,6 +5,7 @@
 #include <gdal_alg.h>
 #include <gdal_priv.h>
 #include <ogrsf_frmts.h>
+#include <vrtdataset.h>
 
 #include <cmath>
 #include <memory>
@@ -17,17 +18,10 @@
 
 namespace terrapolis::hydro {
 
-std::vector<std::pair<std::int32_t, Feature>> polygonize_labels(const Raster<std::int32_t>& labels) {
-  init_gdal();
-  GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");
-  if (!mem) throw processing_error("polygonize: GDAL's MEM driver is missing");
-  std::unique_ptr<GDALDataset> ds(mem->Create("", labels.cols(), labels.rows(), 1, GDT_Int32, nullptr));
-  GeoTransform gt = labels.georef().transform;
-  ds->SetGeoTransform(gt.data());
-  GDALRasterBand* band = ds->GetRasterBand(1);
-  if (band->RasterIO(GF_Write, 0, 0, labels.cols(), labels.rows(), const_cast<std::int32_t*>(labels.values().data()), labels.cols(),
-                     labels.rows(), GDT_Int32, 0, 0) != CE_None)
-    throw processing_error("polygonize: cannot fill the in-memory raster");
+namespace {
+
+/// GDALPolygonize of a band of labels (8-connected; labels < 0 are none).
+std::vector<std::pair<std::int32_t, Feature>> polygonize_band(GDALRasterBand* band) {
   GDALDriver* vmem = GetGDALDriverManager()->GetDriverByName("Memory");
   if (!vmem) vmem = GetGDALDriverManager()->GetDriverByName("MEM");
   std::unique_ptr<GDALDataset> vds(vmem->Create("", 0, 0, 0, GDT_Unknown, nullptr));
@@ -56,6 +50,41 @@ std::vector<std::pair<std::int32_t, Feature>> polygonize_labels(const Raster<std
     out.emplace_back(value, std::move(f));
   }
   return out;
+}
+
+}  // namespace
+
+std::vector<std::pair<std::int32_t, Feature>> polygonize_labels(const Raster<std::int32_t>& labels) {
+  init_gdal();
+  GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");
+  if (!mem) throw processing_error("polygonize: GDAL's MEM driver is missing");
+  std::unique_ptr<GDALDataset> ds(mem->Create("", labels.cols(), labels.rows(), 1, GDT_Int32, nullptr));
+  GeoTransform gt = labels.georef().transform;
+  ds->SetGeoTransform(gt.data());
+  GDALRasterBand* band = ds->GetRasterBand(1);
+  if (band->RasterIO(GF_Write, 0, 0, labels.cols(), labels.rows(), const_cast<std::int32_t*>(labels.values().data()), labels.cols(),
+                     labels.rows(), GDT_Int32, 0, 0) != CE_None)
+    throw processing_error("polygonize: cannot fill the in-memory raster");
+  return polygonize_band(band);
+}
+
+std::vector<std::pair<std::int32_t, Feature>> polygonize_labels(const std::string& path, const Georef& grid) {
+  init_gdal();
+  std::unique_ptr<GDALDataset> source(GDALDataset::Open(path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY));
+  if (!source || source->GetRasterCount() < 1) throw processing_error("polygonize: cannot read " + path);
+  // Read through a virtual raster on the grid's own geotransform (a VRT of tiles may differ from it
+  // in the last bit): the polygons' coordinates are the in-memory grid's.
+  GDALDriver* vrt = GetGDALDriverManager()->GetDriverByName("VRT");
+  if (!vrt) throw processing_error("polygonize: GDAL's VRT driver is missing");
+  const int cols = source->GetRasterXSize(), rows = source->GetRasterYSize();
+  std::unique_ptr<GDALDataset> view(vrt->Create("", cols, rows, 0, GDT_Int32, nullptr));
+  GeoTransform gt = grid.transform;
+  view->SetGeoTransform(gt.data());
+  view->AddBand(GDT_Int32, nullptr);
+  auto* band = static_cast<VRTSourcedRasterBand*>(view->GetRasterBand(1));
+  if (band->AddSimpleSource(source->GetRasterBand(1), 0, 0, cols, rows, 0, 0, cols, rows) != CE_None)
+    throw processing_error("polygonize: cannot read " + path + " through a virtual raster");
+  return polygonize_band(band);
 }
 
 std::vector<Feature> polygonize(const Raster<std::uint8_t>& mask) {

@@ -26,6 +26,9 @@ struct Catchment {
 std::vector<Feature> polygonize(const Raster<std::uint8_t>& mask);
 /// Polygons of the regions of equal label (8-connected; labels < 0 are none), each with its label.
 std::vector<std::pair<std::int32_t, Feature>> polygonize_labels(const Raster<std::int32_t>& labels);
+/// The same of a raster file of labels (a VRT of tiles too), read by rows as GDALPolygonize goes,
+/// placed on `grid`'s geotransform.
+std::vector<std::pair<std::int32_t, Feature>> polygonize_labels(const std::string& path, const Georef& grid);
 
 /// The cells whose D8 path passes through the outlet. The outlet (x, y) in the DEM's CRS is
 /// snapped to the cell of highest upstream area whose centre lies within `snap_radius_m` metres

@@ -86,6 +86,8 @@ template void RunState::write_tile(const std::string&, const MosaicFiles&, int, 
                                    const std::vector<std::pair<std::string, std::string>>&) const;
 template void RunState::write_tile(const std::string&, const MosaicFiles&, int, int, const Raster<std::uint8_t>&,
                                    const std::vector<std::pair<std::string, std::string>>&) const;
+template void RunState::write_tile(const std::string&, const MosaicFiles&, int, int, const Raster<std::int32_t>&,
+                                   const std::vector<std::pair<std::string, std::string>>&) const;
 
 void RunState::write(const std::string& stage, const std::string& name, const VectorLayer& layer, Style style) {
   const std::string description = describe_output(name, terms);

@@ -13,6 +13,7 @@
 #include "core/error.hpp"
 #include "core/geodesy.hpp"
 #include "density/tiled_density.hpp"
+#include "hydro/catchment.hpp"
 #include "hydro/tiled/tiled_hydro.hpp"
 #include "pipeline/by_tiles.hpp"
 #include "io/mask_io.hpp"
@@ -859,7 +860,7 @@ void roads_summary(const json& figures, SummaryText& out) {
 /// The run's road sections with their road's class (roads.geojson) and structure: bridges and
 /// ferries cross the water, tunnels are entered at their portals only.
 VectorLayer classed_sections(const RunState& s) {
-  const Crs& crs = s.dem.georef().crs;
+  const Crs& crs = s.grid.georef.crs;
   const VectorLayer roads = read_vector(saved(s, "roads.geojson"), crs);
   VectorLayer sections = read_vector(saved(s, "road_sections.geojson"), crs);
   std::map<std::int64_t, std::string> class_of;
@@ -875,18 +876,149 @@ VectorLayer classed_sections(const RunState& s) {
   return sections;
 }
 
+/// The summary's figures of one size level.
+json level_figures(const AccessSettings& a, std::size_t destinations, const access::Coverage& c) {
+  json within = json::object();
+  for (std::size_t k = 0; k < a.thresholds_minutes.size(); ++k) {
+    char key[32];
+    std::snprintf(key, sizeof key, "%g_min", a.thresholds_minutes[k]);
+    within[key] = c.total_people > 0 ? std::round(c.within_people[k] / c.total_people * 1e4) / 1e4 : 0.0;
+  }
+  return {{"destinations", destinations}, {"share_within", within}, {"mean_minutes", std::round(c.mean_minutes * 10) / 10},
+          {"p90_minutes", std::round(c.p90_minutes * 10) / 10}, {"unreachable_people", std::llround(c.unreachable_people)}};
+}
+
+/// The people the access stage counts: the sites stage's target population (or its settlements'),
+/// spread over the land by the density model (as the sites' catchments count them).
+double access_people(const RunState& s) {
+  double total = 0;
+  for (const auto& site : s.sites) total += double(site.population);
+  if (s.summary["sites"].contains("target_population")) total = s.summary["sites"]["target_population"].get<double>();
+  return total;
+}
+
+const char* const kUnreachableLand = " land cells reach no settlement (islands or enclosed land without a road)";
+
+/// The access stage by tiles (access::travel_time_by_tiles): each tile of the grid read with two
+/// cells around it (the DEM, the roads' terrain for the land, the road sections drawn on it); the
+/// people, the coverage and the catchments' figures by bands of rows read back from the tiles, in
+/// the whole grid's order; the catchments' polygons from access_nearest.vrt by rows.
+void access_run_tiles(RunState& s, Progress& progress, const Log& log) {
+  const AccessSettings& a = s.settings.access;
+  s.by_tiles->reserve();
+  const TiledInput& in = *s.by_tiles;
+  const double budget_mb = in.tiles.limit_mb() - in.reserved_mb;
+  const DemWindowReader dem(in.dem_path, in.read), lakes(saved(s, "inland_water.vrt"), ReadOptions{});
+  const DemWindowReader density(saved(s, "density.vrt")), buildable(saved(s, "buildable.vrt"));
+  const int cols = s.grid.cols, rows = s.grid.rows;
+  // A tile's search holds about 100 bytes a cell (the roads' terrain for the land, the DEM, roads,
+  // times, ids, the queue); a band of rows 16 (times, ids, people, density, buildable).
+  const int side = in.tiles.tile_size > 0 ? in.tiles.tile_size : std::clamp(int(std::sqrt(0.5 * budget_mb * 1e6 / 100)) - 4, 16, std::max(cols, rows));
+  const int band = std::clamp(int(0.5 * budget_mb * 1e6 / 16 / cols), 1, rows);
+  const RoadWindows terrain = road_windows(dem, lakes, s.grid.georef, s.scenario, s.settings.roads.model, 0, budget_mb, 1);
+  const VectorLayer sections = classed_sections(s);
+  const access::ReadAccessWindow read = [&](int c0, int r0, int w, int h) {
+    access::AccessWindow out;
+    out.dem = dem.read(c0, r0, w, h);
+    out.passable = out.dem.like<std::uint8_t>(0);
+    {
+      const roads::TerrainField t = terrain.read(c0, r0, w, h);
+      for (int r = 0; r < h; ++r)
+        for (int c = 0; c < w; ++c) out.passable(c, r) = !t.water(c0 + c, r0 + r) && !std::isnan(out.dem(c, r));
+    }
+    out.roads = access::road_cells(sections, out.dem, a.options);
+    return out;
+  };
+  // People per cell as sites::people_on_land: the density's mass over the land, in the whole grid's order.
+  const CellMetrics metrics = cell_metrics(s.grid.georef, cols, rows);
+  const double total = access_people(s);
+  double mass = 0;
+  for (int r0 = 0; r0 < rows; r0 += band) {
+    const int h = std::min(band, rows - r0);
+    const Dem d = density.read(0, r0, cols, h), b = buildable.read(0, r0, cols, h);
+    for (int r = 0; r < h; ++r)
+      for (int c = 0; c < cols; ++c)
+        if (b(c, r) == 1 && std::isfinite(d(c, r))) mass += double(d(c, r)) * metrics.area_m2[std::size_t(r0 + r)];
+  }
+  const auto people_band = [&](int r0, int h) {
+    const Dem d = density.read(0, r0, cols, h), b = buildable.read(0, r0, cols, h);
+    Raster<float> people = d.like<float>(0.0f);
+    if (mass > 0)
+      for (int r = 0; r < h; ++r)
+        for (int c = 0; c < cols; ++c)
+          if (b(c, r) == 1 && std::isfinite(d(c, r))) people(c, r) = float(total * double(d(c, r)) * metrics.area_m2[std::size_t(r0 + r)] / mass);
+    return people;
+  };
+  std::vector<access::Settlement> settlements;
+  for (const auto& site : s.sites) settlements.push_back({{site.col, site.row, site.id}, double(site.population)});
+  log.detail("access by tiles: tiles of " + std::to_string(side) + " cells, bands of " + std::to_string(band) + " rows");
+  const int across = (cols + side - 1) / side;
+  json levels = json::object();
+  for (const double level : a.levels_population) {
+    std::vector<access::Destination> to;
+    for (const access::Settlement& st : settlements)
+      if (st.population >= level) to.push_back(st.at);
+    if (to.empty()) continue;
+    const bool all = level == 0;
+    const std::string key = all ? "all" : std::to_string(std::llround(level));
+    const MosaicFiles minutes = s.mosaic(all ? "access_minutes" : "access_minutes_" + key), nearest = s.mosaic("access_nearest");
+    minutes.create();
+    if (all) nearest.create();
+    const access::TiledAccess t = access::travel_time_by_tiles(
+        s.grid.georef, cols, rows, side, read, to, a.options,
+        [&](int c0, int r0, access::AccessResult&& tile) {
+          const int index = (r0 / side) * across + c0 / side;
+          s.write_tile("access", minutes, index, across, tile.minutes, {{"UNIT", "min"}});
+          if (all) s.write_tile("access", nearest, index, across, tile.nearest);
+        },
+        progress);
+    s.write_mosaic("access", minutes, int(t.tiles), across, Style::access_minutes);
+    if (all) s.write_mosaic("access", nearest, int(t.tiles), across, Style::unit_ramp);
+    log.detail("access by tiles: " + std::to_string(t.tile_runs) + " searches of " + std::to_string(t.tiles) + " tiles, frames of " +
+               std::to_string(std::llround(double(t.frame_bytes) / 1e6)) + " MB");
+    // The coverage (two passes for the 90th percentile) and the catchments' sums, by bands.
+    const DemWindowReader times(minutes.vrt());
+    std::optional<DemWindowReader> ids;
+    if (all) ids.emplace(nearest.vrt());
+    access::CoverageCount count(a.thresholds_minutes);
+    access::CatchmentSums sums;
+    for (int pass = 0; pass < 2; ++pass) {
+      if (pass == 1 && !count.percentile_pass()) break;
+      for (int r0 = 0; r0 < rows; r0 += band) {
+        const int h = std::min(band, rows - r0);
+        const Dem m = times.read(0, r0, cols, h);
+        const Raster<float> people = people_band(r0, h);
+        if (pass == 1) {
+          count.collect(m.data(), people.data(), m.size());
+          continue;
+        }
+        count.count(m.data(), people.data(), m.size());
+        if (!all) continue;
+        const Dem idf = ids->read(0, r0, cols, h);
+        Raster<std::int32_t> id = idf.like<std::int32_t>(-1);
+        for (std::size_t i = 0; i < id.size(); ++i) id[i] = std::isnan(idf[i]) ? -1 : std::int32_t(idf[i]);
+        sums.add(id, m, people, metrics.area_m2, r0);
+      }
+    }
+    if (all) s.write("access", "access_catchments.geojson",
+                     sums.layer(hydro::polygonize_labels(nearest.vrt(), s.grid.georef), "people", settlements, s.grid.georef.crs),
+                     Style::access_catchments);
+    levels[key] = level_figures(a, to.size(), count.finish());
+    if (all && t.unreachable_land > 0) log.warn(std::to_string(t.unreachable_land) + kUnreachableLand);
+  }
+  s.summary["access"] = {{"people", std::llround(total)}, {"levels", levels}};
+}
+
 void access_run(RunState& s, Progress& progress, const Log& log) {
   const AccessSettings& a = s.settings.access;
   if (!a.enabled) return;
+  if (s.by_tiles) return access_run_tiles(s, progress, log);
   const roads::TerrainField terrain = road_terrain(s);
   Raster<std::uint8_t> land = s.dem.like<std::uint8_t>(0);
   for (int r = 0; r < s.dem.rows(); ++r)
     for (int c = 0; c < s.dem.cols(); ++c) land(c, r) = !terrain.water(c, r) && !std::isnan(s.dem(c, r));
   const access::RoadCells road_cells = access::road_cells(classed_sections(s), s.dem, a.options);
-  // The region's people over the land by the density model (as the sites' catchments count them).
-  double total = 0;
-  for (const auto& site : s.sites) total += double(site.population);
-  if (s.summary["sites"].contains("target_population")) total = s.summary["sites"]["target_population"].get<double>();
+  const double total = access_people(s);
   const Raster<float> people = sites::people_on_land(*s.density, *s.buildable, total);
   std::vector<access::Settlement> settlements;
   for (const auto& site : s.sites) settlements.push_back({{site.col, site.row, site.id}, double(site.population)});
@@ -899,17 +1031,8 @@ void access_run(RunState& s, Progress& progress, const Log& log) {
       s.write("access", "access_nearest.tif", f.times.nearest, Style::unit_ramp);
       s.write("access", "access_catchments.geojson", access::catchments_layer(f.times, people, "people", settlements), Style::access_catchments);
     }
-    const access::Coverage& c = f.coverage;
-    json within = json::object();
-    for (std::size_t k = 0; k < a.thresholds_minutes.size(); ++k) {
-      char key[32];
-      std::snprintf(key, sizeof key, "%g_min", a.thresholds_minutes[k]);
-      within[key] = c.total_people > 0 ? std::round(c.within_people[k] / c.total_people * 1e4) / 1e4 : 0.0;
-    }
-    levels[f.key] = {{"destinations", f.destinations}, {"share_within", within}, {"mean_minutes", std::round(c.mean_minutes * 10) / 10},
-                     {"p90_minutes", std::round(c.p90_minutes * 10) / 10}, {"unreachable_people", std::llround(c.unreachable_people)}};
-    if (all && f.times.unreachable_land > 0)
-      log.warn(std::to_string(f.times.unreachable_land) + " land cells reach no settlement (islands or enclosed land without a road)");
+    levels[f.key] = level_figures(a, f.destinations, f.coverage);
+    if (all && f.times.unreachable_land > 0) log.warn(std::to_string(f.times.unreachable_land) + kUnreachableLand);
   });
   s.summary["access"] = {{"people", std::llround(total)}, {"levels", levels}};
 }
@@ -967,7 +1090,7 @@ const std::vector<StageDef>& stages() {
       {"sites", {"sites", "seed"}, sites_prepare, sites_run, sites_load, sites_summary, true},
       {"network", {"network"}, network_prepare, network_run, network_load, network_summary, true},
       {"roads", {"roads"}, roads_prepare, roads_run, roads_load, roads_summary, true},
-      {"access", {"access"}, access_prepare, access_run, access_load, access_summary},
+      {"access", {"access"}, access_prepare, access_run, access_load, access_summary, true},
   };
   return list;
 }

@@ -33,5 +33,5 @@ done
 gdal_translate -q -tr 0.002 0.002 tiles/z_0_0.tif odd.tif && cp -r tiles mixed && mv odd.tif mixed/z_0_0.tif
 expect_refused mixed_run "mixed/z_0_1.tif: cell size differs" "$TP" run --set dem="$WORK/mixed" -o mixed_run
 [[ $(wc -l < "$WORK/stderr") -eq 1 ]] || fail "mixed tiles: not one line: $(cat "$WORK/stderr")"
-expect_refused tiled_run "/input/tile_size: a run works tile by tile up to the roads stage yet" "$TP" run --set dem="$WORK/tiles" --set input.tile_size=128 -o tiled_run
+expect_refused tiled_run "/density/weights/altitude: the terrain terms are not computed on tiles yet" "$TP" run --set dem="$WORK/tiles" --set input.tile_size=128 -o tiled_run
 echo "run on a mosaic: ok"

@@ -8,9 +8,11 @@
 # SPDX-License-Identifier: MIT
 source "$(dirname "$0")/lib.sh" "$@"
 cd "$WORK"
-rasters=(elevation hillshade filled flowdir accumulation hydrometry inland_water coast plateau plain buildable density)
-layers=(streams.geojson cities.geojson city_extents.geojson network.geojson roads.geojson sections.geojson junctions.geojson road_sections.geojson)
-tiled=(--set density.preset=belhadj2007 --until roads)
+rasters=(elevation hillshade filled flowdir accumulation hydrometry inland_water coast plateau plain buildable density
+  access_minutes access_minutes_10000 access_nearest)
+layers=(streams.geojson cities.geojson city_extents.geojson network.geojson roads.geojson sections.geojson junctions.geojson road_sections.geojson
+  access_catchments.geojson)
+tiled=(--set density.preset=belhadj2007)
 
 # The bundled DEM (GEBCO 15", sea below 0) on 3 x 3 tiles of 64 cells.
 "$TP" -q run "${tiled[@]}" -o whole
@@ -22,6 +24,7 @@ done
 for l in "${layers[@]}"; do cmp -s "whole/$l" "tiles/$l" || fail "$l differs from the whole grid's run"; done
 grep -q "sites by tiles: bands of" tiles.log || fail "the sites stage did not read the tiles"
 grep -q "roads by windows: windows of at most" tiles.log || fail "the roads stage did not search by windows"
+grep -q "access by tiles: [0-9]* searches of 9 tiles" tiles.log || fail "the access stage did not search by tiles"
 same_summary() {
   /usr/bin/python3 -c 'import json, sys; a, b = (json.load(open(f + "/run.json"))["summary"] for f in sys.argv[1:]); sys.exit(a != b)' "$1" "$2"
 }
@@ -54,7 +57,7 @@ limit=170  # the run on the whole grid peaks at about 270 MB
 [[ -n ${ASAN_OPTIONS:-} ]] && limit=2000  # AddressSanitizer holds 400-700 MB more (shadow memory, quarantine)
 "$TP" -q run "${nz[@]}" --set input.memory_limit_mb=$limit -o nz_tiles
 for r in "${rasters[@]}"; do
-  [[ $r == plain ]] && continue
+  [[ $r == plain || $r == access_* ]] && continue
   same_cells "nz_whole/$r.tif" "nz_tiles/$r.vrt" || fail "nz: $r differs from the whole grid's run"
 done
 for l in "${layers[@]:0:4}"; do cmp -s "nz_whole/$l" "nz_tiles/$l" || fail "nz: $l differs"; done
@@ -79,8 +82,6 @@ no_leftovers "$WORK"
 [[ -z $(find . -name '.scratch*') ]] || fail "a scratch folder was left behind"
 
 # Refused before any stage, exit 2, no folder: the later stages, and what the tiles do not compute yet.
-expect_refused r1 "/input/tile_size: a run works tile by tile up to the roads stage yet .*--until roads" \
-  "$TP" run --set input.tile_size=64 -o r1
 expect_refused r2 "/density/weights/altitude: the terrain terms are not computed on tiles yet" \
   "$TP" run --set input.memory_limit_mb=500 --until density -o r2
 expect_refused r3 "/hydro/classify: not computed on tiles yet" "$TP" run "${tiled[@]}" --set input.tile_size=64 --set hydro.classify=true -o r3
