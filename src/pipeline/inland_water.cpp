@@ -55,12 +55,6 @@ roads::TerrainField road_terrain(const Dem& dem, const Scenario& scenario, const
                              model.road_radius_m, &water);
 }
 
-namespace {
-/// What the search's node budget (RoutingOptions::max_nodes) counts: node slots of 16 bytes and arc
-/// costs cached 4 to a unit; with their share of the queue about 32 bytes each, and 16 more for the
-/// long arcs' cost cache that follows it (4 floats a unit, TargetSearch).
-constexpr double kBytesPerNode = 48;
-}  // namespace
 
 RoadWindows road_windows(const DemWindowReader& dem, const DemWindowReader& lakes, const Georef& georef, const Scenario& scenario,
                          const roads::CostModel& model, double reach_m, double budget_mb, std::size_t parallel) {
@@ -75,7 +69,7 @@ RoadWindows road_windows(const DemWindowReader& dem, const DemWindowReader& lake
   for (int r = 0; r < h.rows; r += band) count.add(dem.read(0, r, h.cols, std::min(band, h.rows - r)), sea_level);
   out.grid.bathymetry = count.bathymetry();
   out.window.max_cells = std::size_t(0.5 * budget / roads::kWindowBytesPerCell);
-  out.max_nodes = std::size_t(0.5 * budget / kBytesPerNode);
+  out.max_nodes = std::size_t(0.5 * budget / roads::kSearchBytesPerNode);
   // The road radius in the grid's smallest cells, as a TerrainField of the grid counts it.
   out.window.margin_cells = roads::window_margin_cells(model.road_radius_m, reach_m, roads::TerrainField::frame(out.grid).min_cell_m());
   out.read = [&dem, &lakes, grid = out.grid, sea_level, model](int c0, int r0, int cols, int rows) {

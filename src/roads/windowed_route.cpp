@@ -179,8 +179,44 @@ WindowedRoad route_by_windows(const TerrainGrid& grid, const ReadTerrainWindow& 
   const auto too_large = [&](const Box& b) { return window.max_cells > 0 && b.grown(window.margin_cells, grid).cells() > window.max_cells; };
   if (too_large(area)) area = ends;
   WindowedRoad out;
+  // Whether no road leaving `area` costs less than `road`, by the straight line, then by the roads
+  // built around it (the reach bound); if not, what area the two bounds need.
+  const auto prove = [&](const Road& road, const RoadGraph& g, const ArcDiscount* discount, const Box& area, std::optional<Box>& needed,
+                         std::optional<Box>& reached) {
+    const TerrainField& t = g.terrain();
+    const std::vector<std::uint32_t>& cells = road.chain.cells;  // all within the area (restrict_search)
+    const Cell a{t.col_of(cells.front()), t.row_of(cells.front())}, b{t.col_of(cells.back()), t.row_of(cells.back())};
+    const double cheapest = g.model().cheapest_per_metre(), floor = discount ? discount->floor : 1.0;
+    const double cost = *road.cost, per_metre = cheapest * floor;
+    if (!(per_metre > 0)) return false;
+    if (cost < kMargin * per_metre * detour_m(a, b, area, grid, scale)) return true;
+    needed = ellipse_box(a, b, cost / (kMargin * per_metre), grid, scale);  // the road of a larger window costs no more
+    if (floor == 1) return false;
+    // Under reuse the straight line prices every metre as a road built: the reach bound knows
+    // where the roads are. Its region: the area up to three times as wide, within the memory the
+    // search's nodes freed.
+    Box region = area;
+    for (int by = std::max(area.c1 - area.c0, area.r1 - area.r0) + 1; by > 0 && region.cells() == area.cells(); by /= 2)
+      if (const Box r = area.grown(by, grid); double(r.cells()) * kReachBytesPerCell <= double(options.max_nodes) * kSearchBytesPerNode) region = r;
+    if (region.cells() == area.cells()) return false;
+    int reach_cells = 1;  // the surface arcs' reach
+    for (std::size_t k = 0; k < g.surface_arcs(); ++k) reach_cells = std::max({reach_cells, std::abs(g.arcs()[k].dcol), std::abs(g.arcs()[k].drow)});
+    std::vector<float> factor;
+    reuse->over_box(region.c0, region.r0, region.c1, region.r1, factor);
+    least_within(factor, region, reach_cells);
+    std::vector<std::uint8_t> read_cells;
+    const Reach r = reach_bound(metrics, region, area, a, b, cheapest, cost / kMargin, factor, read_cells);
+    reuse->read(region.c0, region.r0, region.c1, region.r1, read_cells);
+    if (cost >= kMargin * per_metre * detour_m(a, b, region, grid, scale)) return false;  // a road leaving the region might
+    if (cost <= kMargin * r.outside) {
+      out.proved_by_reach = true;
+      return true;
+    }
+    reached = r.needed.grown(1, grid);  // no cheaper road leaves it
+    return false;
+  };
   for (;;) {
-    std::optional<Box> needed, reached;
+    std::optional<Box> needed, reached;  // what the straight-line bound, and the reach bound, need
     const Box read_box = area.grown(window.margin_cells, grid);
     const bool is_whole = area.c0 == 0 && area.r0 == 0 && area.c1 == whole.c1 && area.r1 == whole.r1;
     const auto refuse = [&](const std::string& why) {
@@ -192,18 +228,15 @@ WindowedRoad route_by_windows(const TerrainGrid& grid, const ReadTerrainWindow& 
     // The previous window's answer stands until this one's search ends: past the nodes the limit
     // allows (processing_error), the previous is the largest window's answer (none on the first).
     std::optional<Road> road;
-    double cheapest = 0, floor = 1;  // the bound's cost per metre: the cheapest, times the reuse floor
-    int reach_cells = 1;             // the surface arcs' reach
+    bool proved = false;
     auto terrain = std::make_unique<TerrainField>(read(read_box.c0, read_box.r0, read_box.c1 - read_box.c0 + 1, read_box.r1 - read_box.r0 + 1));
     terrain->restrict_search(area.c0, area.r0, area.c1 + 1, area.r1 + 1);  // the margin feeds the costs only
     try {
       const RoadGraph g(*terrain, model, graph);
       const ArcDiscount* discount = reuse ? reuse->over_window(*terrain) : nullptr;
-      cheapest = g.model().cheapest_per_metre();
-      for (std::size_t k = 0; k < g.surface_arcs(); ++k)
-        reach_cells = std::max({reach_cells, std::abs(g.arcs()[k].dcol), std::abs(g.arcs()[k].drow)});
-      floor = discount ? discount->floor : 1.0;
       road = route_road(*terrain, g, from, to, options, progress, nullptr, discount);
+      if (!is_whole && road && !road->over_budget && !road->ferry && road->cost && !road->chain.cells.empty())
+        proved = prove(*road, g, discount, area, needed, reached);
     } catch (const Error& e) {
       if (e.kind() != ErrorKind::processing) throw;
       out.limited = true;  // the previous window's answer, or none
@@ -213,52 +246,25 @@ WindowedRoad route_by_windows(const TerrainGrid& grid, const ReadTerrainWindow& 
     out.largest_cells = std::max(out.largest_cells, read_box.cells());
     out.road = std::move(road);
     out.terrain = std::move(terrain);
-    const TerrainField& t = *out.terrain;
     if (is_whole || (out.road && out.road->over_budget)) return out;
-    if (out.road && !out.road->ferry && out.road->cost && !out.road->chain.cells.empty()) {
-      const std::vector<std::uint32_t>& cells = out.road->chain.cells;  // all within the area (restrict_search)
-      const Cell a{t.col_of(cells.front()), t.row_of(cells.front())}, b{t.col_of(cells.back()), t.row_of(cells.back())};
-      const double cost = *out.road->cost, per_metre = kMargin * cheapest * floor;
-      if (cost < per_metre * detour_m(a, b, area, grid, scale)) {
-        out.proved = true;
-        return out;
-      }
-      // The area the bound needs for this cost; the road of a larger window costs no more.
-      if (per_metre > 0) needed = ellipse_box(a, b, cost / per_metre, grid, scale);
-      // Under reuse the straight line prices every metre as a road built: the reach bound knows
-      // where the roads are. Its region: the area three times as wide, within the memory the
-      // search's nodes freed.
-      if (floor < 1 && cheapest > 0) {
-        Box region = area;
-        for (int by = std::max(area.c1 - area.c0, area.r1 - area.r0) + 1; by > 0 && region.cells() == area.cells(); by /= 2)
-          if (const Box r = area.grown(by, grid); r.cells() <= 3 * options.max_nodes) region = r;
-        if (region.cells() > area.cells()) {
-          std::vector<float> factor;
-          reuse->over_box(region.c0, region.r0, region.c1, region.r1, factor);
-          least_within(factor, region, reach_cells);
-          std::vector<std::uint8_t> read_cells;
-          const Reach r = reach_bound(metrics, region, area, a, b, cheapest, cost / kMargin, factor, read_cells);
-          reuse->read(region.c0, region.r0, region.c1, region.r1, read_cells);
-          const double beyond = per_metre * detour_m(a, b, region, grid, scale);  // a road leaving the region
-          if (cost <= kMargin * r.outside && cost < beyond) {
-            out.proved = out.proved_by_reach = true;
-            return out;
-          }
-          if (cost < beyond) reached = r.needed.grown(1, grid);  // no cheaper road leaves it
-        }
-      }
+    if (proved) {
+      out.proved = true;
+      return out;
     }
     // Hold what the reach bound needs, or at least double the area (the next road may leave it
-    // again) and hold what the straight-line bound needs, or grow as far as the limit allows; past
-    // it, the largest window's answer stands (limited).
-    int by = std::max(area.c1 - area.c0, area.r1 - area.r0) / 2 + 1;
+    // again) and hold what the straight-line bound needs; or grow as far as the limit allows, if
+    // that is a quarter more; past it, the largest window's answer stands (limited).
     if (reached && area.united(*reached).cells() == area.cells()) reached.reset();  // nothing new to hold
-    Box next = reached ? area.united(*reached) : area.grown(by, grid);
+    Box next = reached ? area.united(*reached) : area.grown(std::max(area.c1 - area.c0, area.r1 - area.r0) / 2 + 1, grid);
     if (needed && !reached) next = next.united(*needed);
-    while (too_large(next) && by > 1) next = area.grown(by /= 2, grid);
     if (too_large(next)) {
-      out.limited = true;
-      return out;
+      int fits = 0, over = std::max(area.c1 - area.c0, area.r1 - area.r0) + 1;  // the largest growth that fits
+      while (over - fits > 1) (too_large(area.grown((fits + over) / 2, grid)) ? over : fits) = (fits + over) / 2;
+      next = area.grown(fits, grid);
+      if (4 * next.cells() < 5 * area.cells()) {
+        out.limited = true;
+        return out;
+      }
     }
     area = next;
   }

@@ -37,6 +37,14 @@ struct WindowOptions {
 /// the search's per-cell arrays (nodes, arc caches, relaxed distances: about 30). The nodes the
 /// search stores come on top (RoutingOptions::max_nodes; pipeline::road_windows counts 48 bytes each).
 inline constexpr double kWindowBytesPerCell = 60;
+/// Bytes a search node takes (RoutingOptions::max_nodes counts them): node slots of 16 bytes and arc
+/// costs cached 4 to a unit; with their share of the queue about 32 bytes each, and 16 more for the
+/// long arcs' cost cache that follows it (4 floats a unit, TargetSearch).
+inline constexpr double kSearchBytesPerNode = 48;
+/// Bytes a cell of the reach bound's region takes (two times and a factor as floats, flags, and
+/// about three queue entries of 16 bytes): its region holds at most the nodes' bytes, which the
+/// search freed, at this rate.
+inline constexpr double kReachBytesPerCell = 64;
 
 /// The margin WindowOptions::margin_cells needs: the road radius and a reach (the corridor's:
 /// its platform's half-width plus its tallest side), in the grid's smallest cells, plus 2.
@@ -69,7 +77,7 @@ struct WindowedRoad {
 /// the reach bound (Dijkstra over a larger region of the grid, on the cheapest cost per metre times
 /// the factors of the roads nearby, read from no terrain) proves the road or names the area a cheaper
 /// road could use, which the next window holds. Its region takes the memory the search's nodes
-/// freed (16 bytes a cell against RoutingOptions::max_nodes' 48 a node).
+/// freed (kReachBytesPerCell against kSearchBytesPerNode).
 /// Road reuse (route_network by windows): the roads built so far.
 struct WindowReuse {
   /// Their discount over a window's cells (ArcDiscount on the window's indices), or nullptr for
