@@ -51,13 +51,18 @@ std::vector<double> move_lengths(const Georef& georef, int cols, int rows) {
 double tobler_kmh(double dz_dx) { return 6.0 * std::exp(-3.5 * std::fabs(dz_dx + 0.05)); }
 
 RoadCells road_cells(const VectorLayer& roads, const Raster<float>& like, const AccessOptions& options) {
+  return road_cells(roads, like, options, like.georef(), 0, 0);
+}
+
+RoadCells road_cells(const VectorLayer& roads, const Raster<float>& like, const AccessOptions& options, const Georef& grid, int col0,
+                     int row0) {
   RoadCells out{like.like<float>(0.0f), like.like<std::uint8_t>(0)};
   Raster<std::uint8_t> surface = like.like<std::uint8_t>(0);  // a road at the surface passes there
   const int class_field = roads.field_index("class"), structure_field = roads.field_index("structure");
-  const GridLocator locator(like.georef());
+  const GridLocator locator(grid);  // the grid's pixels: every window marks the cells the whole grid would
   bool underground = false;
   auto mark = [&](double col, double row, float kmh) {
-    const int c = int(std::floor(col)), r = int(std::floor(row));
+    const int c = int(std::floor(col)) - col0, r = int(std::floor(row)) - row0;
     if (!out.kmh.inside(c, r)) return;
     out.kmh(c, r) = std::max(out.kmh(c, r), kmh);
     (underground ? out.tunnel : surface)(c, r) = 1;
@@ -80,6 +85,9 @@ RoadCells road_cells(const VectorLayer& roads, const Raster<float>& like, const 
         }
         // Samples a quarter of a cell apart: consecutive cells touch by a side or a corner.
         const auto a = locator.crs_to_pixel(part[k - 1][0], part[k - 1][1]);
+        const double lo_c = std::min(a[0], b[0]) - col0, hi_c = std::max(a[0], b[0]) - col0;
+        const double lo_r = std::min(a[1], b[1]) - row0, hi_r = std::max(a[1], b[1]) - row0;
+        if (hi_c < -1 || hi_r < -1 || lo_c > like.cols() + 1 || lo_r > like.rows() + 1) continue;  // off this window
         const int steps = std::max(1, int(std::ceil(4 * std::max(std::fabs(b[0] - a[0]), std::fabs(b[1] - a[1])))));
         for (int s = 1; s <= steps; ++s) {
           const double t = double(s) / steps;
@@ -260,7 +268,8 @@ TiledAccess travel_time_by_tiles(const Georef& georef, int cols, int rows, int t
                                  const std::vector<Destination>& destinations, const AccessOptions& options, const WriteAccessTile& write,
                                  Progress& progress) {
   check_options(options);
-  if (tile_size < 1) throw bad_input("access by tiles: the tile size must be at least 1 cell");
+  // A knight's move reaches two cells: from tiles of 2 or more it reaches only the next tiles.
+  if (tile_size < 2) throw bad_input("access by tiles: the tile size must be at least 2 cells");
   const std::vector<double> length = move_lengths(georef, cols, rows);
   const int across = (cols + tile_size - 1) / tile_size, down = (rows + tile_size - 1) / tile_size;
   const std::size_t tiles = std::size_t(across) * std::size_t(down);

@@ -55,6 +55,10 @@ struct RoadCells {
 /// `like` with 8-connected cells: a `class` field naming a roads::kRoadClasses class sets its speed
 /// (lines without one are local roads), a `structure` field "tunnel" marks it underground.
 RoadCells road_cells(const VectorLayer& roads, const Raster<float>& like, const AccessOptions& options);
+/// The same on a window of `grid` whose first cell is the grid's (col0, row0): the lines are drawn
+/// in the grid's pixels, so a window marks exactly the cells the whole grid would.
+RoadCells road_cells(const VectorLayer& roads, const Raster<float>& like, const AccessOptions& options, const Georef& grid, int col0,
+                     int row0);
 
 /// Travel times to the nearest of `destinations` by one multi-source Dijkstra over the grid,
 /// from the destinations outward along reversed moves (a move u -> v is timed from u's side: the
@@ -84,7 +88,7 @@ struct TiledAccess {
   std::size_t frame_bytes = 0;       ///< what the tiles' frames hold between searches
 };
 
-/// travel_time by tiles of `tile_size` cells of a grid of cols x rows (`georef`): each tile is
+/// travel_time by tiles of `tile_size` (2 or more) cells of a grid of cols x rows (`georef`): each tile is
 /// searched on a window of two more cells around it (a knight's move), from its destinations and
 /// the times its neighbours' searches gave their two outer rows and columns (each tile's frame,
 /// the only state kept between searches); a tile whose neighbours' frames improve is searched

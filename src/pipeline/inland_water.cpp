@@ -55,7 +55,6 @@ roads::TerrainField road_terrain(const Dem& dem, const Scenario& scenario, const
                              model.road_radius_m, &water);
 }
 
-
 RoadWindows road_windows(const DemWindowReader& dem, const DemWindowReader& lakes, const Georef& georef, const Scenario& scenario,
                          const roads::CostModel& model, double reach_m, double budget_mb, std::size_t parallel) {
   const RasterHeader& h = dem.header();

@@ -912,9 +912,19 @@ void access_run_tiles(RunState& s, Progress& progress, const Log& log) {
   const DemWindowReader density(saved(s, "density.vrt")), buildable(saved(s, "buildable.vrt"));
   const int cols = s.grid.cols, rows = s.grid.rows;
   // A tile's search holds about 100 bytes a cell (the roads' terrain for the land, the DEM, roads,
-  // times, ids, the queue); a band of rows 16 (times, ids, people, density, buildable).
-  const int side = in.tiles.tile_size > 0 ? in.tiles.tile_size : std::clamp(int(std::sqrt(0.5 * budget_mb * 1e6 / 100)) - 4, 16, std::max(cols, rows));
-  const int band = std::clamp(int(0.5 * budget_mb * 1e6 / 16 / cols), 1, rows);
+  // times, ids, the queue): the tiles take half of what the limit leaves.
+  // The tiles' frames (12 bytes a cell of their two outer rows and columns) a quarter of the rest.
+  const double frames_mb = 12.0 * 8 * double(cols) * double(rows) / 1e6, tile_mb = 0.5 * budget_mb;
+  int side = in.tiles.tile_size;
+  if (side <= 0) {
+    side = std::max(16, std::min(int(std::sqrt(tile_mb * 1e6 / 100)) - 4, std::max(cols, rows)));
+    side = std::max(side, int(std::ceil(frames_mb / (0.25 * budget_mb))));  // frames of larger tiles take less
+    if (100.0 * (side + 4.0) * (side + 4.0) / 1e6 > tile_mb)
+      throw bad_input("/input/memory_limit_mb: too little for the access stage's tiles and their frames (" + std::to_string(std::llround(frames_mb / side)) +
+                      " MB of frames at tiles of " + std::to_string(side) + " cells)");
+  }
+  // A band of rows: times, ids (read as floats and as ids), people, density, buildable: 24 bytes a cell.
+  const int band = std::clamp(int(0.25 * budget_mb * 1e6 / 24 / cols), 1, rows);
   const RoadWindows terrain = road_windows(dem, lakes, s.grid.georef, s.scenario, s.settings.roads.model, 0, budget_mb, 1);
   const VectorLayer sections = classed_sections(s);
   const access::ReadAccessWindow read = [&](int c0, int r0, int w, int h) {
@@ -926,7 +936,7 @@ void access_run_tiles(RunState& s, Progress& progress, const Log& log) {
       for (int r = 0; r < h; ++r)
         for (int c = 0; c < w; ++c) out.passable(c, r) = !t.water(c0 + c, r0 + r) && !std::isnan(out.dem(c, r));
     }
-    out.roads = access::road_cells(sections, out.dem, a.options);
+    out.roads = access::road_cells(sections, out.dem, a.options, s.grid.georef, c0, r0);
     return out;
   };
   // People per cell as sites::people_on_land: the density's mass over the land, in the whole grid's order.
@@ -994,7 +1004,7 @@ void access_run_tiles(RunState& s, Progress& progress, const Log& log) {
         }
         count.count(m.data(), people.data(), m.size());
         if (!all) continue;
-        const Dem idf = ids->read(0, r0, cols, h);
+        const Dem idf = ids->read(0, r0, cols, h);  // ids as floats: exact below 2^24 settlements
         Raster<std::int32_t> id = idf.like<std::int32_t>(-1);
         for (std::size_t i = 0; i < id.size(); ++i) id[i] = std::isnan(idf[i]) ? -1 : std::int32_t(idf[i]);
         sums.add(id, m, people, metrics.area_m2, r0);

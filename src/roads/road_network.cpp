@@ -467,6 +467,7 @@ class NetworkRouter {
     WindowedRoad w = roads::route_by_windows(windows_->grid, windows_->read, g.model(), g.options(), edges_[i].a, edges_[i].b, o,
                                              windows_->window, nullptr, &reuse);
     std::vector<float>().swap(at.factor);  // held by the links routed ahead until they are committed
+    at.seen = ArcDiscount{};                // it pointed at the factors and at tiles since re-laid
     if (w.road)
       for (std::uint32_t& cell : w.road->chain.cells) cell = std::uint32_t(t_.index(w.terrain->col_of(cell), w.terrain->row_of(cell)));
     at.road = std::move(w.road);

@@ -86,10 +86,6 @@ void least_within(std::vector<float>& factor, const Box& box, int reach) {
 
 std::string cell_text(Cell c) { return "(" + std::to_string(c.col) + ", " + std::to_string(c.row) + ")"; }
 
-/// An arc of the search graph is at most this many times shorter than the 8-connected steps along
-/// it (1.0824 at 22.5 degrees; the rest covers the rows' different cell sizes).
-constexpr double kOctileSlack = 1.09;
-
 /// A road is proved when it costs less than this times the bound: a margin for the costs' rounding.
 constexpr double kMargin = 0.995;
 
@@ -97,7 +93,7 @@ constexpr double kMargin = 0.995;
 /// read from no terrain. A metre costs at least the cheapest cost per metre times the factor of
 /// the roads built within an arc's reach of it (`factor`: the region's cells, the least factor
 /// within `reach` cells, 1 off the roads), and an arc costs at least its 8-connected steps over
-/// kOctileSlack; so the two Dijkstra distances D_a(x) + D_b(x) bound every road through x within
+/// octile_slack (of the region's cells); so the two Dijkstra distances D_a(x) + D_b(x) bound every road through x within
 /// the region, far above the straight line times the smallest factor when most of the way is off
 /// the roads.
 struct Reach {
@@ -113,6 +109,16 @@ Reach reach_bound(const CellMetrics& m, const Box& region, const Box& area, Cell
     double f;
     std::uint32_t i;
   };
+  // The region's cells: widths, heights and diagonals between their extremes over its rows.
+  double w_min = kInfinity, w_max = 0, h_min = kInfinity, h_max = 0, d_max = 0;
+  for (int r = region.r0; r <= region.r1; ++r) {
+    w_min = std::min(w_min, m.width_m[std::size_t(r)]), w_max = std::max(w_max, m.width_m[std::size_t(r)]);
+    if (r == region.r0) continue;
+    h_min = std::min(h_min, m.height_m[std::size_t(r)]), h_max = std::max(h_max, m.height_m[std::size_t(r)]);
+    d_max = std::max(d_max, m.diagonal_m[std::size_t(r)]);
+  }
+  if (region.r0 == region.r1) h_min = h_max = m.height_m[std::size_t(region.r0)], d_max = std::hypot(w_max, h_max);
+  const double slack = octile_slack(w_min, w_max, h_min, h_max, d_max);
   std::vector<float> from_a(n, float(kInfinity)), from_b(n, float(kInfinity));
   Reach out;
   out.needed = area;
@@ -129,9 +135,12 @@ Reach reach_bound(const CellMetrics& m, const Box& region, const Box& area, Cell
       if (e.f > double(g[e.i]) || (read[e.i] & (second ? 2 : 1))) continue;
       read[e.i] |= second ? 2 : 1;
       const int col = region.c0 + int(e.i % std::size_t(cols)), row = region.r0 + int(e.i / std::size_t(cols));
-      if (second && from_a[e.i] < limit) {
+      if (second) {
         const double through = double(from_a[e.i]) + e.f;
-        if (through < limit) out.needed = out.needed.united({col, row, col, row});
+        // Past the limit here, past it beyond: a cell y reached through this one has
+        // D_a(y) + D_b(y) >= D_a(here) + D_b(here) (the steps cost the same both ways).
+        if (through >= limit) continue;
+        out.needed = out.needed.united({col, row, col, row});
         if (!area.holds(col, row)) out.outside = std::min(out.outside, through);
       }
       for (int dr = -1; dr <= 1; ++dr)
@@ -139,11 +148,9 @@ Reach reach_bound(const CellMetrics& m, const Box& region, const Box& area, Cell
           if ((dc == 0 && dr == 0) || !region.holds(col + dc, row + dr)) continue;
           // height_m[r] and diagonal_m[r] join rows r - 1 and r.
           const std::size_t lower = std::size_t(std::max(row, row + dr));
-          const double length = dr == 0 ? std::min(m.width_m[std::size_t(row)], m.width_m[std::size_t(row + dr)])
-                                : dc == 0 ? m.height_m[lower]
-                                          : m.diagonal_m[lower];
+          const double length = dr == 0 ? m.width_m[std::size_t(row)] : dc == 0 ? m.height_m[lower] : m.diagonal_m[lower];
           const std::size_t j = at(col + dc, row + dr);
-          const double d = e.f + length / kOctileSlack * per_metre * std::min(factor[e.i], factor[j]);
+          const double d = e.f + length / slack * per_metre * std::min(factor[e.i], factor[j]);
           // Stored as floats rounded down: still lower bounds.
           float stored = float(d);
           if (double(stored) > d) stored = std::nextafter(stored, 0.0f);
@@ -159,6 +166,20 @@ Reach reach_bound(const CellMetrics& m, const Box& region, const Box& area, Cell
 }
 
 }  // namespace
+
+double octile_slack(double w_min, double w_max, double h_min, double h_max, double d_max) {
+  // A move of a >= b cells (a across, b along, or the other way) is at least |(a w_min, b h_min)|
+  // long; its 8-connected steps at most (a - b) w_max + b d_max. The worst ratio over the
+  // directions t = b / a, sampled finely (the ratio is smooth: 1e-3 covers the samples' gaps).
+  constexpr int kSamples = 4096;
+  double worst = 1;
+  for (int k = 0; k <= kSamples; ++k) {
+    const double t = double(k) / kSamples;
+    worst = std::max(worst, ((1 - t) * w_max + t * d_max) / std::hypot(w_min, t * h_min));
+    worst = std::max(worst, ((1 - t) * h_max + t * d_max) / std::hypot(h_min, t * w_min));
+  }
+  return worst * (1 + 1e-3);
+}
 
 int window_margin_cells(double road_radius_m, double reach_m, double min_cell_m) {
   return int(std::ceil(std::max(road_radius_m, reach_m) / min_cell_m)) + 2;
@@ -201,13 +222,13 @@ WindowedRoad route_by_windows(const TerrainGrid& grid, const ReadTerrainWindow& 
     if (region.cells() == area.cells()) return false;
     int reach_cells = 1;  // the surface arcs' reach
     for (std::size_t k = 0; k < g.surface_arcs(); ++k) reach_cells = std::max({reach_cells, std::abs(g.arcs()[k].dcol), std::abs(g.arcs()[k].drow)});
+    if (cost >= kMargin * per_metre * detour_m(a, b, region, grid, scale)) return false;  // a road leaving the region might
     std::vector<float> factor;
     reuse->over_box(region.c0, region.r0, region.c1, region.r1, factor);
     least_within(factor, region, reach_cells);
     std::vector<std::uint8_t> read_cells;
     const Reach r = reach_bound(metrics, region, area, a, b, cheapest, cost / kMargin, factor, read_cells);
     reuse->read(region.c0, region.r0, region.c1, region.r1, read_cells);
-    if (cost >= kMargin * per_metre * detour_m(a, b, region, grid, scale)) return false;  // a road leaving the region might
     if (cost <= kMargin * r.outside) {
       out.proved_by_reach = true;
       return true;
@@ -259,6 +280,7 @@ WindowedRoad route_by_windows(const TerrainGrid& grid, const ReadTerrainWindow& 
     if (needed && !reached) next = next.united(*needed);
     if (too_large(next)) {
       int fits = 0, over = std::max(area.c1 - area.c0, area.r1 - area.r0) + 1;  // the largest growth that fits
+      if (!too_large(area.grown(over, grid))) fits = over;
       while (over - fits > 1) (too_large(area.grown((fits + over) / 2, grid)) ? over : fits) = (fits + over) / 2;
       next = area.grown(fits, grid);
       if (4 * next.cells() < 5 * area.cells()) {

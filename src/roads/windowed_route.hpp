@@ -46,6 +46,12 @@ inline constexpr double kSearchBytesPerNode = 48;
 /// search freed, at this rate.
 inline constexpr double kReachBytesPerCell = 64;
 
+/// How many times longer the 8-connected steps along a straight move can be than the move, on
+/// cells whose widths lie in [w_min, w_max], heights in [h_min, h_max], diagonals at most d_max
+/// (metres): 1.0824 on square cells, more on a geographic grid's narrower ones (1.13 at 47.5
+/// degrees). The reach bound divides its steps by it.
+double octile_slack(double w_min, double w_max, double h_min, double h_max, double d_max);
+
 /// The margin WindowOptions::margin_cells needs: the road radius and a reach (the corridor's:
 /// its platform's half-width plus its tallest side), in the grid's smallest cells, plus 2.
 int window_margin_cells(double road_radius_m, double reach_m, double min_cell_m);
@@ -67,9 +73,11 @@ struct WindowedRoad {
 /// road that leaves I could: cheapest cost per metre x 0.995 x the shortest length from one end to
 /// the other through a cell outside I (the straight-line bound of RoadGraph::lower_bound, at the
 /// grid's smallest cell). Then the road's cost is the whole grid's optimum; its cells are the
-/// whole grid's road too unless two roads cost exactly the same. Else the area grows (at least
-/// doubles) up to what max_cells allows; a road still not proved, not found, or a ferry (the
-/// window's land masses) is then the largest window's answer (WindowedRoad::limited), as is the
+/// whole grid's road too unless two roads cost exactly the same. Else the area grows: to the box
+/// the reach bound needs (below), or at least doubled and holding what the straight line needs; past
+/// max_cells, at once to the largest window it allows, unless that is less than a quarter more. A road
+/// still not proved, not found, or a ferry (the window's land masses) is then the largest window's
+/// answer (WindowedRoad::limited), as is the
 /// previous window's when a search stores more than RoutingOptions::max_nodes (no road on the first). A first
 /// window (the ends and pad_cells) past max_cells throws bad_input naming it. The Bézier router is
 /// not searched by windows (bad_input).
@@ -78,6 +86,7 @@ struct WindowedRoad {
 /// the factors of the roads nearby, read from no terrain) proves the road or names the area a cheaper
 /// road could use, which the next window holds. Its region takes the memory the search's nodes
 /// freed (kReachBytesPerCell against kSearchBytesPerNode).
+///
 /// Road reuse (route_network by windows): the roads built so far.
 struct WindowReuse {
   /// Their discount over a window's cells (ArcDiscount on the window's indices), or nullptr for

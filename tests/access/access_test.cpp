@@ -141,8 +141,8 @@ TEST(Access, CoverageCountsPeopleWithinEachThreshold) {
 }
 
 TEST(Access, ByTilesTheWholeGridsTimesAndIds) {
-  // Random hills, lakes, nodata, roads of every class (some tunnels), destinations: by tiles of 1
-  // to 37 cells (a knight's move crosses tiles of 1), the times and ids are the whole grid's, bit for
+  // Random hills, lakes, nodata, roads of every class (some tunnels), destinations: by tiles of 2
+  // to 37 cells (a knight's move crosses a tile of 2), the times and ids are the whole grid's, bit for
   // bit, and so is the count of land that reaches nothing. A flat grid makes exact ties, where the
   // smaller id must win on both sides.
   std::mt19937_64 rng(34);
@@ -152,12 +152,16 @@ TEST(Access, ByTilesTheWholeGridsTimesAndIds) {
     const bool flat = trial % 5 == 0;
     std::vector<std::array<double, 4>> hills;
     for (int k = 0; k < 6; ++k) hills.push_back({u(rng) * cols, u(rng) * rows, 50 + 300 * u(rng), 3 + 8 * u(rng)});
-    const Dem dem = grid(cols, rows, [&](int c, int r) {
+    Dem dem = grid(cols, rows, [&](int c, int r) {
       if (flat) return 10.0;
       double z = 20;
       for (const auto& h : hills) z += h[2] * std::exp(-((c - h[0]) * (c - h[0]) + (r - h[1]) * (r - h[1])) / (2 * h[3] * h[3]));
       return z;
     });
+    if (trial % 3 == 2) {  // geographic, 3" cells: a window's origin differs from the grid's in the last bits
+      dem.georef().transform = {9.0, 1.0 / 1200, 0.0, 47.5, 0.0, -1.0 / 1200};
+      dem.georef().crs = crs_from_user("EPSG:4326");
+    }
     Dem holed = dem;
     Raster<std::uint8_t> land = all_land(dem);
     for (int k = 0; k < 3; ++k) {  // lakes
@@ -188,19 +192,18 @@ TEST(Access, ByTilesTheWholeGridsTimesAndIds) {
     const RoadCells cells = road_cells(roads, dem, options);
     const AccessResult whole = travel_time(holed, land, cells, towns, options, quiet);
 
-    const int tile = trial == 0 ? 1 : 1 + int(rng() % 37);
+    const int tile = trial == 0 ? 2 : 2 + int(rng() % 36);
     const ReadAccessWindow read = [&](int c0, int r0, int w, int h) {
       Georef g = dem.georef();
       g.transform[0] += c0 * g.transform[1];
       g.transform[3] += r0 * g.transform[5];
-      AccessWindow out{Raster<float>(w, h, g), Raster<std::uint8_t>(w, h, g), {Raster<float>(w, h, g), Raster<std::uint8_t>(w, h, g)}};
+      AccessWindow out{Raster<float>(w, h, g), Raster<std::uint8_t>(w, h, g), {}};
       for (int r = 0; r < h; ++r)
         for (int c = 0; c < w; ++c) {
           out.dem(c, r) = holed(c0 + c, r0 + r);
           out.passable(c, r) = land(c0 + c, r0 + r);
-          out.roads.kmh(c, r) = cells.kmh(c0 + c, r0 + r);
-          out.roads.tunnel(c, r) = cells.tunnel(c0 + c, r0 + r);
         }
+      out.roads = road_cells(roads, out.dem, options, dem.georef(), c0, r0);  // drawn on each window, as the run does
       return out;
     };
     Raster<float> minutes = dem.like<float>(-7.0f);
@@ -208,7 +211,7 @@ TEST(Access, ByTilesTheWholeGridsTimesAndIds) {
     int written = 0;
     const WriteAccessTile write = [&](int c0, int r0, AccessResult&& t) {
       ++written;
-      EXPECT_EQ(t.minutes.georef().transform[0], dem.georef().transform[0] + c0 * kCell);
+      EXPECT_EQ(t.minutes.georef().transform[0], dem.georef().transform[0] + c0 * dem.georef().transform[1]);
       for (int r = 0; r < t.minutes.rows(); ++r)
         for (int c = 0; c < t.minutes.cols(); ++c) {
           minutes(c0 + c, r0 + r) = t.minutes(c, r);
@@ -224,9 +227,6 @@ TEST(Access, ByTilesTheWholeGridsTimesAndIds) {
         ASSERT_EQ(whole.minutes[i], minutes[i]) << trial << " cell " << i << " tile " << tile;
       }
       ASSERT_EQ(whole.nearest[i], nearest[i]) << trial << " cell " << i << " tile " << tile;
-    }
-    if (tile < std::max(cols, rows)) {
-      EXPECT_GT(tiled.tile_runs, tiled.tiles) << trial;  // frames improved: searched again
     }
   }
 }

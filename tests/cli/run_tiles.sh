@@ -3,8 +3,8 @@
 # terrain, hydro and density stages read the DEM by windows and write one GeoTIFF a tile and a VRT
 # per raster, the same cells as the run on the whole grid, the same streams and figures; the sites
 # stage reads the density's tiles by bands and blocks, the roads stage searches each link on a
-# window of the DEM; the settlements, the network, the roads and preview.png are the whole grid's
-# bytes; memory bounded by the limit; what is not computed on tiles yet refused before any stage.
+# window of the DEM, the access stage its travel times by tiles; the settlements, the network, the
+# roads, the catchments and preview.png are the whole grid's bytes; memory bounded by the limit; what is not computed on tiles yet refused before any stage.
 # SPDX-License-Identifier: MIT
 source "$(dirname "$0")/lib.sh" "$@"
 cd "$WORK"

@@ -130,8 +130,8 @@ TEST(RoadByWindows, GivesTheWholeGridsRoadOnRandomLandscapes) {
 TEST(RoadByWindows, UnderRoadReuseTheReachBoundProvesTheWholeGridsRoad) {
   // Roads already built (factor 0.5 along random lines): the straight-line bound at half the
   // cheapest cost per metre rarely proves a road; the reach bound (the roads' factors only where
-  // they are) does, and the road is still the whole grid's. With the bound made 4 times too large
-  // (an invalid proof) the roads differ.
+  // they are) does, and the road is still the whole grid's. (Checked by hand: with the bound made
+  // 4 times too large, an invalid proof, this test fails.)
   std::mt19937_64 rng(7);
   int routed = 0, by_reach = 0;
   for (int trial = 0; trial < 12; ++trial) {
@@ -197,6 +197,30 @@ TEST(RoadByWindows, UnderRoadReuseTheReachBoundProvesTheWholeGridsRoad) {
   }
   EXPECT_GE(routed, 30);
   EXPECT_GE(by_reach, 5);  // the reach bound decided some, and rightly
+}
+
+TEST(RoadByWindows, TheReachBoundsSlackCoversEveryMoveOnNarrowCells) {
+  // Square cells: the 8-connected steps along a move are at most 1.0824 times as long (22.5 degrees).
+  const double square = octile_slack(30, 30, 30, 30, 30 * std::sqrt(2.0));
+  EXPECT_GT(square, 1.0823);
+  EXPECT_LT(square, 1.0840);
+  // Cells 3" wide at 47.5 degrees (63 x 93 m): more, and every move of up to 60 cells within it.
+  std::mt19937_64 rng(4);
+  for (int trial = 0; trial < 50; ++trial) {
+    const double lat = 60 * double(rng() % 1000) / 1000, h = 92.6, w = h * std::cos(lat / 57.29577951308232);
+    const double spread = 1 + 0.01 * double(rng() % 5);  // rows of slightly different widths
+    const double slack = octile_slack(w, w * spread, h, h * spread, std::hypot(w * spread, h * spread));
+    for (int a = 0; a <= 60; ++a)
+      for (int b = 0; b <= 60; ++b) {
+        if (a == 0 && b == 0) continue;
+        const int lo = std::min(a, b), hi = std::max(a, b);
+        const double steps = (hi - lo) * (a >= b ? w * spread : h * spread) + lo * std::hypot(w * spread, h * spread);
+        ASSERT_LE(steps / std::hypot(a * w, b * h), slack) << lat << " " << a << " " << b;
+      }
+    if (lat > 40) {
+      EXPECT_GT(slack, 1.10) << lat;  // the square cells' 1.09 would not do
+    }
+  }
 }
 
 TEST(RoadByWindows, ARoadLargerThanTheLimitIsRefusedNamingIt) {
