@@ -913,15 +913,16 @@ void access_run_tiles(RunState& s, Progress& progress, const Log& log) {
   const int cols = s.grid.cols, rows = s.grid.rows;
   // A tile's search holds about 100 bytes a cell (the roads' terrain for the land, the DEM, roads,
   // times, ids, the queue): the tiles take half of what the limit leaves.
-  // The tiles' frames (12 bytes a cell of their two outer rows and columns) a quarter of the rest.
-  const double frames_mb = 12.0 * 8 * double(cols) * double(rows) / 1e6, tile_mb = 0.5 * budget_mb;
+  // The tiles' frames (12 bytes a cell of their two outer rows and columns: 96 / side a grid cell)
+  // at most a quarter of it.
+  const double tile_mb = 0.5 * budget_mb, frames_mb_by_side = 96.0 * double(cols) * double(rows) / 1e6;
   int side = in.tiles.tile_size;
   if (side <= 0) {
     side = std::max(16, std::min(int(std::sqrt(tile_mb * 1e6 / 100)) - 4, std::max(cols, rows)));
-    side = std::max(side, int(std::ceil(frames_mb / (0.25 * budget_mb))));  // frames of larger tiles take less
+    side = std::max(side, int(std::ceil(frames_mb_by_side / (0.25 * budget_mb))));  // larger tiles, fewer frame cells
     if (100.0 * (side + 4.0) * (side + 4.0) / 1e6 > tile_mb)
-      throw bad_input("/input/memory_limit_mb: too little for the access stage's tiles and their frames (" + std::to_string(std::llround(frames_mb / side)) +
-                      " MB of frames at tiles of " + std::to_string(side) + " cells)");
+      throw bad_input("/input/memory_limit_mb: too little for the access stage's tiles and their frames (" +
+                      std::to_string(std::llround(frames_mb_by_side / side)) + " MB of frames at tiles of " + std::to_string(side) + " cells)");
   }
   // A band of rows: times, ids (read as floats and as ids), people, density, buildable: 24 bytes a cell.
   const int band = std::clamp(int(0.25 * budget_mb * 1e6 / 24 / cols), 1, rows);
