@@ -943,23 +943,12 @@ void access_run_tiles(RunState& s, Progress& progress, const Log& log) {
   // People per cell as sites::people_on_land: the density's mass over the land, in the whole grid's order.
   const CellMetrics metrics = cell_metrics(s.grid.georef, cols, rows);
   const double total = access_people(s);
-  double mass = 0;
+  sites::PeopleOnLand on_land(s.grid.georef, cols, rows, total);
   for (int r0 = 0; r0 < rows; r0 += band) {
     const int h = std::min(band, rows - r0);
-    const Dem d = density.read(0, r0, cols, h), b = buildable.read(0, r0, cols, h);
-    for (int r = 0; r < h; ++r)
-      for (int c = 0; c < cols; ++c)
-        if (b(c, r) == 1 && std::isfinite(d(c, r))) mass += double(d(c, r)) * metrics.area_m2[std::size_t(r0 + r)];
+    on_land.add(density.read(0, r0, cols, h), buildable.read(0, r0, cols, h), r0);
   }
-  const auto people_band = [&](int r0, int h) {
-    const Dem d = density.read(0, r0, cols, h), b = buildable.read(0, r0, cols, h);
-    Raster<float> people = d.like<float>(0.0f);
-    if (mass > 0)
-      for (int r = 0; r < h; ++r)
-        for (int c = 0; c < cols; ++c)
-          if (b(c, r) == 1 && std::isfinite(d(c, r))) people(c, r) = float(total * double(d(c, r)) * metrics.area_m2[std::size_t(r0 + r)] / mass);
-    return people;
-  };
+  const auto people_band = [&](int r0, int h) { return on_land.people(density.read(0, r0, cols, h), buildable.read(0, r0, cols, h), r0); };
   std::vector<access::Settlement> settlements;
   for (const auto& site : s.sites) settlements.push_back({{site.col, site.row, site.id}, double(site.population)});
   log.detail("access by tiles: tiles of " + std::to_string(side) + " cells, bands of " + std::to_string(band) + " rows");

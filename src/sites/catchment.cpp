@@ -68,26 +68,15 @@ std::vector<double> catchment_people(const Land& land, const std::vector<Site>& 
   return people;
 }
 
+PeopleOnLand::PeopleOnLand(const Georef& grid, int cols, int rows, double total)
+    : area_m2_(cell_metrics(grid, cols, rows).area_m2), total_(total) {}
+
 Raster<float> people_on_land(const Raster<float>& density, const Raster<std::uint8_t>& buildable, double total) {
   if (buildable.cols() != density.cols() || buildable.rows() != density.rows())
     throw bad_input("sites: the buildable mask and the density model are not on the same grid");
-  const CellMetrics metrics = cell_metrics(density.georef(), density.cols(), density.rows());
-  Raster<float> people = density.like<float>(0.0f);
-  double mass = 0;
-  for (int r = 0; r < density.rows(); ++r)
-    for (int c = 0; c < density.cols(); ++c) {
-      const std::size_t i = density.index(c, r);
-      if (buildable[i] != 1 || buildable.is_nodata(i) || !std::isfinite(density[i])) continue;
-      mass += double(density[i]) * metrics.area_m2[std::size_t(r)];
-    }
-  if (!(mass > 0)) return people;
-  for (int r = 0; r < density.rows(); ++r)
-    for (int c = 0; c < density.cols(); ++c) {
-      const std::size_t i = density.index(c, r);
-      if (buildable[i] == 1 && !buildable.is_nodata(i) && std::isfinite(density[i]))
-        people[i] = float(total * double(density[i]) * metrics.area_m2[std::size_t(r)] / mass);
-    }
-  return people;
+  PeopleOnLand people(density.georef(), density.cols(), density.rows(), total);
+  people.add(density, buildable, 0);
+  return people.people(density, buildable, 0);
 }
 
 }  // namespace terrapolis::sites

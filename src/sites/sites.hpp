@@ -1,6 +1,7 @@
 // City sites: size quotas, placement on a density model and the inclusion hierarchy (Belhadj §4.3.1).
 // SPDX-License-Identifier: MIT
 #pragma once
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <string>
@@ -219,6 +220,38 @@ std::vector<double> catchment_people(const Land& land, const std::vector<Site>& 
 /// `total` people spread over the habitable cells as catchment_people spreads them (in proportion
 /// to density x cell area), per cell; 0 elsewhere.
 Raster<float> people_on_land(const Raster<float>& density, const Raster<std::uint8_t>& buildable, double total);
+
+/// people_on_land over a grid read by bands of whole rows: add() every band, in order (the density's
+/// mass over the land, summed in the whole grid's order), then people() of any band gives the
+/// whole grid's values. `buildable` is the mask as written (1 habitable) or read back as floats.
+class PeopleOnLand {
+ public:
+  PeopleOnLand(const Georef& grid, int cols, int rows, double total);
+  template <class B>
+  void add(const Raster<float>& density, const Raster<B>& buildable, int row0) {
+    for (int r = 0; r < density.rows(); ++r)
+      for (int c = 0; c < density.cols(); ++c)
+        if (habitable(density, buildable, density.index(c, r))) mass_ += double(density(c, r)) * area_m2_[std::size_t(row0 + r)];
+  }
+  template <class B>
+  Raster<float> people(const Raster<float>& density, const Raster<B>& buildable, int row0) const {
+    Raster<float> out = density.template like<float>(0.0f);
+    if (mass_ > 0)
+      for (int r = 0; r < density.rows(); ++r)
+        for (int c = 0; c < density.cols(); ++c)
+          if (habitable(density, buildable, density.index(c, r)))
+            out(c, r) = float(total_ * double(density(c, r)) * area_m2_[std::size_t(row0 + r)] / mass_);
+    return out;
+  }
+
+ private:
+  template <class B>
+  static bool habitable(const Raster<float>& density, const Raster<B>& buildable, std::size_t i) {
+    return buildable[i] == B(1) && !buildable.is_nodata(i) && std::isfinite(density[i]);
+  }
+  std::vector<double> area_m2_;  ///< the grid's cell area per row
+  double total_ = 0, mass_ = 0;
+};
 
 /// People per km² above which a whole region counts as urban: the cell density of an urban
 /// centre in the EU-OECD degree of urbanisation (1,500; Dijkstra & Poelman 2014).
