@@ -195,11 +195,6 @@ json run_scenario(const Scenario& scenario, const RunOptions& options, Progress&
     grid = grid_of(dem);
   }
   const std::size_t last = options.until.empty() ? stages().size() - 1 : stage_index("--until", options.until);
-  for (std::size_t i = 0; tiles.given() && i <= last; ++i)
-    if (!stages()[i].by_tiles)
-      throw bad_input(scenario.source + std::string(tiles.tile_size > 0 ? ": /input/tile_size" : ": /input/memory_limit_mb") +
-                      ": a run works tile by tile up to the " + stages()[i - 1].name + " stage yet (the " + stages()[i].name +
-                      " stage reads the whole grid): add --until " + stages()[i - 1].name);
   // Every stage's settings and checks before the first stage runs, and before anything is created.
   StageSettings settings;
   for (const StageDef& stage : stages()) {

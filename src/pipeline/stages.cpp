@@ -941,7 +941,6 @@ void access_run_tiles(RunState& s, Progress& progress, const Log& log) {
     return out;
   };
   // People per cell as sites::people_on_land: the density's mass over the land, in the whole grid's order.
-  const CellMetrics metrics = cell_metrics(s.grid.georef, cols, rows);
   const double total = access_people(s);
   sites::PeopleOnLand on_land(s.grid.georef, cols, rows, total);
   for (int r0 = 0; r0 < rows; r0 += band) {
@@ -997,7 +996,7 @@ void access_run_tiles(RunState& s, Progress& progress, const Log& log) {
         const Dem idf = ids->read(0, r0, cols, h);  // ids as floats: exact below 2^24 settlements
         Raster<std::int32_t> id = idf.like<std::int32_t>(-1);
         for (std::size_t i = 0; i < id.size(); ++i) id[i] = std::isnan(idf[i]) ? -1 : std::int32_t(idf[i]);
-        sums.add(id, m, people, metrics.area_m2, r0);
+        sums.add(id, m, people, on_land.area_m2(), r0);
       }
     }
     if (all) s.write("access", "access_catchments.geojson",
@@ -1084,13 +1083,13 @@ const StageDef& stage(const std::string& name) {
 
 const std::vector<StageDef>& stages() {
   static const std::vector<StageDef> list = {
-      {"terrain", {"dem", "input"}, terrain_prepare, terrain_run, terrain_load, terrain_summary, true},
-      {"hydro", {"water", "hydro"}, hydro_prepare, hydro_run, hydro_load, hydro_summary, true},
-      {"density", {"density", "plugins"}, density_prepare, density_run, density_load, density_summary, true},
-      {"sites", {"sites", "seed"}, sites_prepare, sites_run, sites_load, sites_summary, true},
-      {"network", {"network"}, network_prepare, network_run, network_load, network_summary, true},
-      {"roads", {"roads"}, roads_prepare, roads_run, roads_load, roads_summary, true},
-      {"access", {"access"}, access_prepare, access_run, access_load, access_summary, true},
+      {"terrain", {"dem", "input"}, terrain_prepare, terrain_run, terrain_load, terrain_summary},
+      {"hydro", {"water", "hydro"}, hydro_prepare, hydro_run, hydro_load, hydro_summary},
+      {"density", {"density", "plugins"}, density_prepare, density_run, density_load, density_summary},
+      {"sites", {"sites", "seed"}, sites_prepare, sites_run, sites_load, sites_summary},
+      {"network", {"network"}, network_prepare, network_run, network_load, network_summary},
+      {"roads", {"roads"}, roads_prepare, roads_run, roads_load, roads_summary},
+      {"access", {"access"}, access_prepare, access_run, access_load, access_summary},
   };
   return list;
 }

@@ -47,9 +47,6 @@ struct StageDef {
   /// The stage's lines of the run summary, from the run's figures (run.json's `summary`, which
   /// holds this stage's entry).
   void (*summary)(const nlohmann::ordered_json& figures, SummaryText&);
-  /// Works tile by tile (input.tile_size, input.memory_limit_mb): reads the DEM by windows and
-  /// writes its rasters by tiles, when RunState::by_tiles is set.
-  bool by_tiles = false;
 };
 
 /// The stages, in data-flow order: the one list the runner, --help and the docs read.

@@ -233,6 +233,8 @@ class PeopleOnLand {
       for (int c = 0; c < density.cols(); ++c)
         if (habitable(density, buildable, density.index(c, r))) mass_ += double(density(c, r)) * area_m2_[std::size_t(row0 + r)];
   }
+  /// The grid's cell area per row (m²).
+  const std::vector<double>& area_m2() const { return area_m2_; }
   template <class B>
   Raster<float> people(const Raster<float>& density, const Raster<B>& buildable, int row0) const {
     Raster<float> out = density.template like<float>(0.0f);
