@@ -31,4 +31,10 @@ void release_free_memory() {
 #endif
 }
 
+void map_large_blocks() {
+#if defined(__GLIBC__)
+  mallopt(M_MMAP_THRESHOLD, 1 << 20);  // a fixed threshold also stops glibc's raising it
+#endif
+}
+
 }  // namespace terrapolis

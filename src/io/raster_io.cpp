@@ -318,6 +318,7 @@ std::vector<std::string> folder_tiles(const std::string& folder) {
 
 double reserve_reader_memory(double limit_mb) {
   init_gdal();
+  map_large_blocks();
   release_free_memory();  // what an earlier step freed is not the process's any more
   double cache_mb = std::min(64.0, limit_mb / 8);
   if (!CPLGetConfigOption("GDAL_CACHEMAX", nullptr)) GDALSetCacheMax64(GIntBig(cache_mb * 1e6));

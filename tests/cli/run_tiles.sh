@@ -70,7 +70,9 @@ peak = max(s["peak_memory_mb"] for s in t["timings"])
 whole = max(s["peak_memory_mb"] for s in w["timings"])
 print(f"nz: peak {peak:.0f} MB by tiles (limit {sys.argv[1]} MB), {whole:.0f} MB on the whole grid")
 import os
-assert os.environ.get("ASAN_OPTIONS") or peak <= float(sys.argv[1]) < whole, (peak, whole)
+# The heap's slack (freed pages a thread's arena keeps) is not planned: 5 % over the limit at most
+# (the continuous integration once peaked at 172 MB here before large blocks were mapped apart).
+assert os.environ.get("ASAN_OPTIONS") or peak <= 1.05 * float(sys.argv[1]) < whole, (peak, whole)
 PY
 
 # The region as it is: the real places of Cap Corse (GeoNames) kept where they are, on tiles too.
