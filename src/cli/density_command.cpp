@@ -187,6 +187,8 @@ class DensityCommand final : public Command {
     if (!options.factors.empty() || !scenario.resolved["density"]["layers"].empty())
       throw bad_input("--layer: user layers are rescaled by their range over the grid, not computed on tiles yet");
     if (!plugins_.specs.empty()) throw bad_input("--plugin: plugins are not run on tiles yet");
+    if (rivers_used(options))
+      throw bad_input("river_near: this command does not find the rivers on tiles (terrapolis run does): give it weight 0, and no boosted model");
     const bool hydrometry = hydrometry_used(options), compute_hydrometry = hydrometry && hydrometry_path_.empty();
     const hydro::HydroOptions hydro = pipeline::hydro_options(scenario);
     if (compute_hydrometry && hydro.hydrometry.method != hydro::HydrometryMethod::belhadj)
@@ -220,7 +222,7 @@ class DensityCommand final : public Command {
     for (const char* l : layers)
       if (hydrometry || std::string(l) != "hydrometry") fs::create_directory(dir / l);
     const density::TiledDensityReport report = density::run_tiled_density(
-        h.cols, h.rows, h.georef, read, options, tiles.tile_size, tiles.limit_mb(),
+        h.cols, h.rows, h.georef, read, options, tiles.tile_size, tiles.limit_mb(), computed->path(),
         [&](int t, int across, const density::DensityResult& tile) {
           write_rasters(tile, options, terms(scenario), [&](const std::string& n) { return MosaicFiles{dir.string(), n}.tile(t, across); });
         },

@@ -19,6 +19,7 @@
 #include "density/boosted.hpp"
 #include "density/calibration.hpp"
 #include "density/disc_sums.hpp"
+#include "density/global_terms.hpp"
 #include "density/tiled_density.hpp"
 
 namespace terrapolis::density {
@@ -93,56 +94,7 @@ float slope_deg(const Dem& dem, const CellMetrics& m, int c, int r) {
   return float(std::atan(std::hypot(dx, dy)) * 180.0 / std::numbers::pi);
 }
 
-/// The 1-D squared distance transform of f sampled at increasing positions y (Felzenszwalb &
-/// Huttenlocher 2012, non-uniform samples): d[q] = min_p f[p] + (y[q] - y[p])^2.
-void lower_envelope(const std::vector<double>& y, const std::vector<double>& f, std::vector<double>& d, std::vector<int>& v,
-                    std::vector<double>& z) {
-  const int n = int(y.size());
-  int k = -1;
-  for (int q = 0; q < n; ++q) {
-    if (!std::isfinite(f[std::size_t(q)])) continue;
-    while (k >= 0) {
-      const int p = v[std::size_t(k)];
-      const double s = ((f[std::size_t(q)] + y[std::size_t(q)] * y[std::size_t(q)]) - (f[std::size_t(p)] + y[std::size_t(p)] * y[std::size_t(p)])) /
-                       (2 * (y[std::size_t(q)] - y[std::size_t(p)]));
-      if (s <= z[std::size_t(k)]) --k;
-      else {
-        z[std::size_t(k + 1)] = s;
-        break;
-      }
-    }
-    if (k < 0) z[0] = -std::numeric_limits<double>::infinity();
-    v[std::size_t(++k)] = q;
-    z[std::size_t(k + 1)] = std::numeric_limits<double>::infinity();
-  }
-  if (k < 0) {
-    std::fill(d.begin(), d.end(), std::numeric_limits<double>::infinity());
-    return;
-  }
-  for (int q = 0, j = 0; q < n; ++q) {
-    while (z[std::size_t(j + 1)] < y[std::size_t(q)]) ++j;
-    const int p = v[std::size_t(j)];
-    d[std::size_t(q)] = f[std::size_t(p)] + (y[std::size_t(q)] - y[std::size_t(p)]) * (y[std::size_t(q)] - y[std::size_t(p)]);
-  }
-}
 
-/// Replaces each value by its rank among the raster's values (NaN skipped): the share of values
-/// below it, ties counted half, in [0,1]. Scale-free, so that "low for this region" means the same
-/// in the Alps and on a coastal plain.
-void to_land_rank(Raster<float>& r) {
-  std::vector<float> sorted;
-  for (std::size_t i = 0; i < r.size(); ++i)
-    if (!std::isnan(r[i])) sorted.push_back(r[i]);
-  std::sort(sorted.begin(), sorted.end());
-  const double n = double(sorted.size());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, r.size(), 1 << 14), [&](const tbb::blocked_range<std::size_t>& range) {
-    for (std::size_t i = range.begin(); i < range.end(); ++i) {
-      if (std::isnan(r[i])) continue;
-      const auto lo = std::lower_bound(sorted.begin(), sorted.end(), r[i]), hi = std::upper_bound(lo, sorted.end(), r[i]);
-      r[i] = float((double(lo - sorted.begin()) + 0.5 * double(hi - lo)) / n);
-    }
-  });
-}
 
 }  // namespace
 
@@ -174,38 +126,6 @@ void check_settings(const DensityOptions& o, const std::vector<double>& layer_we
   if (!any && !o.model) throw bad_input("/density/weights: every weight is 0 (and every layer's), the density would be undefined");
 }
 
-std::vector<float> distance_to_m(const std::vector<std::uint8_t>& feature, const CellMetrics& metrics, int cols, int rows) {
-  const std::size_t n = std::size_t(cols) * std::size_t(rows);
-  std::vector<double> row_d2(n);
-  // Rows: squared metres to the nearest feature of the row, at the row's width.
-  tbb::parallel_for(tbb::blocked_range<int>(0, rows, 8), [&](const tbb::blocked_range<int>& range) {
-    std::vector<double> y(static_cast<std::size_t>(cols)), f(static_cast<std::size_t>(cols)), d(static_cast<std::size_t>(cols)),
-        z(std::size_t(cols) + 1);
-    std::vector<int> v(static_cast<std::size_t>(cols));
-    for (int r = range.begin(); r < range.end(); ++r) {
-      const double w = metrics.width_m[std::size_t(r)];
-      for (int c = 0; c < cols; ++c) {
-        y[std::size_t(c)] = c * w;
-        f[std::size_t(c)] = feature[std::size_t(r) * std::size_t(cols) + std::size_t(c)] ? 0.0 : std::numeric_limits<double>::infinity();
-      }
-      lower_envelope(y, f, d, v, z);
-      for (int c = 0; c < cols; ++c) row_d2[std::size_t(r) * std::size_t(cols) + std::size_t(c)] = d[std::size_t(c)];
-    }
-  });
-  std::vector<double> northing(static_cast<std::size_t>(rows), 0.0);
-  for (int r = 1; r < rows; ++r) northing[std::size_t(r)] = northing[std::size_t(r - 1)] + metrics.height_m[std::size_t(r)];
-  std::vector<float> out(n);
-  tbb::parallel_for(tbb::blocked_range<int>(0, cols, 16), [&](const tbb::blocked_range<int>& range) {
-    std::vector<double> f(static_cast<std::size_t>(rows)), d(static_cast<std::size_t>(rows)), z(std::size_t(rows) + 1);
-    std::vector<int> v(static_cast<std::size_t>(rows));
-    for (int c = range.begin(); c < range.end(); ++c) {
-      for (int r = 0; r < rows; ++r) f[std::size_t(r)] = row_d2[std::size_t(r) * std::size_t(cols) + std::size_t(c)];
-      lower_envelope(northing, f, d, v, z);
-      for (int r = 0; r < rows; ++r) out[std::size_t(r) * std::size_t(cols) + std::size_t(c)] = float(std::sqrt(d[std::size_t(r)]));
-    }
-  });
-  return out;
-}
 
 double combine(const double* weights, const double* values, std::size_t n) {
   double negative = 0, total = 0, sum = 0;
@@ -457,20 +377,19 @@ bool terrain_used(const DensityOptions& options) {
 }
 
 /// Topographic position (Weiss 2001; Guisan et al. 1999): each land cell's altitude minus the mean
-/// altitude of the land cells within `radius_m` (the disc of DiscPlan), NaN off land.
-Raster<float> topographic_position(const Dem& dem, const Grid& g, double radius_m, int max_bands) {
+/// altitude of the land cells within the disc of `plan`, NaN off land and off the core.
+Raster<float> topographic_position(const Dem& dem, const Grid& g, const DiscPlan& plan) {
   Raster<float> out = dem.like<float>(nan_f);
-  const DiscPlan plan(g.metrics, g.rows, radius_m, max_bands);
   const Window win = disc_window(g, plan, plan);
   const std::vector<std::uint8_t>& kind = g.kind;
   const double mid = g.land_min <= g.land_max ? 0.5 * (double(g.land_min) + double(g.land_max)) : 0.0;
   const SummedArea<std::uint32_t> count(win, g.cols, [&](std::size_t i) { return std::uint32_t(kind[i] == land); });
   const SummedArea<double> sum(win, g.cols, [&](std::size_t i) { return kind[i] == land ? double(dem[i]) - mid : 0.0; });
-  tbb::parallel_for(tbb::blocked_range<int>(0, g.rows, 4), [&](const tbb::blocked_range<int>& range) {
+  tbb::parallel_for(tbb::blocked_range<int>(g.core.y0, g.core.y0 + g.core.rows, 4), [&](const tbb::blocked_range<int>& range) {
     std::vector<std::uint32_t> a(static_cast<std::size_t>(g.cols));
     std::vector<double> b(static_cast<std::size_t>(g.cols));
     for (int r = range.begin(); r < range.end(); ++r) {
-      const int x0 = g.span_lo[std::size_t(r)], x1 = g.span_hi[std::size_t(r)];
+      const int x0 = g.core_lo(r), x1 = g.core_hi(r);
       if (x0 >= x1) continue;
       std::fill(a.begin() + x0, a.begin() + x1, 0u);
       std::fill(b.begin() + x0, b.begin() + x1, 0.0);
@@ -485,40 +404,59 @@ Raster<float> topographic_position(const Dem& dem, const Grid& g, double radius_
   return out;
 }
 
-/// The terrain terms the thesis does not have (TerrainTerm, fitted by `terrapolis calibrate`).
-void terrain_terms(const Dem& dem, const Grid& g, const DensityOptions& options, DensityResult& result, Progress& progress) {
+/// The terrain terms the thesis does not have (TerrainTerm, fitted by `terrapolis calibrate`), on
+/// the core's land. On a window, `whole` gives the whole grid's discs, distances and ranks (no
+/// ranks: the terms are left unranked, for the tiles to count them).
+void terrain_terms(const Dem& dem, const Grid& g, const DensityOptions& options, const WholeTerrainFigures* whole, DensityResult& result,
+                   Progress& progress) {
   ProgressStep step(progress, "density: terrain terms");
   const std::size_t n = dem.size();
-  std::vector<std::uint8_t> wet(n), river(n, 0);
-  for (std::size_t i = 0; i < n; ++i) wet[i] = g.kind[i] == water;
-  const bool rivers_known = options.rivers.size() == n;
-  if (options.rivers.size() != 0 && !rivers_known) throw bad_input("rivers: not on the DEM's grid");
-  if (rivers_known)
-    for (std::size_t i = 0; i < n; ++i) river[i] = options.rivers[i] != 0 && options.rivers[i] != options.rivers.nodata;
-  const std::vector<float> to_water = g.any_water ? distance_to_m(wet, g.metrics, g.cols, g.rows) : std::vector<float>();
-  const std::vector<float> to_river = rivers_known ? distance_to_m(river, g.metrics, g.cols, g.rows) : std::vector<float>();
+  const bool rivers_known = whole ? whole->rivers_known : options.rivers.size() == n;
+  const bool any_water = whole ? whole->any_water : g.any_water;
+  if (!whole && options.rivers.size() != 0 && !rivers_known) throw bad_input("rivers: not on the DEM's grid");
+  std::vector<float> to_water, to_river;
+  if (whole) {
+    to_water = whole->to_water, to_river = whole->to_river;
+  } else {
+    if (any_water) to_water = distance_to_m(water_cells(dem, options), g.metrics, g.cols, g.rows);
+    if (rivers_known) to_river = distance_to_m(river_mask(options.rivers), g.metrics, g.cols, g.rows);
+  }
   step.update(0.3);
-  // Radii of at least two cells, so the disc holds the neighbours on coarse grids.
-  const double largest_step = largest_cell_step(g.metrics);
   auto term = [&](TerrainTerm t) -> Raster<float>& { return result.terrain[std::size_t(t)]; };
-  term(TerrainTerm::position_1km) = topographic_position(dem, g, std::max(1000.0, 2 * largest_step), options.ring_bands);
-  step.update(0.5);
-  term(TerrainTerm::position_5km) = topographic_position(dem, g, std::max(5000.0, 2 * largest_step), options.ring_bands);
+  if (whole) {
+    term(TerrainTerm::position_1km) = topographic_position(dem, g, whole->near);
+    step.update(0.5);
+    term(TerrainTerm::position_5km) = topographic_position(dem, g, whole->far);
+  } else {
+    const std::array<DiscPlan, 2> plans = position_discs(g.metrics, g.rows, options.ring_bands);
+    term(TerrainTerm::position_1km) = topographic_position(dem, g, plans[0]);
+    step.update(0.5);
+    term(TerrainTerm::position_5km) = topographic_position(dem, g, plans[1]);
+  }
   step.update(0.8);
   for (TerrainTerm t : {TerrainTerm::altitude, TerrainTerm::slope, TerrainTerm::coast_near, TerrainTerm::river_near})
     term(t) = dem.like<float>(nan_f);
-  tbb::parallel_for(tbb::blocked_range<int>(0, g.rows, 8), [&](const tbb::blocked_range<int>& range) {
+  tbb::parallel_for(tbb::blocked_range<int>(g.core.y0, g.core.y0 + g.core.rows, 8), [&](const tbb::blocked_range<int>& range) {
     for (int r = range.begin(); r < range.end(); ++r)
-      for (int x = 0; x < g.cols; ++x) {
+      for (int x = g.core.x0; x < g.core.x0 + g.core.cols; ++x) {
         const std::size_t i = dem.index(x, r);
         if (g.kind[i] != land) continue;
         term(TerrainTerm::altitude)[i] = dem[i];
         term(TerrainTerm::slope)[i] = slope_deg(dem, g.metrics, x, r);
-        term(TerrainTerm::coast_near)[i] = g.any_water ? float(std::exp(-double(to_water[i]) / 10000.0)) : 0.0f;
+        term(TerrainTerm::coast_near)[i] = any_water ? float(std::exp(-double(to_water[i]) / 10000.0)) : 0.0f;
         term(TerrainTerm::river_near)[i] = rivers_known ? float(std::exp(-double(to_river[i]) / 2000.0)) : 0.0f;
       }
   });
-  for (TerrainTerm t : {TerrainTerm::altitude, TerrainTerm::slope, TerrainTerm::position_1km, TerrainTerm::position_5km}) to_land_rank(term(t));
+  if (whole && !whole->ranks) return;
+  for (std::size_t k = 0; k < kRankedTerms.size(); ++k) {
+    Raster<float>& values = term(kRankedTerms[k]);
+    LandRanks own;
+    if (!whole) own.add(values.data(), values.size()), own.finish();
+    const LandRanks& ranks = whole ? (*whole->ranks)[k] : own;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, values.size(), 1 << 14), [&](const tbb::blocked_range<std::size_t>& range) {
+      for (std::size_t i = range.begin(); i < range.end(); ++i) values[i] = ranks.rank(values[i]);
+    });
+  }
 }
 
 /// The boosted trees' density of every habitable cell of the core, in [0,1] (NaN elsewhere).
@@ -635,10 +573,10 @@ void gather_stats(const Dem& dem, const Grid& g, DensityResult& result) {
 namespace {
 
 /// The model on `grid` once its masks are known, with the discs of the whole grid and, on a
-/// window, the whole grid's coast and plateau maxima.
+/// window, the whole grid's coast and plateau maxima and terrain figures.
 void characteristics(const Dem& dem, const Grid& grid, const DiscPlan& inner, const DiscPlan& outer, double r_min,
-                     const std::optional<std::array<float, 2>>& maxima, const DensityOptions& options, DensityResult& result,
-                     Progress& progress) {
+                     const std::optional<std::array<float, 2>>& maxima, const WholeTerrainFigures* terrain, const DensityOptions& options,
+                     DensityResult& result, Progress& progress) {
   result.stats.r_min_m = r_min;
   result.stats.r_max_m = options.r_max_m;
   result.stats.ring_bands = std::max(inner.band_count(), outer.band_count());
@@ -646,7 +584,7 @@ void characteristics(const Dem& dem, const Grid& grid, const DiscPlan& inner, co
   const Window win = disc_window(grid, inner, outer);
   result.plain = plain_characteristic(dem, grid, inner, win, options.plain_max_variation_m, progress);
   ring_shares(dem, grid, inner, outer, win, options, maxima, result, progress);
-  if (terrain_used(options) || options.terrain_terms || options.model) terrain_terms(dem, grid, options, result, progress);
+  if (needs_terrain_terms(options)) terrain_terms(dem, grid, options, terrain, result, progress);
   combine_terms(dem, grid, options, result, progress);
   gather_stats(dem, grid, result);
 }
@@ -664,7 +602,7 @@ DensityResult compute_density(const Dem& dem, const Raster<float>& hydrometry, c
   const double r_min = raised_r_min(grid.metrics, options);
   const DiscPlan inner(grid.metrics, grid.rows, r_min, options.ring_bands);
   const DiscPlan outer(grid.metrics, grid.rows, options.r_max_m, options.ring_bands);
-  characteristics(dem, grid, inner, outer, r_min, std::nullopt, options, result, progress);
+  characteristics(dem, grid, inner, outer, r_min, std::nullopt, nullptr, options, result, progress);
   return result;
 }
 
@@ -673,6 +611,26 @@ double raised_r_min(const CellMetrics& metrics, const DensityOptions& options) {
   if (!(options.r_max_m > r_min))
     throw bad_input("/density/r_max_m: must be larger than r_min (" + std::to_string(r_min) + " m once raised to the cell size)");
   return r_min;
+}
+
+std::array<DiscPlan, 2> position_discs(const CellMetrics& metrics, int rows, int max_bands) {
+  // Radii of at least two cells, so that the disc holds the neighbours on coarse grids.
+  const double largest_step = largest_cell_step(metrics);
+  return {DiscPlan(metrics, rows, std::max(1000.0, 2 * largest_step), max_bands), DiscPlan(metrics, rows, std::max(5000.0, 2 * largest_step), max_bands)};
+}
+
+bool needs_terrain_terms(const DensityOptions& options) { return terrain_used(options) || options.terrain_terms || options.model; }
+
+std::vector<std::uint8_t> water_cells(const Dem& dem, const DensityOptions& options) {
+  std::vector<std::uint8_t> wet = cell_kinds(dem, options);
+  for (std::uint8_t& k : wet) k = k == water;
+  return wet;
+}
+
+std::vector<std::uint8_t> river_mask(const Raster<std::uint8_t>& rivers) {
+  std::vector<std::uint8_t> mask(rivers.size());
+  for (std::size_t i = 0; i < mask.size(); ++i) mask[i] = rivers[i] != 0 && rivers[i] != rivers.nodata;
+  return mask;
 }
 
 std::array<float, 2> land_range(const Dem& dem, const DensityOptions& options) {
@@ -686,15 +644,16 @@ std::array<float, 2> land_range(const Dem& dem, const DensityOptions& options) {
 DensityResult compute_density_window(const Dem& dem, const Raster<float>& hydrometry, const DensityOptions& options,
                                      const WholeGridFigures& whole, Progress& progress) {
   check_options(dem, hydrometry, options);
-  if (terrain_used(options) || options.terrain_terms || options.model)
-    throw bad_input("density: the terrain terms (and the boosted model that reads them) are not computed on tiles yet");
+  if (needs_terrain_terms(options) && !whole.terrain)
+    throw processing_error("density: a window's terrain terms need the whole grid's figures");
   Grid grid = describe_grid(dem, options, whole.metrics);
   grid.core = whole.core;
   grid.land_min = whole.land_range[0], grid.land_max = whole.land_range[1];
   DensityResult result;
   result.stats.cells = std::size_t(whole.core.cols) * std::size_t(whole.core.rows);
   mark_buildable(dem, grid, hydrometry, options, result, progress);
-  characteristics(dem, grid, whole.inner, whole.outer, whole.r_min_m, whole.maxima, options, result, progress);
+  characteristics(dem, grid, whole.inner, whole.outer, whole.r_min_m, whole.maxima, whole.terrain ? &*whole.terrain : nullptr, options, result,
+                  progress);
   return result;
 }
 

@@ -14,6 +14,7 @@
 #include "core/geodesy.hpp"
 #include "core/progress.hpp"
 #include "core/raster.hpp"
+#include "density/global_terms.hpp"
 
 namespace terrapolis::density {
 
@@ -27,6 +28,9 @@ namespace terrapolis::density {
 enum class TerrainTerm : std::size_t { altitude, slope, coast_near, river_near, position_1km, position_5km };
 inline constexpr std::array<const char*, 6> kTerrainTerms = {"altitude", "slope", "coast_near", "river_near", "position_1km", "position_5km"};
 inline constexpr std::size_t kTerrainCount = kTerrainTerms.size();
+/// The terms ranked among the region's land cells (LandRanks).
+inline constexpr std::array<TerrainTerm, 4> kRankedTerms = {TerrainTerm::altitude, TerrainTerm::slope, TerrainTerm::position_1km,
+                                                           TerrainTerm::position_5km};
 
 class BoostedModel;
 
@@ -155,9 +159,12 @@ DensityResult compute_density(const Dem& dem, const Raster<float>& hydrometry, c
 void to_unit_range(Raster<float>& layer);
 
 
-/// Distance in metres from each cell's centre to the nearest cell where `feature` is non-zero
-/// (infinity when there is none): an exact Euclidean transform (Felzenszwalb & Huttenlocher
-/// 2012) with columns measured at the feature row's width, rows by the northings of the grid.
-std::vector<float> distance_to_m(const std::vector<std::uint8_t>& feature, const CellMetrics& metrics, int cols, int rows);
+/// Whether the terrain terms are computed: a terrain weight not 0, options.terrain_terms, or boosted trees.
+bool needs_terrain_terms(const DensityOptions& options);
+
+/// The features of the terrain terms' distances, 1 on a feature cell: the water (at or below the
+/// sea level, nodata when it is sea, the water mask) and the rivers (non-zero, not nodata).
+std::vector<std::uint8_t> water_cells(const Dem& dem, const DensityOptions& options);
+std::vector<std::uint8_t> river_mask(const Raster<std::uint8_t>& rivers);
 
 }  // namespace terrapolis::density

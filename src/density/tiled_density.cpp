@@ -3,6 +3,7 @@
 #include "density/tiled_density.hpp"
 
 #include <algorithm>
+#include <memory>
 #include <cmath>
 #include <string>
 
@@ -41,19 +42,34 @@ double plan_bytes(const DiscPlan& plan, int rows) {
   return bytes;
 }
 
+/// The distances to the water and, when known, the rivers, by bands of full rows (DistanceStrips).
+std::unique_ptr<DistanceStrips> whole_grid_distances(const CellMetrics& metrics, int cols, int rows, const ReadWindowInputs& read, bool rivers,
+                                                     const std::string& scratch_dir, double budget_bytes, Progress& progress) {
+  return std::make_unique<DistanceStrips>(
+      metrics, cols, rows, rivers ? 2 : 1, scratch_dir, budget_bytes,
+      [&](int r0, int n) {
+        WindowInputs in = read(0, r0, cols, n, true);
+        std::vector<std::vector<std::uint8_t>> masks{water_cells(in.dem, in.options)};
+        if (rivers) masks.push_back(river_mask(in.options.rivers));
+        return masks;
+      },
+      progress);
+}
+
 }  // namespace
 
-int density_tile_size_for(int cols, int rows, int halo_rows, int halo_cols, double global_bytes, double memory_limit_mb, double reserved_mb) {
+int density_tile_size_for(int cols, int rows, int halo_rows, int halo_cols, double global_bytes, double memory_limit_mb, double reserved_mb,
+                          double cell_bytes) {
   return hydro::tiled::largest_tile_side(
       [&](int side) {
-        return kDensityBytesPerCell * double(std::min(side, rows) + 2 * halo_rows) * double(std::min(side, cols) + 2 * halo_cols) + global_bytes;
+        return cell_bytes * double(std::min(side, rows) + 2 * halo_rows) * double(std::min(side, cols) + 2 * halo_cols) + global_bytes;
       },
       memory_limit_mb, reserved_mb,
       "density tiles of 64 x 64 cells with a halo of " + std::to_string(halo_cols) + " x " + std::to_string(halo_rows) + " cells (r_max)");
 }
 
 TiledDensityReport run_tiled_density(int cols, int rows, const Georef& georef, const ReadWindowInputs& read,
-                                     const DensityOptions& options, int tile_size, double memory_limit_mb,
+                                     const DensityOptions& options, int tile_size, double memory_limit_mb, const std::string& scratch_dir,
                                      const WriteDensityTile& write, Progress& progress, double reserved_mb) {
   TiledDensityReport report;
   const CellMetrics metrics = cell_metrics(georef, cols, rows);
@@ -62,14 +78,26 @@ TiledDensityReport run_tiled_density(int cols, int rows, const Georef& georef, c
   // grid's first row, which a window would sum from its own.
   const DiscPlan inner(metrics, rows, r_min, options.ring_bands), outer(metrics, rows, options.r_max_m, options.ring_bands);
   report.global_bytes = plan_bytes(inner, rows) + plan_bytes(outer, rows) + 4.0 * sizeof(double) * rows;
-  // A ring cell's plain needs the r_min disc around it: the halo is the two reaches.
+  // The terrain terms' discs, and their ranks counted over the whole grid.
+  const bool terms = needs_terrain_terms(options);
+  const std::array<DiscPlan, 2> positions = terms ? position_discs(metrics, rows, options.ring_bands) : std::array<DiscPlan, 2>{};
+  if (terms) report.global_bytes += plan_bytes(positions[0], rows) + plan_bytes(positions[1], rows) + double(kRankedTerms.size()) * LandRanks::kBytes;
+  // A ring cell's plain needs the r_min disc around it: the halo is the two reaches (or the
+  // positions' wider disc).
   auto halo_of = [&](int row0, int n) {
     const std::array<int, 2> ring = reach_of_rows(outer, row0, n);
-    return std::array<int, 2>{ring[0] + inner.reach_rows(), ring[1] + inner.reach_cols()};
+    std::array<int, 2> halo{ring[0] + inner.reach_rows(), ring[1] + inner.reach_cols()};
+    if (terms) {
+      const std::array<int, 2> far = reach_of_rows(positions[1], row0, n);
+      halo = {std::max(halo[0], far[0]), std::max(halo[1], far[1])};
+    }
+    return halo;
   };
-  const std::array<int, 2> widest = {outer.reach_rows() + inner.reach_rows(), outer.reach_cols() + inner.reach_cols()};
+  std::array<int, 2> widest = {outer.reach_rows() + inner.reach_rows(), outer.reach_cols() + inner.reach_cols()};
+  if (terms) widest = {std::max(widest[0], positions[1].reach_rows()), std::max(widest[1], positions[1].reach_cols())};
+  const double cell_bytes = kDensityBytesPerCell + (terms ? kTerrainBytesPerCell : 0);
   report.tile_size = tile_size > 0 ? std::max(tile_size, 8)
-                                   : density_tile_size_for(cols, rows, widest[0], widest[1], report.global_bytes, memory_limit_mb, reserved_mb);
+                                   : density_tile_size_for(cols, rows, widest[0], widest[1], report.global_bytes, memory_limit_mb, reserved_mb, cell_bytes);
   const TileGrid grid(cols, rows, report.tile_size);
   report.tiles = grid.count();
   report.across = grid.across();
@@ -87,7 +115,20 @@ TiledDensityReport run_tiled_density(int cols, int rows, const Georef& georef, c
       step.update(double(t + 1) / grid.count());
     }
   }
-  // 2. The coast and plateau maxima over habitable land, then 3. each tile divided by them.
+  // With the terrain terms, the distances to water and rivers over the whole grid, in a budget of
+  // a tile's window when no limit is given.
+  std::unique_ptr<DistanceStrips> distances;
+  std::optional<std::array<LandRanks, kRankedTerms.size()>> ranks;  // 8 MB each: only with the terms
+  bool rivers_known = false;
+  if (terms) {
+    ranks.emplace();
+    rivers_known = read(0, 0, 1, 1, true).options.rivers.size() == 1;
+    const double side = report.tile_size + 2.0 * std::max(widest[0], widest[1]);
+    const double budget = memory_limit_mb > 0 ? (memory_limit_mb - reserved_mb) * 1e6 - report.global_bytes : cell_bytes * side * side;
+    distances = whole_grid_distances(metrics, cols, rows, read, rivers_known, scratch_dir, budget, progress);
+  }
+  // 2. The coast and plateau maxima over habitable land (and the land ranks' counts), then 3. each
+  // tile divided by them.
   auto pass = [&](const char* what, const std::optional<std::array<float, 2>>& maxima, auto&& use) {
     ProgressStep step(progress, what);
     for (int t = 0; t < grid.count(); ++t) {
@@ -97,10 +138,18 @@ TiledDensityReport run_tiled_density(int cols, int rows, const Georef& georef, c
       const int c0 = w.col0, r0 = w.row0, c1 = w.col0 + w.cols, r1 = w.row0 + w.rows;
       report.halo_rows = std::max(report.halo_rows, halo[0]);
       report.halo_cols = std::max(report.halo_cols, halo[1]);
-      report.window_bytes = std::max(report.window_bytes, kDensityBytesPerCell * double(c1 - c0) * double(r1 - r0));
+      report.window_bytes = std::max(report.window_bytes, cell_bytes * double(c1 - c0) * double(r1 - r0));
       WindowInputs in = read(c0, r0, c1 - c0, r1 - r0, false);
       WholeGridFigures whole{metric_rows(metrics, r0, r1 - r0), range, r_min, inner.from_row(r0), outer.from_row(r0),
-                             Window{r.col0 - c0, r.row0 - r0, r.cols, r.rows}, maxima};
+                             Window{r.col0 - c0, r.row0 - r0, r.cols, r.rows}, maxima, std::nullopt};
+      if (terms) {
+        WholeTerrainFigures& t = whole.terrain.emplace();
+        t.near = positions[0].from_row(r0), t.far = positions[1].from_row(r0);
+        t.any_water = distances->any(0), t.rivers_known = rivers_known;
+        if (t.any_water) t.to_water = distances->window(0, c0, r0, c1 - c0, r1 - r0);
+        if (rivers_known) t.to_river = distances->window(1, c0, r0, c1 - c0, r1 - r0);
+        if (maxima) t.ranks = &*ranks;
+      }
       use(t, compute_density_window(in.dem, in.hydrometry, in.options, whole, quiet), whole.core);
       step.update(double(t + 1) / grid.count());
     }
@@ -108,7 +157,14 @@ TiledDensityReport run_tiled_density(int cols, int rows, const Georef& georef, c
   std::array<float, 2> maxima{0, 0};
   pass("density by tiles: coast and plateau maxima", std::nullopt, [&](int, const DensityResult& d, const Window&) {
     maxima = {std::max(maxima[0], d.stats.coast_max), std::max(maxima[1], d.stats.plateau_max)};
+    if (terms)
+      for (std::size_t k = 0; k < kRankedTerms.size(); ++k) {
+        const Raster<float>& values = d.term(kRankedTerms[k]);
+        (*ranks)[k].add(values.data(), values.size());  // NaN off the core's land
+      }
   });
+  if (terms)
+    for (LandRanks& r : *ranks) r.finish();
   DensityStats& stats = report.stats;
   pass("density by tiles", maxima, [&](int t, const DensityResult& d, const Window& core) {
     DensityResult tile;
@@ -118,6 +174,8 @@ TiledDensityReport run_tiled_density(int cols, int rows, const Georef& georef, c
     tile.hydrometry = hydro::tiled::crop(d.hydrometry, core.x0, core.y0, core.cols, core.rows);
     tile.density = hydro::tiled::crop(d.density, core.x0, core.y0, core.cols, core.rows);
     tile.buildable = hydro::tiled::crop(d.buildable, core.x0, core.y0, core.cols, core.rows);
+    for (std::size_t k = 0; k < kTerrainCount; ++k)
+      if (d.terrain[k].size()) tile.terrain[k] = hydro::tiled::crop(d.terrain[k], core.x0, core.y0, core.cols, core.rows);
     tile.stats = d.stats;
     add_stats(stats, d.stats);
     write(t, grid.across(), tile);

@@ -5,11 +5,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 
 #include "core/error.hpp"
 #include "hydro/tiled/tiled_hydro.hpp"
 #include "io/mask_io.hpp"
 #include "pipeline/density_folder.hpp"
+#include "pipeline/stage_options.hpp"
 
 namespace terrapolis::pipeline {
 
@@ -69,13 +71,17 @@ std::string describe(const hydro::tiled::TiledBelhadjReport& b) {
 }
 
 density::ReadWindowInputs density_windows(const DemWindowReader& dem, const Scenario& scenario, const density::DensityOptions& options,
-                                          const std::string& inland_water, const ReadHydrometry& hydrometry) {
-  return [&dem, &scenario, &options, inland_water, hydrometry](int c0, int r0, int cols, int rows, bool dem_only) {
+                                          const std::string& inland_water, const ReadHydrometry& hydrometry,
+                                          const std::string& accumulation_km2) {
+  std::shared_ptr<const DemWindowReader> accumulation;
+  if (!accumulation_km2.empty() && density::needs_terrain_terms(options)) accumulation = std::make_shared<const DemWindowReader>(accumulation_km2);
+  return [&dem, &scenario, &options, inland_water, hydrometry, accumulation](int c0, int r0, int cols, int rows, bool dem_only) {
     density::WindowInputs in;
     in.dem = dem.read(c0, r0, cols, rows);
     in.options = options;
     const Georef& grid = in.dem.georef();
     in.options.water_mask = read_mask(inland_water, grid, cols, rows);
+    if (accumulation) in.options.rivers = river_cells(accumulation->read(c0, r0, cols, rows), scenario);
     if (dem_only) return in;
     read_density_files(scenario, grid, cols, rows, "", in.options);
     in.hydrometry = hydrometry ? hydrometry(in.dem, c0, r0) : in.dem.like<float>(0.0f);

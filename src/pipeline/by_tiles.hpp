@@ -46,10 +46,12 @@ std::string describe(const hydro::tiled::TiledBelhadjReport& report);
 /// The hydrometry of a window of the DEM (its cells [c0, c0 + window.cols()) x ...).
 using ReadHydrometry = std::function<Raster<float>(const Dem& window, int c0, int r0)>;
 /// The density model's inputs by windows (density::run_tiled_density): the DEM, the inland water
-/// (the VRT of inland_water_by_tiles), the scenario's exclusions and `hydrometry`'s (empty: zeros).
+/// (the VRT of inland_water_by_tiles), the scenario's exclusions, `hydrometry`'s (empty: zeros)
+/// and, when the terrain terms are computed, the rivers of `accumulation_km2` (empty: none).
 /// Holds references to `dem`, `scenario` and `options`.
 density::ReadWindowInputs density_windows(const DemWindowReader& dem, const Scenario& scenario, const density::DensityOptions& options,
-                                          const std::string& inland_water, const ReadHydrometry& hydrometry);
+                                          const std::string& inland_water, const ReadHydrometry& hydrometry,
+                                          const std::string& accumulation_km2 = "");
 
 /// The land of the sites stage read from the density stage's tiles (density.vrt, buildable.vrt):
 /// bands of rows and blocks sized to the memory limit, the disc tests' blocks grown by the largest

@@ -198,10 +198,10 @@ sites::SitesOptions sites_options(const Scenario& scenario) {
   return o;
 }
 
-Raster<std::uint8_t> river_cells(const Raster<double>& accumulation_m2, const Scenario& scenario) {
+Raster<std::uint8_t> river_cells(const Raster<float>& accumulation_km2, const Scenario& scenario) {
   const double threshold_m2 = scenario.resolved["hydro"]["streams_threshold_km2"].get<double>() * 1e6;
-  Raster<std::uint8_t> rivers = accumulation_m2.like<std::uint8_t>(0);
-  for (std::size_t i = 0; i < rivers.size(); ++i) rivers[i] = accumulation_m2[i] >= threshold_m2 ? 1 : 0;  // NaN: not a river
+  Raster<std::uint8_t> rivers = accumulation_km2.like<std::uint8_t>(0);
+  for (std::size_t i = 0; i < rivers.size(); ++i) rivers[i] = double(accumulation_km2[i]) * 1e6 >= threshold_m2 ? 1 : 0;  // NaN: not a river
   return rivers;
 }
 

@@ -70,8 +70,9 @@ std::vector<std::string> density_files(const Scenario& scenario);
 sites::SitesOptions sites_options(const Scenario& scenario);
 network::NetworkOptions network_options(const Scenario& scenario);
 /// River cells (1) for the density's river_near term: upstream area of hydro.streams_threshold_km2
-/// or more, the streams layer's definition.
-Raster<std::uint8_t> river_cells(const Raster<double>& accumulation_m2, const Scenario& scenario);
+/// or more, the streams layer's definition, on the km² as accumulation.tif holds them (so that a
+/// run, a run resumed from its files and a run by tiles find the same rivers).
+Raster<std::uint8_t> river_cells(const Raster<float>& accumulation_km2, const Scenario& scenario);
 
 /// The roads section: the cost model (the paper's defaults, a costs file over them, structures
 /// switched off), the routing options with the scenario's seed, and the vegetation raster.

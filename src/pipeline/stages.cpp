@@ -250,23 +250,21 @@ void hydro_run(RunState& s, Progress& progress, const Log& log) {
   s.write("hydro", "filled.tif", r.filled, Style::elevation);
   s.write("hydro", "flowdir.tif", hydro::encode_d8(r.d8, s.settings.d8_codes), Style::flow_direction, d8_metadata(s));
   double largest_km2 = 0;
-  s.write("hydro", "accumulation.tif", area_km2(r.accumulation, largest_km2), Style::accumulation, {{"UNIT", "km2"}});
+  const Raster<float> km2 = area_km2(r.accumulation, largest_km2);
+  s.write("hydro", "accumulation.tif", km2, Style::accumulation, {{"UNIT", "km2"}});
   s.write("hydro", "hydrometry.tif", r.hydrometry, Style::unit_ramp);
   s.write("hydro", "streams.geojson", r.streams, Style::streams);
   s.summary["hydro"] = hydro_figures(r.streams, largest_km2, r.hydrometry_iterations);
   if (r.hydrometry_iterations > 0) log.detail("belhadj: " + std::to_string(r.hydrometry_iterations) + " iterations");
   s.hydrometry = std::move(r.hydrometry);
   write_inland_water(s, progress, log);
-  s.rivers = river_cells(r.accumulation, s.scenario);
+  s.rivers = river_cells(km2, s.scenario);
 }
 
 void hydro_load(RunState& s) {
   if (s.by_tiles) return;  // the density stage reads the hydrometry and the inland water by windows
   s.hydrometry = read_resampled(saved(s, "hydrometry.tif"), s.dem.georef(), s.dem.cols(), s.dem.rows(), Resampling::nearest);
-  const Raster<float> km2 = read_resampled(saved(s, "accumulation.tif"), s.dem.georef(), s.dem.cols(), s.dem.rows(), Resampling::nearest);
-  Raster<double> m2 = s.dem.like<double>(NAN);
-  for (std::size_t i = 0; i < m2.size(); ++i) m2[i] = double(km2[i]) * 1e6;
-  s.rivers = river_cells(m2, s.scenario);
+  s.rivers = river_cells(read_resampled(saved(s, "accumulation.tif"), s.dem.georef(), s.dem.cols(), s.dem.rows(), Resampling::nearest), s.scenario);
 }
 
 void hydro_prepare(const Scenario& scenario, const RasterHeader&, Settings& s) {
@@ -331,10 +329,12 @@ void density_run_tiles(RunState& s, Progress& progress, const Log& log) {
   const DemWindowReader reader(in.dem_path, in.read), hydrometry(saved(s, "hydrometry.vrt"));
   const density::DensityOptions& options = s.settings.density;
   const density::ReadWindowInputs read = density_windows(reader, s.scenario, options, saved(s, "inland_water.vrt"),
-                                                         [&](const Dem& w, int c0, int r0) { return hydrometry.read(c0, r0, w.cols(), w.rows()); });
+                                                         [&](const Dem& w, int c0, int r0) { return hydrometry.read(c0, r0, w.cols(), w.rows()); },
+                                                         saved(s, "accumulation.vrt"));
   for (const auto& [name, style] : kDensityRasters) s.mosaic(name).create();
+  const ScratchFolder scratch((s.folder / ".scratch").string());
   const density::TiledDensityReport report = density::run_tiled_density(
-      s.grid.cols, s.grid.rows, s.grid.georef, read, options, in.tiles.tile_size, in.tiles.limit_mb(),
+      s.grid.cols, s.grid.rows, s.grid.georef, read, options, in.tiles.tile_size, in.tiles.limit_mb(), scratch.path(),
       [&](int t, int across, const density::DensityResult& d) {
         const Raster<float>* floats[] = {&d.coast, &d.plateau, &d.plain};
         for (int k = 0; k < 3; ++k) s.write_tile("density", s.mosaic(kDensityRasters[k].first), t, across, *floats[k]);
@@ -380,13 +380,8 @@ void density_prepare(const Scenario& scenario, const RasterHeader& grid, Setting
     check_file("/density/exclusions/" + std::to_string(i), scenario.file(density["exclusions"][i].get<std::string>()));
   density::raised_r_min(cell_metrics(grid.georef, grid.cols, grid.rows), s.density);  // r_max against r_min raised to this grid's cells
   if (!tile_settings(scenario).given()) return;
-  // The terrain terms rank and measure distances over the whole grid; layers are rescaled by their whole range.
-  for (std::size_t t = 0; t < density::kTerrainCount; ++t)
-    if (s.density.terrain_weights[t] != 0)
-      throw bad_input(std::string("/density/weights/") + density::kTerrainTerms[t] + ": the terrain terms are not computed on tiles yet "
-                      "(they rank the whole grid): give density.preset belhadj2007 or weight 0");
+  // Layers are rescaled by their whole range.
   if (!density["layers"].empty()) throw bad_input("/density/layers: not computed on tiles yet");
-  if (!density["model"].get<std::string>().empty()) throw bad_input("/density/model: not computed on tiles yet");
   if (!scenario.resolved["plugins"].empty()) throw bad_input("/plugins: not run on tiles yet");
 }
 
@@ -1063,7 +1058,8 @@ HydroForDensity hydro_for_density(const Scenario& scenario, const Dem& dem, cons
   hydro.with_streams = false;  // neither the hydrometry nor the upstream areas depend on them
   hydro.with_hydrometry = hydrometry;
   hydro::HydroResult h = hydro::run_hydro(dem, hydro, progress);
-  if (rivers) out.rivers = river_cells(h.accumulation, scenario);
+  double largest_km2 = 0;
+  if (rivers) out.rivers = river_cells(area_km2(h.accumulation, largest_km2), scenario);
   out.hydrometry = std::move(h.hydrometry);
   return out;
 }

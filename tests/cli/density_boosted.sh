@@ -44,6 +44,13 @@ assert m["scenario"]["density"]["model"] == "fit.boosted.json", m["scenario"]["d
 assert m["summary"]["sites"]["cities"] > 0
 PY
 
+# By tiles: the trees read the terms ranked and measured over the whole grid.
+"$TP" -q run boosted.json -o by_tiles --set input.tile_size=60 2> /dev/null
+same_cells one/density.tif by_tiles/density.vrt || fail "the boosted density differs on tiles"
+cmp -s one/cities.geojson by_tiles/cities.geojson || fail "the boosted run's settlements differ on tiles"
+# The density command does not find the rivers on tiles (their river_near term).
+expect_refused dtiles "river_near: this command does not find the rivers on tiles" "$TP" density "$dem" dtiles --model fit.boosted.json --tile-size 60
+
 # Refitted trees under the same name: a rerun does not reuse the density made with the old ones.
 "$TP" -q calibrate "$dem" --settlements "$places" --model boosted --trees 41 --depth 2 --fragment fit.json --overwrite > /dev/null
 expect_fail 2 "/density/model names a file changed since the saved run; rerun from density" "$TP" run boosted.json -o one --from sites

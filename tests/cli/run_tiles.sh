@@ -12,7 +12,7 @@ rasters=(elevation hillshade filled flowdir accumulation hydrometry inland_water
   access_minutes access_minutes_10000 access_nearest)
 layers=(streams.geojson cities.geojson city_extents.geojson network.geojson roads.geojson sections.geojson junctions.geojson road_sections.geojson
   access_catchments.geojson)
-tiled=(--set density.preset=belhadj2007)
+tiled=(--set density.preset=belhadj2007)  # a town of 10,000 or more: the access stage's second level
 
 # The bundled DEM (GEBCO 15", sea below 0) on 3 x 3 tiles of 64 cells.
 "$TP" -q run "${tiled[@]}" -o whole
@@ -32,6 +32,16 @@ same_summary whole tiles || fail "the run's figures differ from the whole grid's
 grep -q "TERRAPOLIS_STAGE=density" <(gdalinfo tiles/density/tile_0001_0002.tif) || fail "a tile without its provenance"
 grep -q 'density.vrt' tiles/project.qgs || fail "the QGIS project does not show the tiled rasters"
 cmp -s whole/preview.png tiles/preview.png || fail "preview.png differs from the whole grid's run (drawn from the VRTs' rows)"
+
+# The default preset: its terrain terms ranked and measured over the whole grid (the distances by
+# bands of rows and strips of columns), on tiles of 50.
+"$TP" -q run -o fitted_whole
+"$TP" -q run --set input.tile_size=50 -o fitted_tiles
+for r in density buildable access_minutes access_nearest; do same_cells "fitted_whole/$r.tif" "fitted_tiles/$r.vrt" || fail "default preset: $r differs on tiles"; done
+for l in cities.geojson network.geojson roads.geojson access_catchments.geojson; do
+  cmp -s "fitted_whole/$l" "fitted_tiles/$l" || fail "default preset: $l differs on tiles"
+done
+same_summary fitted_whole fitted_tiles || fail "default preset: the run's figures differ on tiles"
 
 # A rerun from the density stage reads the hydro stage's tiles back, the sites stage the density's.
 "$TP" -q run "${tiled[@]}" --set input.tile_size=64 --set density.r_max_m=4000 --from density -o tiles
@@ -84,8 +94,6 @@ no_leftovers "$WORK"
 [[ -z $(find . -name '.scratch*') ]] || fail "a scratch folder was left behind"
 
 # Refused before any stage, exit 2, no folder: the later stages, and what the tiles do not compute yet.
-expect_refused r2 "/density/weights/altitude: the terrain terms are not computed on tiles yet" \
-  "$TP" run --set input.memory_limit_mb=500 --until density -o r2
 expect_refused r3 "/hydro/classify: not computed on tiles yet" "$TP" run "${tiled[@]}" --set input.tile_size=64 --set hydro.classify=true -o r3
 expect_refused r4 "/hydro/flow mfd: not computed on tiles yet" "$TP" run "${tiled[@]}" --set input.tile_size=64 --set hydro.flow=mfd -o r4
 expect_refused r7 "/roads/existing: not computed on tiles yet" \

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <algorithm>
 #include <random>
 
 #include "core/error.hpp"
@@ -23,7 +24,7 @@ constexpr float nan_f = std::numeric_limits<float>::quiet_NaN();
 struct Landscape {
   Dem dem;
   Raster<float> hydrometry;
-  Raster<std::uint8_t> lake, excluded;
+  Raster<std::uint8_t> lake, excluded, rivers;
 };
 
 Landscape landscape(unsigned seed) {
@@ -34,6 +35,7 @@ Landscape landscape(unsigned seed) {
   l.hydrometry = l.dem.like<float>(0);
   l.lake = l.dem.like<std::uint8_t>(0);
   l.excluded = l.dem.like<std::uint8_t>(0);
+  l.rivers = l.dem.like<std::uint8_t>(0);
   const double p1 = u(rng) * 6, p2 = u(rng) * 6;
   for (int r = 0; r < l.dem.rows(); ++r)
     for (int c = 0; c < l.dem.cols(); ++c) {
@@ -45,6 +47,7 @@ Landscape landscape(unsigned seed) {
       l.hydrometry(c, r) = float(u(rng));
       if (std::hypot(c - 70, r - 80) < 6) l.lake(c, r) = 1;
       if (c > 120 && r > 90) l.excluded(c, r) = 1;
+      if (std::abs(r - 55 - int(20 * std::sin(c / 17.0 + p1))) < 1 && c > 30) l.rivers(c, r) = u(rng) < 0.5 ? 1 : 7;  // a river of two codes
     }
   return l;
 }
@@ -65,11 +68,12 @@ void expect_same_bits(const Raster<T>& whole, const std::vector<Raster<T>>& tile
   EXPECT_EQ(differ, 0u) << what << ": rows of tiles that differ from the whole grid";
 }
 
-void check_tiles_equal_whole(const Landscape& l, const DensityOptions& options, int tile_size) {
+void check_tiles_equal_whole(const Landscape& l, const DensityOptions& options, int tile_size, bool rivers = false) {
   SilentProgress quiet;
   DensityOptions whole_options = options;
   whole_options.water_mask = l.lake;
   whole_options.exclusion_masks = {l.excluded};
+  if (rivers) whole_options.rivers = l.rivers;
   const DensityResult whole = compute_density(l.dem, l.hydrometry, whole_options, quiet);
   std::vector<Window> rects;
   std::vector<DensityResult> tiles;
@@ -78,10 +82,11 @@ void check_tiles_equal_whole(const Landscape& l, const DensityOptions& options, 
     WindowInputs in{window_of(l.dem, c0, r0, cols, rows), window_of(l.hydrometry, c0, r0, cols, rows), options};
     in.options.water_mask = window_of(l.lake, c0, r0, cols, rows);
     in.options.exclusion_masks = {window_of(l.excluded, c0, r0, cols, rows)};
+    if (rivers) in.options.rivers = window_of(l.rivers, c0, r0, cols, rows);
     return in;
   };
   const TiledDensityReport report = run_tiled_density(
-      l.dem.cols(), l.dem.rows(), l.dem.georef(), read, options, tile_size, 0,
+      l.dem.cols(), l.dem.rows(), l.dem.georef(), read, options, tile_size, 0, ::testing::TempDir(),
       [&](int, int, const DensityResult& tile) {
         const GeoTransform& t = tile.density.georef().transform;
         const GeoTransform& g = l.dem.georef().transform;
@@ -104,6 +109,12 @@ void check_tiles_equal_whole(const Landscape& l, const DensityOptions& options, 
   expect_same_bits(whole.hydrometry, layer(&DensityResult::hydrometry), rects, "hydrometry");
   expect_same_bits(whole.density, layer(&DensityResult::density), rects, "density");
   expect_same_bits(whole.buildable, layer(&DensityResult::buildable), rects, "buildable");
+  if (needs_terrain_terms(options))
+    for (std::size_t k = 0; k < kTerrainCount; ++k) {
+      std::vector<Raster<float>> terms;
+      for (const auto& t : tiles) terms.push_back(t.terrain[k]);
+      expect_same_bits(whole.terrain[k], terms, rects, kTerrainTerms[k]);
+    }
   const DensityStats &a = whole.stats, &b = report.stats;
   EXPECT_EQ(a.cells, b.cells);
   EXPECT_EQ(a.known_cells, b.known_cells);
@@ -158,16 +169,86 @@ TEST(TiledDensity, TileSizeFromMemoryLimit) {
   EXPECT_EQ(density_tile_size_for(50, 40, 5, 5, 0, 1.0), 1 << 15);
 }
 
-TEST(TiledDensity, TerrainTermsAreRefused) {
-  const Landscape l = landscape(5);
+TEST(TiledDensity, TerrainTermsEqualTheWholeGridsRanksAndDistances) {
+  // The fitted preset's terms (ranks among the whole grid's land, distances to the sea, the lake
+  // and the rivers) on tiles of 9 to 64 cells, with and without rivers; the terms themselves and
+  // the density are compared.
+  const Landscape l = landscape(7);
   DensityOptions o = test_options();
-  o.terrain_weights[0] = 1;
-  SilentProgress quiet;
-  auto read = [&](int c0, int r0, int cols, int rows, bool) {
-    return WindowInputs{window_of(l.dem, c0, r0, cols, rows), window_of(l.hydrometry, c0, r0, cols, rows), o};
-  };
-  EXPECT_THROW(run_tiled_density(l.dem.cols(), l.dem.rows(), l.dem.georef(), read, o, 40, 0, [](int, int, const DensityResult&) {}, quiet),
-               Error);
+  o.terrain_weights = {0.5, -0.7, 1.2, 0.8, -0.3, 0.4};
+  for (int tile : {9, 23, 64}) {
+    SCOPED_TRACE(tile);
+    check_tiles_equal_whole(l, o, tile, true);
+  }
+  o.terrain_weights = {0, 0, 1, 0, 0, 0};
+  o.terrain_terms = true;
+  check_tiles_equal_whole(l, o, 31, false);
+}
+
+TEST(LandRanks, SharesBelowWithTiesHalfOnTheRoundedValues) {
+  // 1, 2, 2, 3: a quarter below 2 and half the ties, 0.5; 1 and 3 at 0.125 and 0.875. -0 is 0.
+  const float values[] = {2, 1, nan_f, 3, 2, -0.0f, 0.0f};
+  LandRanks r;
+  r.add(values, 5);
+  r.finish();
+  EXPECT_EQ(r.count(), 4u);
+  EXPECT_FLOAT_EQ(r.rank(1), 0.125f);
+  EXPECT_FLOAT_EQ(r.rank(2), 0.5f);
+  EXPECT_FLOAT_EQ(r.rank(3), 0.875f);
+  EXPECT_TRUE(std::isnan(r.rank(nan_f)));
+  // Between 1024 and 2048 a key is 0.5 m wide: 2000 and 2000.25 tie, 2000.5 does not.
+  const float close[] = {2000, 2000.25f, 2000.5f, -5, -4};
+  LandRanks c;
+  c.add(close, 5);
+  c.add(values + 5, 2);  // -0 and +0: one value
+  c.finish();
+  EXPECT_FLOAT_EQ(c.rank(-5), 0.5f / 7);
+  EXPECT_FLOAT_EQ(c.rank(-4), 1.5f / 7);
+  EXPECT_FLOAT_EQ(c.rank(0), 3.0f / 7);
+  EXPECT_FLOAT_EQ(c.rank(2000), 5.0f / 7);
+  EXPECT_FLOAT_EQ(c.rank(2000.25f), 5.0f / 7);
+  EXPECT_FLOAT_EQ(c.rank(2000.5f), 6.5f / 7);
+}
+
+TEST(DistanceStrips, EqualTheWholeGridsTransformOnAnyBandsAndStrips) {
+  // Random features on a geographic grid (rows of different widths); budgets from one row and one
+  // column to the whole grid: the distances must be distance_to_m's bit for bit.
+  std::mt19937 rng(5);
+  for (int trial = 0; trial < 6; ++trial) {
+    const int cols = 20 + int(rng() % 60), rows = 15 + int(rng() % 50);
+    const Georef g = trial % 2 ? test::geographic(55.0 + trial, 1.0 / 120) : test::projected(90, 75);
+    const CellMetrics m = cell_metrics(g, cols, rows);
+    std::vector<std::vector<std::uint8_t>> features(2, std::vector<std::uint8_t>(std::size_t(cols) * std::size_t(rows), 0));
+    for (auto& f : features)
+      for (auto& v : f) v = rng() % 97 == 0;
+    if (trial == 3) std::fill(features[1].begin(), features[1].end(), 0);  // no feature at all: infinity
+    for (double budget : {1.0, 5e3, 4e4, 1e9}) {
+      SCOPED_TRACE(testing::Message() << "trial " << trial << ", budget " << budget);
+      SilentProgress quiet;
+      int bands = 0;
+      DistanceStrips strips(m, cols, rows, 2, ::testing::TempDir(), budget, [&](int r0, int n) {
+        ++bands;
+        std::vector<std::vector<std::uint8_t>> band;
+        for (const auto& f : features) band.emplace_back(f.begin() + std::ptrdiff_t(r0) * cols, f.begin() + std::ptrdiff_t(r0 + n) * cols);
+        return band;
+      }, quiet);
+      if (budget == 1.0) {
+        EXPECT_EQ(bands, rows);
+      }
+      for (int k = 0; k < 2; ++k) {
+        EXPECT_EQ(strips.any(k), std::find(features[std::size_t(k)].begin(), features[std::size_t(k)].end(), 1) != features[std::size_t(k)].end());
+        const std::vector<float> whole = distance_to_m(features[std::size_t(k)], m, cols, rows);
+        const int c0 = int(rng() % std::uint32_t(cols / 2)), r0 = int(rng() % std::uint32_t(rows / 2));
+        const std::vector<float> w = strips.window(k, c0, r0, cols - c0, rows - r0);
+        std::size_t differ = 0;
+        for (int r = r0; r < rows; ++r)
+          for (int c = c0; c < cols; ++c)
+            differ += std::memcmp(&whole[std::size_t(r) * std::size_t(cols) + std::size_t(c)],
+                                  &w[std::size_t(r - r0) * std::size_t(cols - c0) + std::size_t(c - c0)], sizeof(float)) != 0;
+        EXPECT_EQ(differ, 0u) << "feature " << k;
+      }
+    }
+  }
 }
 
 }  // namespace
