@@ -15,7 +15,7 @@
 # terrapolis-mpi on WEAK_RANKS (default "1 2"), one thread a rank: cells/s a rank, CPU, peak
 # resident memory of each rank (GNU time), the engine's reported state, disk written. WEAK_DIR:
 # where the mosaic and outputs go (default a temporary folder; removed at the end).
-# RUN=1: a run to the network stage (RUN_UNTIL) on such a continent, whole grid vs input.memory_limit_mb (RUN_COPIES, RUN_MEMORY).
+# RUN=1: a run to the network stage (RUN_UNTIL) on such a continent, whole grid vs input.memory_limit_mb (RUN_COPIES, RUN_MEMORY, RUN_PRESET).
 # DENSITY=1: the density stage instead, whole grid vs tile by tile (DENSITY_OPTIONS, ";"-separated).
 # SPDX-License-Identifier: MIT
 set -euo pipefail
@@ -173,7 +173,7 @@ if [[ ${WEAK:-0} == 1 ]]; then
   exit
 fi
 
-# A run by tiles (RUN=1): `terrapolis run --until network` (RUN_UNTIL; density.preset belhadj2007)
+# A run by tiles (RUN=1): `terrapolis run --until network` (RUN_UNTIL; density.preset RUN_PRESET, the default fitted)
 # on the mirror-tiled continent of RUN_COPIES copies of WEAK_DEM (default 36: 5.2e7 cells), on the
 # whole grid and with input.memory_limit_mb RUN_MEMORY (default 400): wall, CPU, peak resident
 # memory, each stage's time and peak, and the tiled outputs checked against the whole grid's.
@@ -183,7 +183,7 @@ run_bench() {
   trap "rm -rf '$work' '$dir'" EXIT
   mirror_images "$dem" "$dir"
   mosaic "$copies" "$dir"
-  local set=(--set dem="$dir/continent-$copies.vrt" --set density.preset=belhadj2007 --set outputs.preview=false --until "${RUN_UNTIL:-network}")
+  local set=(--set dem="$dir/continent-$copies.vrt" --set density.preset="${RUN_PRESET:-fitted}" --set outputs.preview=false --until "${RUN_UNTIL:-network}")
   echo "run by tiles: $copies copies of $(basename "$dem"), $(gdalinfo "$dir/continent-$copies.vrt" | sed -n 's/^Size is //p') cells, $(nproc) cores"
   local label out
   for label in whole tiled; do

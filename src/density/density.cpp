@@ -414,13 +414,11 @@ void terrain_terms(const Dem& dem, const Grid& g, const DensityOptions& options,
   const bool rivers_known = whole ? whole->rivers_known : options.rivers.size() == n;
   const bool any_water = whole ? whole->any_water : g.any_water;
   if (!whole && options.rivers.size() != 0 && !rivers_known) throw bad_input("rivers: not on the DEM's grid");
-  std::vector<float> to_water, to_river;
-  if (whole) {
-    to_water = whole->to_water, to_river = whole->to_river;
-  } else {
-    if (any_water) to_water = distance_to_m(water_cells(dem, options), g.metrics, g.cols, g.rows);
-    if (rivers_known) to_river = distance_to_m(river_mask(options.rivers), g.metrics, g.cols, g.rows);
-  }
+  std::vector<float> own_water, own_river;  // on the whole grid; a window's come with `whole`
+  if (!whole && any_water) own_water = distance_to_m(water_cells(dem, options), g.metrics, g.cols, g.rows);
+  if (!whole && rivers_known) own_river = distance_to_m(river_mask(options.rivers), g.metrics, g.cols, g.rows);
+  const std::vector<float>& to_water = whole ? whole->to_water : own_water;
+  const std::vector<float>& to_river = whole ? whole->to_river : own_river;
   step.update(0.3);
   auto term = [&](TerrainTerm t) -> Raster<float>& { return result.terrain[std::size_t(t)]; };
   if (whole) {
@@ -450,9 +448,9 @@ void terrain_terms(const Dem& dem, const Grid& g, const DensityOptions& options,
   if (whole && !whole->ranks) return;
   for (std::size_t k = 0; k < kRankedTerms.size(); ++k) {
     Raster<float>& values = term(kRankedTerms[k]);
-    LandRanks own;
-    if (!whole) own.add(values.data(), values.size()), own.finish();
-    const LandRanks& ranks = whole ? (*whole->ranks)[k] : own;
+    std::optional<LandRanks> own;  // 4 MB: only on the whole grid
+    if (!whole) own.emplace().add(values.data(), values.size()), own->finish();
+    const LandRanks& ranks = whole ? (*whole->ranks)[k] : *own;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, values.size(), 1 << 14), [&](const tbb::blocked_range<std::size_t>& range) {
       for (std::size_t i = range.begin(); i < range.end(); ++i) values[i] = ranks.rank(values[i]);
     });
@@ -585,6 +583,7 @@ void characteristics(const Dem& dem, const Grid& grid, const DiscPlan& inner, co
   result.plain = plain_characteristic(dem, grid, inner, win, options.plain_max_variation_m, progress);
   ring_shares(dem, grid, inner, outer, win, options, maxima, result, progress);
   if (needs_terrain_terms(options)) terrain_terms(dem, grid, options, terrain, result, progress);
+  if (terrain && !terrain->ranks) return;  // the tiles' first pass: the terms are not ranked yet, no density
   combine_terms(dem, grid, options, result, progress);
   gather_stats(dem, grid, result);
 }

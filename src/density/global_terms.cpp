@@ -110,6 +110,7 @@ int make_scratch(const std::string& dir, std::string& path) {
   std::string name = dir + "/distancesXXXXXX";
   const int fd = ::mkstemp(name.data());
   if (fd < 0) throw processing_error(dir + ": cannot make a scratch file (" + std::strerror(errno) + ")");
+  ::unlink(name.c_str());  // gone with the descriptor, even if the process is killed
   path = name;
   return fd;
 }
@@ -129,13 +130,12 @@ std::size_t LandRanks::key(float v) {
 
 void LandRanks::add(const float* values, std::size_t n) {
   for (std::size_t i = 0; i < n; ++i)
-    if (!std::isnan(values[i])) ++counts_[key(values[i])], ++total_;
+    if (!std::isnan(values[i])) {
+      if (++counts_[key(values[i])] == 0) throw processing_error("density: more than 4.3 billion land cells of one value to rank");
+      ++total_;
+    }
 }
 
-void LandRanks::add(const LandRanks& other) {
-  for (std::size_t k = 0; k < counts_.size(); ++k) counts_[k] += other.counts_[k];
-  total_ += other.total_;
-}
 
 void LandRanks::finish() {
   ranks_.assign(counts_.size(), 0.0f);
@@ -145,7 +145,7 @@ void LandRanks::finish() {
     if (counts_[k]) ranks_[k] = float((double(below) + 0.5 * double(counts_[k])) / n);
     below += counts_[k];
   }
-  std::vector<std::uint64_t>().swap(counts_);
+  std::vector<std::uint32_t>().swap(counts_);
 }
 
 float LandRanks::rank(float v) const { return std::isnan(v) ? v : ranks_[key(v)]; }
@@ -199,6 +199,7 @@ DistanceStrips::DistanceStrips(const CellMetrics& metrics, int cols, int rows, i
         const std::vector<std::vector<std::uint8_t>> masks = read(r0, n);
         for (int k = 0; k < features; ++k) {
           const std::vector<std::uint8_t>& mask = masks[std::size_t(k)];
+          if (mask.size() != std::size_t(n) * std::size_t(cols)) throw processing_error("density: a band of the distances' features is not on the grid");
           if (std::any_of(mask.begin(), mask.end(), [](std::uint8_t m) { return m != 0; })) any_[std::size_t(k)] = true;
           tbb::parallel_for(tbb::blocked_range<int>(0, n, 8), [&](const tbb::blocked_range<int>& range) {
             RowTransform t(std::size_t(std::max(cols, 0)));
@@ -240,21 +241,21 @@ DistanceStrips::DistanceStrips(const CellMetrics& metrics, int cols, int rows, i
         });
         write_all(files_[std::size_t(k)], out.data(), out.size() * sizeof(float), off_t(cell_at(c0, w, 0) * sizeof(float)), paths_[std::size_t(k)]);
         step.update((double(k) + double(c0 + w) / cols) / features);
+        if (c0 + w == cols) ::close(squared[std::size_t(k)]), squared[std::size_t(k)] = -1;  // its disk space back before the next feature's
       }
   } catch (...) {
-    for (std::size_t k = 0; k < squared.size(); ++k)
-      if (squared[k] >= 0) ::close(squared[k]), ::unlink(squared_paths[k].c_str());
+    for (int fd : squared)
+      if (fd >= 0) ::close(fd);
     close_files();
     throw;
   }
-  for (std::size_t k = 0; k < squared.size(); ++k) ::close(squared[k]), ::unlink(squared_paths[k].c_str());
 }
 
 DistanceStrips::~DistanceStrips() { close_files(); }
 
 void DistanceStrips::close_files() {
   for (std::size_t k = 0; k < files_.size(); ++k)
-    if (files_[k] >= 0) ::close(files_[k]), ::unlink(paths_[k].c_str()), files_[k] = -1;
+    if (files_[k] >= 0) ::close(files_[k]), files_[k] = -1;
 }
 
 std::vector<float> DistanceStrips::window(int k, int col0, int row0, int cols, int rows) const {
@@ -266,8 +267,8 @@ std::vector<float> DistanceStrips::window(int k, int col0, int row0, int cols, i
              off_t((std::size_t(s0) * std::size_t(rows_) + std::size_t(row0) * std::size_t(w)) * sizeof(float)), paths_[std::size_t(k)]);
     const int c_lo = std::max(col0, s0), c_hi = std::min(col0 + cols, s0 + w);
     for (int r = 0; r < rows; ++r)
-      std::copy(&block[std::size_t(r) * std::size_t(w) + std::size_t(c_lo - s0)], &block[std::size_t(r) * std::size_t(w) + std::size_t(c_hi - s0)],
-                &out[std::size_t(r) * std::size_t(cols) + std::size_t(c_lo - col0)]);
+      std::copy_n(block.data() + std::size_t(r) * std::size_t(w) + std::size_t(c_lo - s0), c_hi - c_lo,
+                  out.data() + std::size_t(r) * std::size_t(cols) + std::size_t(c_lo - col0));
   }
   return out;
 }

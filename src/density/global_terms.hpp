@@ -14,17 +14,16 @@ namespace terrapolis::density {
 
 /// Ranks among the region's land cells (the share of cells below, ties counted half, in [0,1]) on
 /// the values rounded down to the float's top 20 bits (11 bits of mantissa): steps of 0.03 m at
-/// 100 m of altitude, 0.5 m at 1000-2048 m, 2 m above 4096 m, 0.004 degree at 15 degrees of slope. The rounding makes the counts a fixed table
-/// of 2^20 (8 MB) that tiles add up in any order, so a region larger than memory gets the whole
-/// grid's ranks bit for bit.
+/// 100 m of altitude, 0.5 m at 1024-2048 m, 2 m above 4096 m, 0.004 degree at 15 degrees of slope.
+/// The rounding makes the counts a fixed table of 2^20 (4 MB) that tiles add up in any order, so a
+/// region larger than memory gets the whole grid's ranks bit for bit.
 class LandRanks {
  public:
   static constexpr int kKeyBits = 20;
-  static constexpr double kBytes = double(std::size_t(1) << kKeyBits) * sizeof(std::uint64_t);
+  static constexpr double kBytes = double(std::size_t(1) << kKeyBits) * sizeof(std::uint32_t);
   LandRanks();
-  /// Counts the values that are not NaN.
+  /// Counts the values that are not NaN (throws when one key would hold 2^32 cells).
   void add(const float* values, std::size_t n);
-  void add(const LandRanks& other);
   /// Turns the counts into ranks (call once, after the last add).
   void finish();
   /// The rank of v (finish called; v counted or equal to a counted value once rounded).
@@ -33,7 +32,7 @@ class LandRanks {
 
  private:
   static std::size_t key(float v);
-  std::vector<std::uint64_t> counts_;
+  std::vector<std::uint32_t> counts_;
   std::vector<float> ranks_;
   std::uint64_t total_ = 0;
 };
@@ -55,7 +54,8 @@ class DistanceStrips {
   /// strip (its column transforms and their floats).
   static constexpr double kBandBytesPerCell = 48, kStripBytesPerCell = 24;
   /// `budget_bytes` sizes the bands and strips (a band of one row and a strip of one column at
-  /// least). The scratch files are made in `scratch_dir` and removed by the destructor.
+  /// least). The scratch files in `scratch_dir` are unlinked once open: 12 bytes a cell and
+  /// feature at most while one feature is transformed, 4 bytes a cell and feature kept.
   DistanceStrips(const CellMetrics& metrics, int cols, int rows, int features, const std::string& scratch_dir, double budget_bytes,
                  const ReadBand& read, Progress& progress);
   ~DistanceStrips();

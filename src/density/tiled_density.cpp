@@ -65,7 +65,7 @@ int density_tile_size_for(int cols, int rows, int halo_rows, int halo_cols, doub
         return cell_bytes * double(std::min(side, rows) + 2 * halo_rows) * double(std::min(side, cols) + 2 * halo_cols) + global_bytes;
       },
       memory_limit_mb, reserved_mb,
-      "density tiles of 64 x 64 cells with a halo of " + std::to_string(halo_cols) + " x " + std::to_string(halo_rows) + " cells (r_max)");
+      "density tiles of 64 x 64 cells with a halo of " + std::to_string(halo_cols) + " x " + std::to_string(halo_rows) + " cells (the discs' reach)");
 }
 
 TiledDensityReport run_tiled_density(int cols, int rows, const Georef& georef, const ReadWindowInputs& read,
@@ -95,7 +95,7 @@ TiledDensityReport run_tiled_density(int cols, int rows, const Georef& georef, c
   };
   std::array<int, 2> widest = {outer.reach_rows() + inner.reach_rows(), outer.reach_cols() + inner.reach_cols()};
   if (terms) widest = {std::max(widest[0], positions[1].reach_rows()), std::max(widest[1], positions[1].reach_cols())};
-  const double cell_bytes = kDensityBytesPerCell + (terms ? kTerrainBytesPerCell : 0);
+  const double cell_bytes = kDensityBytesPerCell + (terms ? kTerrainBytesPerCell : 0) + (options.model ? kBoostedBytesPerCell : 0);
   report.tile_size = tile_size > 0 ? std::max(tile_size, 8)
                                    : density_tile_size_for(cols, rows, widest[0], widest[1], report.global_bytes, memory_limit_mb, reserved_mb, cell_bytes);
   const TileGrid grid(cols, rows, report.tile_size);

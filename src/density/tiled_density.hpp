@@ -86,8 +86,9 @@ struct TiledDensityReport {
 /// used to size tiles from a memory limit.
 inline constexpr double kDensityBytesPerCell = 64;
 /// Bytes per cell of a window more with the terrain terms (six rasters, the positions' sums, the
-/// distances read back).
-inline constexpr double kTerrainBytesPerCell = 48;
+/// distances read back), and more again with boosted trees (their table of the ten terms, its
+/// copy in XGBoost, the margins).
+inline constexpr double kTerrainBytesPerCell = 56, kBoostedBytesPerCell = 100;
 
 /// The largest tile side (at least 64) whose window fits `memory_limit_mb` with the global state;
 /// throws bad_input when none does.

@@ -81,8 +81,10 @@ density::ReadWindowInputs density_windows(const DemWindowReader& dem, const Scen
     in.options = options;
     const Georef& grid = in.dem.georef();
     in.options.water_mask = read_mask(inland_water, grid, cols, rows);
-    if (accumulation) in.options.rivers = river_cells(accumulation->read(c0, r0, cols, rows), scenario);
-    if (dem_only) return in;
+    if (dem_only) {
+      if (accumulation) in.options.rivers = river_cells(accumulation->read(c0, r0, cols, rows), scenario);  // for the distances' bands
+      return in;
+    }
     read_density_files(scenario, grid, cols, rows, "", in.options);
     in.hydrometry = hydrometry ? hydrometry(in.dem, c0, r0) : in.dem.like<float>(0.0f);
     return in;

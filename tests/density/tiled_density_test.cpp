@@ -214,7 +214,7 @@ TEST(DistanceStrips, EqualTheWholeGridsTransformOnAnyBandsAndStrips) {
   // Random features on a geographic grid (rows of different widths); budgets from one row and one
   // column to the whole grid: the distances must be distance_to_m's bit for bit.
   std::mt19937 rng(5);
-  for (int trial = 0; trial < 6; ++trial) {
+  for (int trial = 0; trial < 9; ++trial) {
     const int cols = 20 + int(rng() % 60), rows = 15 + int(rng() % 50);
     const Georef g = trial % 2 ? test::geographic(55.0 + trial, 1.0 / 120) : test::projected(90, 75);
     const CellMetrics m = cell_metrics(g, cols, rows);
@@ -238,13 +238,15 @@ TEST(DistanceStrips, EqualTheWholeGridsTransformOnAnyBandsAndStrips) {
       for (int k = 0; k < 2; ++k) {
         EXPECT_EQ(strips.any(k), std::find(features[std::size_t(k)].begin(), features[std::size_t(k)].end(), 1) != features[std::size_t(k)].end());
         const std::vector<float> whole = distance_to_m(features[std::size_t(k)], m, cols, rows);
+        // A window anywhere: to the grid's last row and column, or inside.
         const int c0 = int(rng() % std::uint32_t(cols / 2)), r0 = int(rng() % std::uint32_t(rows / 2));
-        const std::vector<float> w = strips.window(k, c0, r0, cols - c0, rows - r0);
+        const int wc = trial % 3 ? cols - c0 : 1 + int(rng() % std::uint32_t(cols - c0)), wr = trial % 3 ? rows - r0 : 1 + int(rng() % std::uint32_t(rows - r0));
+        const std::vector<float> w = strips.window(k, c0, r0, wc, wr);
         std::size_t differ = 0;
-        for (int r = r0; r < rows; ++r)
-          for (int c = c0; c < cols; ++c)
+        for (int r = r0; r < r0 + wr; ++r)
+          for (int c = c0; c < c0 + wc; ++c)
             differ += std::memcmp(&whole[std::size_t(r) * std::size_t(cols) + std::size_t(c)],
-                                  &w[std::size_t(r - r0) * std::size_t(cols - c0) + std::size_t(c - c0)], sizeof(float)) != 0;
+                                  &w[std::size_t(r - r0) * std::size_t(wc) + std::size_t(c - c0)], sizeof(float)) != 0;
         EXPECT_EQ(differ, 0u) << "feature " << k;
       }
     }
