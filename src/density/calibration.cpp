@@ -101,30 +101,42 @@ std::array<double, 3> baselines_at(const DensityResult& m, std::size_t i) {
 
 double Skill::best_baseline() const { return *std::max_element(baseline_auc.begin(), baseline_auc.end()); }
 
+Scores scores_at(const Raster<float>& density, const DensityResult& terms, std::size_t i) {
+  const auto b = baselines_at(terms, i);
+  return {density[i], float(b[0]), float(b[1]), float(b[2])};
+}
+
 Skill skill(const Raster<float>& density, const DensityResult& terms, const std::vector<Place>& places, const std::vector<std::uint8_t>& land) {
-  std::vector<double> bg;
-  std::array<std::vector<double>, 3> bg_base;
-  for (std::size_t i = 0; i < land.size(); ++i) {
-    if (!land[i]) continue;
-    bg.push_back(density[i]);
-    const auto b = baselines_at(terms, i);
-    for (int k = 0; k < 3; ++k) bg_base[std::size_t(k)].push_back(b[std::size_t(k)]);
-  }
-  std::vector<double> pres, weights;
-  std::array<std::vector<double>, 3> pres_base;
-  for (const Place& p : places) {
-    const std::size_t i = density.index(p.col, p.row);
-    pres.push_back(density[i]);
-    weights.push_back(p.population);
-    const auto b = baselines_at(terms, i);
-    for (int k = 0; k < 3; ++k) pres_base[std::size_t(k)].push_back(b[std::size_t(k)]);
-  }
+  SkillCounter counter;
+  for (std::size_t i = 0; i < land.size(); ++i)
+    if (land[i]) counter.add_land(scores_at(density, terms, i));
+  std::vector<Scores> at;
+  std::vector<double> populations;
+  for (const Place& p : places) at.push_back(scores_at(density, terms, density.index(p.col, p.row))), populations.push_back(p.population);
+  return counter.skill(at, populations);
+}
+
+void SkillCounter::add_land(const Scores& s) {
+  for (std::size_t k = 0; k < 4; ++k) ranks_[k].add(&s[k], 1);
+}
+
+Skill SkillCounter::skill(const std::vector<Scores>& places, const std::vector<double>& populations) {
+  for (LandRanks& r : ranks_) r.finish();
+  std::array<double, 4> sum{}, total{}, weighted{}, weight{};
+  for (std::size_t p = 0; p < places.size(); ++p)
+    for (std::size_t k = 0; k < 4; ++k) {
+      if (std::isnan(places[p][k]) || ranks_[k].count() == 0) continue;
+      const double share = ranks_[k].rank(places[p][k]);
+      sum[k] += share, total[k] += 1;
+      weighted[k] += populations[p] * share, weight[k] += populations[p];
+    }
+  const auto mean = [](double s, double n) { return n > 0 ? s / n : NAN; };
   Skill s;
-  s.auc = auc(pres, {}, bg);
-  s.weighted_auc = auc(pres, weights, bg);
+  s.auc = mean(sum[0], total[0]);
+  s.weighted_auc = mean(weighted[0], weight[0]);
   for (std::size_t k = 0; k < 3; ++k) {
-    s.baseline_auc[k] = auc(pres_base[k], {}, bg_base[k]);
-    s.baseline_weighted_auc[k] = auc(pres_base[k], weights, bg_base[k]);
+    s.baseline_auc[k] = mean(sum[k + 1], total[k + 1]);
+    s.baseline_weighted_auc[k] = mean(weighted[k + 1], weight[k + 1]);
   }
   return s;
 }

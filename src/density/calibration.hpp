@@ -52,4 +52,19 @@ struct Skill {
 Skill skill(const Raster<float>& density, const DensityResult& terms, const std::vector<Place>& places,
             const std::vector<std::uint8_t>& land);
 
+/// The density's and the baselines' scores at a cell: the density, then baselines_at's three.
+using Scores = std::array<float, 4>;
+Scores scores_at(const Raster<float>& density, const DensityResult& terms, std::size_t i);
+/// skill() counted cell by cell, in any order (a region by tiles): the land cells' scores go into
+/// one LandRanks each, and a place's AUC share is its score's rank among them (the keys' rounding,
+/// docs/density.md; a place's NaN score takes no part).
+class SkillCounter {
+ public:
+  void add_land(const Scores& s);
+  Skill skill(const std::vector<Scores>& places, const std::vector<double>& populations);
+
+ private:
+  std::array<LandRanks, 4> ranks_;
+};
+
 }  // namespace terrapolis::density

@@ -142,7 +142,7 @@ void LandRanks::finish() {
   const double n = double(total_);
   std::uint64_t below = 0;
   for (std::size_t k = 0; k < counts_.size(); ++k) {
-    if (counts_[k]) ranks_[k] = float((double(below) + 0.5 * double(counts_[k])) / n);
+    ranks_[k] = float((double(below) + 0.5 * double(counts_[k])) / n);  // a value never counted: the share below it
     below += counts_[k];
   }
   std::vector<std::uint32_t>().swap(counts_);

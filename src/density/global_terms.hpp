@@ -26,7 +26,7 @@ class LandRanks {
   void add(const float* values, std::size_t n);
   /// Turns the counts into ranks (call once, after the last add).
   void finish();
-  /// The rank of v (finish called; v counted or equal to a counted value once rounded).
+  /// The rank of v (finish called): the share of the counted values below v's key, plus half its own.
   float rank(float v) const;
   std::uint64_t count() const { return total_; }
 

@@ -91,6 +91,14 @@ density::ReadWindowInputs density_windows(const DemWindowReader& dem, const Scen
   };
 }
 
+RunDensityWindows::RunDensityWindows(const std::string& dem_path, const ReadOptions& read, const std::string& run_folder, const Scenario& scenario,
+                                     density::DensityOptions options)
+    : options_(std::move(options)), dem_(dem_path, read), hydrometry_(run_folder + "/hydrometry.vrt") {
+  read_ = density_windows(
+      dem_, scenario, options_, run_folder + "/inland_water.vrt",
+      [this](const Dem& w, int c0, int r0) { return hydrometry_.read(c0, r0, w.cols(), w.rows()); }, run_folder + "/accumulation.vrt");
+}
+
 // A window's cells hold 13 bytes while read (a raster read as floats, 4, and GDAL's copy of it, 4;
 // the view's density and buildable, 5); a band's 4 more (the catchments' owner), a block's 2 (the
 // disc test's row gaps). Measured, the process grows by about 1.5 times that (the VRT's buffers,

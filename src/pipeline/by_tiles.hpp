@@ -53,6 +53,21 @@ density::ReadWindowInputs density_windows(const DemWindowReader& dem, const Scen
                                           const std::string& inland_water, const ReadHydrometry& hydrometry,
                                           const std::string& accumulation_km2 = "");
 
+/// The density stage's inputs in a run by tiles, by windows (density_windows): the DEM and the
+/// hydro stage's hydrometry.vrt, inland_water.vrt and accumulation.vrt in `run_folder`.
+class RunDensityWindows {
+ public:
+  RunDensityWindows(const std::string& dem_path, const ReadOptions& read, const std::string& run_folder, const Scenario& scenario,
+                    density::DensityOptions options);
+  const density::ReadWindowInputs& read() const { return read_; }
+  const density::DensityOptions& options() const { return options_; }
+
+ private:
+  density::DensityOptions options_;
+  DemWindowReader dem_, hydrometry_;
+  density::ReadWindowInputs read_;
+};
+
 /// The land of the sites stage read from the density stage's tiles (density.vrt, buildable.vrt):
 /// bands of rows and blocks sized to the memory limit, the disc tests' blocks grown by the largest
 /// disc.

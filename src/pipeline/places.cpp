@@ -186,7 +186,16 @@ std::vector<std::string> existing_place_warnings(const ExistingPlaces& places) {
 }
 
 std::vector<density::Place> read_places(const std::string& path, const Dem& dem, const std::vector<std::uint8_t>& land, int& dropped) {
-  const std::vector<RawPlace> raw = read_raw(path, dem.georef().crs);
+  return read_places(path, dem.georef(), dem.cols(), dem.rows(), [&](int c0, int r0, int cols, int rows) {
+    std::vector<std::uint8_t> window(std::size_t(cols) * std::size_t(rows));
+    for (int r = 0; r < rows; ++r)
+      for (int c = 0; c < cols; ++c) window[std::size_t(r) * std::size_t(cols) + std::size_t(c)] = land[dem.index(c0 + c, r0 + r)];
+    return window;
+  }, dropped);
+}
+
+std::vector<density::Place> read_places(const std::string& path, const Georef& grid, int cols, int rows, const LandWindow& land, int& dropped) {
+  const std::vector<RawPlace> raw = read_raw(path, grid.crs);
   dropped = 0;
   std::vector<density::Place> places;
   for (const RawPlace& p : raw) {
@@ -194,20 +203,26 @@ std::vector<density::Place> read_places(const std::string& path, const Dem& dem,
       ++dropped;
       continue;
     }
-    const auto [col, row] = cell_of(dem.georef(), p.x, p.y);
-    int best_c = -1, best_r = -1, best_d = 1 << 30;
-    for (int r = row - 2; r <= row + 2; ++r)
-      for (int c = col - 2; c <= col + 2; ++c) {
-        if (!dem.inside(c, r) || !land[dem.index(c, r)]) continue;
-        const int d = (c - col) * (c - col) + (r - row) * (r - row);
-        if (d < best_d) best_d = d, best_c = c, best_r = r;
-      }
+    const auto [col, row] = cell_of(grid, p.x, p.y);
     // A place outside the grid (the reference's bounding box is wider than the DEM) or far from land.
-    if (best_c < 0 || !dem.inside(col, row)) {
+    if (col < 0 || row < 0 || col >= cols || row >= rows) {
       ++dropped;
       continue;
     }
-    const auto xy = dem.georef().cell_centre(best_c, best_r);
+    const int c0 = std::max(0, col - 2), r0 = std::max(0, row - 2), c1 = std::min(cols, col + 3), r1 = std::min(rows, row + 3);
+    const std::vector<std::uint8_t> near = land(c0, r0, c1 - c0, r1 - r0);
+    int best_c = -1, best_r = -1, best_d = 1 << 30;
+    for (int r = r0; r < r1; ++r)
+      for (int c = c0; c < c1; ++c) {
+        if (!near[std::size_t(r - r0) * std::size_t(c1 - c0) + std::size_t(c - c0)]) continue;
+        const int d = (c - col) * (c - col) + (r - row) * (r - row);
+        if (d < best_d) best_d = d, best_c = c, best_r = r;
+      }
+    if (best_c < 0) {
+      ++dropped;
+      continue;
+    }
+    const auto xy = grid.cell_centre(best_c, best_r);
     places.push_back({p.name, p.population, best_d == 0 ? p.x : xy[0], best_d == 0 ? p.y : xy[1], best_c, best_r});
   }
   std::stable_sort(places.begin(), places.end(), [](const density::Place& a, const density::Place& b) { return a.population > b.population; });

@@ -2,6 +2,7 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,10 @@ namespace terrapolis::pipeline {
 /// of a coarse grid is moved to the nearest land cell). `dropped` counts the others.
 /// Throws bad_input naming `path` when it cannot be read or has no population field.
 std::vector<density::Place> read_places(const std::string& path, const Dem& dem, const std::vector<std::uint8_t>& land, int& dropped);
+/// The same on a grid read by windows: `land(c0, r0, cols, rows)` gives the window's land (1),
+/// row-major; it is asked for the 5 x 5 cells around each place, clipped to the grid.
+using LandWindow = std::function<std::vector<std::uint8_t>(int c0, int r0, int cols, int rows)>;
+std::vector<density::Place> read_places(const std::string& path, const Georef& grid, int cols, int rows, const LandWindow& land, int& dropped);
 
 /// The settlements that exist, for sites.existing: the places of `path` (the formats read_places
 /// reads) with their populations (rounded to whole people), each on the cell holding it or, when

@@ -5,12 +5,16 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
+#include <memory>
 #include <limits>
 #include <optional>
 #include <random>
 
+#include "core/error.hpp"
 #include "core/geodesy.hpp"
 #include "density/calibration.hpp"
+#include "pipeline/by_tiles.hpp"
 #include "pipeline/places.hpp"
 #include "pipeline/stage_options.hpp"
 
@@ -72,14 +76,98 @@ std::vector<std::string> settlement_warnings(const RunState& s, const sites::Sit
   return warnings;
 }
 
-json realism_figures(RunState& s, density::DensityOptions options, const sites::SitesResult& r, const std::string& reference,
-                     std::vector<std::string>& warnings, Progress& progress) {
-  // The terrain terms for the baselines and the land mask: the run's density inputs, terms on.
+namespace {
+
+/// What the figures read of the grid: the places on land, the skill at them, and the land cells
+/// for the random draws.
+struct RealismGrid {
+  std::vector<density::Place> places;
+  int dropped = 0;
+  density::Skill skill;
+  std::uint64_t land_cells = 0;
+  std::function<std::array<double, 2>(std::uint64_t k)> land_cell_centre;  ///< of the k-th land cell, row-major
+};
+
+/// On the whole grid: the terrain terms computed once more (switched on for the baselines and the land).
+RealismGrid on_whole_grid(RunState& s, density::DensityOptions options, const std::string& reference, Progress& progress) {
   options.terrain_terms = true;
   const density::DensityResult terms = density::compute_density(s.dem, *s.hydrometry, options, progress);
   const std::vector<std::uint8_t> land = density::land_cells(terms);
-  int dropped = 0;
-  std::vector<density::Place> places = read_places(reference, s.dem, land, dropped);
+  RealismGrid g;
+  g.places = read_places(reference, s.dem, land, g.dropped);
+  if (!g.places.empty()) g.skill = density::skill(*s.density, terms, g.places, land);
+  auto cells = std::make_shared<std::vector<std::size_t>>();
+  for (std::size_t i = 0; i < land.size(); ++i)
+    if (land[i]) cells->push_back(i);
+  g.land_cells = cells->size();
+  g.land_cell_centre = [cells, georef = s.dem.georef(), cols = std::size_t(s.dem.cols())](std::uint64_t k) {
+    const std::size_t i = (*cells)[std::size_t(k)];
+    return georef.cell_centre(int(i % cols), int(i / cols));
+  };
+  return g;
+}
+
+/// By tiles: the density stage's tiles computed once more with the terms, each land cell's scores
+/// counted (density::SkillCounter) and the land cells counted per row; a place's land and the k-th
+/// land cell read back by windows.
+RealismGrid by_tiles(RunState& s, density::DensityOptions options, const std::string& reference, Progress& progress) {
+  s.by_tiles->reserve();
+  const TiledInput& in = *s.by_tiles;
+  options.terrain_terms = true;
+  auto windows = std::make_shared<const RunDensityWindows>(in.dem_path, in.read, s.folder.string(), s.scenario, options);
+  const int cols = s.grid.cols, rows = s.grid.rows;
+  const Georef georef = s.grid.georef;
+  const LandWindow land_of = [windows](int c0, int r0, int w, int h) {
+    const density::WindowInputs window = windows->read()(c0, r0, w, h, true);
+    std::vector<std::uint8_t> land = density::water_cells(window.dem, window.options);
+    for (std::size_t i = 0; i < land.size(); ++i) land[i] = !land[i] && !std::isnan(window.dem[i]);
+    return land;
+  };
+  RealismGrid g;
+  g.places = read_places(reference, georef, cols, rows, land_of, g.dropped);
+  density::SkillCounter counter;
+  constexpr float nan_f = std::numeric_limits<float>::quiet_NaN();
+  std::vector<density::Scores> at(g.places.size(), density::Scores{nan_f, nan_f, nan_f, nan_f});
+  auto below = std::make_shared<std::vector<std::uint64_t>>(std::size_t(rows) + 1, 0);  // land cells per row, then before each row
+  const ScratchFolder scratch((s.folder / ".scratch").string());
+  density::run_tiled_density(
+      cols, rows, georef, windows->read(), windows->options(), in.tiles.tile_size, in.tiles.limit_mb(), scratch.path(),
+      [&](int, int, const density::DensityResult& tile) {
+        const GeoTransform &t = tile.density.georef().transform, &grid = georef.transform;
+        const int c0 = int(std::lround((t[0] - grid[0]) / grid[1])), r0 = int(std::lround((t[3] - grid[3]) / grid[5]));
+        const Raster<float>& altitude = tile.term(density::TerrainTerm::altitude);  // NaN off land
+        for (int y = 0; y < tile.density.rows(); ++y)
+          for (int x = 0; x < tile.density.cols(); ++x)
+            if (const std::size_t i = tile.density.index(x, y); !std::isnan(altitude[i]))
+              counter.add_land(density::scores_at(tile.density, tile, i)), ++(*below)[std::size_t(r0 + y) + 1];
+        for (std::size_t k = 0; k < g.places.size(); ++k)
+          if (const auto& p = g.places[k]; tile.density.inside(p.col - c0, p.row - r0))
+            at[k] = density::scores_at(tile.density, tile, tile.density.index(p.col - c0, p.row - r0));
+      },
+      progress, in.reserved_mb);
+  std::vector<double> populations;
+  for (const auto& p : g.places) populations.push_back(p.population);
+  if (!g.places.empty()) g.skill = counter.skill(at, populations);
+  for (int r = 0; r < rows; ++r) (*below)[std::size_t(r) + 1] += (*below)[std::size_t(r)];
+  g.land_cells = below->back();
+  g.land_cell_centre = [below, land_of, georef, cols](std::uint64_t k) {
+    const int row = int(std::upper_bound(below->begin(), below->end(), k) - below->begin()) - 1;
+    const std::vector<std::uint8_t> land = land_of(0, row, cols, 1);
+    std::uint64_t seen = (*below)[std::size_t(row)];
+    for (int c = 0; c < cols; ++c)
+      if (land[std::size_t(c)] && seen++ == k) return georef.cell_centre(c, row);
+    throw processing_error("realism: the land of row " + std::to_string(row) + " read back differs from its count");
+  };
+  return g;
+}
+
+}  // namespace
+
+json realism_figures(RunState& s, density::DensityOptions options, const sites::SitesResult& r, const std::string& reference,
+                     std::vector<std::string>& warnings, Progress& progress) {
+  RealismGrid grid = s.by_tiles ? by_tiles(s, std::move(options), reference, progress) : on_whole_grid(s, std::move(options), reference, progress);
+  const std::vector<density::Place>& places = grid.places;
+  const int dropped = grid.dropped;
   const double min_population = s.scenario.resolved["sites"]["min_population"].get<double>();
   std::vector<double> real_sizes, generated_sizes;
   double real_total = 0, generated_total = 0;
@@ -102,7 +190,7 @@ json realism_figures(RunState& s, density::DensityOptions options, const sites::
                                {"reference", std::isfinite(q_ref) ? json(rounded(q_ref, 1e-3)) : json(nullptr)}};
   if (places.empty()) return out;
 
-  const density::Skill skill = density::skill(*s.density, terms, places, land);
+  const density::Skill& skill = grid.skill;
   json baselines = json::object();
   for (std::size_t k = 0; k < 3; ++k)
     baselines[density::kBaselineNames[k]] = {{"auc", rounded(skill.baseline_auc[k], 1e-3)}, {"weighted_auc", rounded(skill.baseline_weighted_auc[k], 1e-3)}};
@@ -115,7 +203,7 @@ json realism_figures(RunState& s, density::DensityOptions options, const sites::
   }
 
   // Location: the ten largest real places against the ten largest generated settlements.
-  const Crs& crs = s.dem.georef().crs;
+  const Crs& crs = s.grid.georef.crs;
   const std::size_t top = std::min<std::size_t>(10, places.size()), top_gen = std::min<std::size_t>(10, r.sites.size());
   std::vector<std::size_t> order(r.sites.size());
   for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
@@ -136,17 +224,13 @@ json realism_figures(RunState& s, density::DensityOptions options, const sites::
                        {"nearest_top_km", std::isfinite(d) ? json(rounded(d / 1000, 0.01)) : json(nullptr)}});
   }
   // The same count for random land points in place of the generated settlements (seeded draws).
-  std::vector<std::size_t> land_cells;
-  for (std::size_t i = 0; i < land.size(); ++i)
-    if (land[i]) land_cells.push_back(i);
   std::mt19937_64 generator(s.scenario.resolved["seed"].get<std::uint64_t>());
   const int draws = 100;
   double random_within = 0;
-  for (int d = 0; d < draws && top_gen > 0; ++d) {
+  for (int d = 0; d < draws && top_gen > 0 && grid.land_cells > 0; ++d) {
     std::vector<std::array<double, 2>> points;
     for (std::size_t k = 0; k < top_gen; ++k) {
-      const std::size_t i = land_cells[std::size_t(generator() % land_cells.size())];
-      points.push_back(s.dem.georef().cell_centre(int(i % std::size_t(s.dem.cols())), int(i / std::size_t(s.dem.cols()))));
+      points.push_back(grid.land_cell_centre(generator() % grid.land_cells));
     }
     for (std::size_t k = 0; k < top; ++k) random_within += nearest(places[k].x, places[k].y, points) <= 10000;
   }

@@ -326,15 +326,11 @@ constexpr std::pair<const char*, Style> kDensityRasters[] = {
 void density_run_tiles(RunState& s, Progress& progress, const Log& log) {
   s.by_tiles->reserve();
   const TiledInput& in = *s.by_tiles;
-  const DemWindowReader reader(in.dem_path, in.read), hydrometry(saved(s, "hydrometry.vrt"));
-  const density::DensityOptions& options = s.settings.density;
-  const density::ReadWindowInputs read = density_windows(reader, s.scenario, options, saved(s, "inland_water.vrt"),
-                                                         [&](const Dem& w, int c0, int r0) { return hydrometry.read(c0, r0, w.cols(), w.rows()); },
-                                                         saved(s, "accumulation.vrt"));
+  const RunDensityWindows windows(in.dem_path, in.read, s.folder.string(), s.scenario, s.settings.density);
   for (const auto& [name, style] : kDensityRasters) s.mosaic(name).create();
   const ScratchFolder scratch((s.folder / ".scratch").string());
   const density::TiledDensityReport report = density::run_tiled_density(
-      s.grid.cols, s.grid.rows, s.grid.georef, read, options, in.tiles.tile_size, in.tiles.limit_mb(), scratch.path(),
+      s.grid.cols, s.grid.rows, s.grid.georef, windows.read(), windows.options(), in.tiles.tile_size, in.tiles.limit_mb(), scratch.path(),
       [&](int t, int across, const density::DensityResult& d) {
         const Raster<float>* floats[] = {&d.coast, &d.plateau, &d.plain};
         for (int k = 0; k < 3; ++k) s.write_tile("density", s.mosaic(kDensityRasters[k].first), t, across, *floats[k]);
@@ -524,7 +520,9 @@ void sites_run(RunState& s, Progress& progress, const Log& log) {
   std::vector<std::string> warnings = existing_file.empty() ? std::vector<std::string>() : existing_warnings(existing, options, r);
   for (auto& w : settlement_warnings(s, r)) warnings.push_back(std::move(w));
   const std::string reference = s.scenario.path("/sites/reference");
-  const json realism = reference.empty() ? json() : realism_figures(s, density_inputs(s), r, reference, warnings, progress);
+  const json realism = reference.empty()  ? json()
+                       : s.by_tiles ? realism_figures(s, s.settings.density, r, reference, warnings, progress)
+                                    : realism_figures(s, density_inputs(s), r, reference, warnings, progress);
   for (const auto& w : warnings) log.warn(w);
   summary["warnings"] = warnings;
   if (!reference.empty()) s.summary["realism"] = realism;  // last: inserting moves the entries `summary` points into
@@ -540,8 +538,6 @@ void sites_load(RunState& s) {
 void sites_prepare(const Scenario& scenario, const RasterHeader& grid, Settings& s) {
   s.sites = sites_options(scenario);
   check_file("/sites/reference", scenario.path("/sites/reference"));
-  if (tile_settings(scenario).given() && !scenario.path("/sites/reference").empty())
-    throw bad_input("/sites/reference: the realism figures are not computed on tiles yet (they read the whole density)");
   if (const std::string existing = scenario.path("/sites/existing"); !existing.empty()) {
     check_file("/sites/existing", existing);
     // Its format and figures now (whether each place finds land needs the density).

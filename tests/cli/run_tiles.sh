@@ -4,7 +4,8 @@
 # per raster, the same cells as the run on the whole grid, the same streams and figures; the sites
 # stage reads the density's tiles by bands and blocks, the roads stage searches each link on a
 # window of the DEM, the access stage its travel times by tiles; the settlements, the network, the
-# roads, the catchments and preview.png are the whole grid's bytes; memory bounded by the limit; what is not computed on tiles yet refused before any stage.
+# roads, the catchments and preview.png are the whole grid's bytes, the realism figures the whole grid's; memory bounded by the limit;
+# what is not computed on tiles yet refused before any stage.
 # SPDX-License-Identifier: MIT
 source "$(dirname "$0")/lib.sh" "$@"
 cd "$WORK"
@@ -93,14 +94,24 @@ for l in cities.geojson network.geojson roads.geojson; do cmp -s "places_whole/$
 no_leftovers "$WORK"
 [[ -z $(find . -name '.scratch*') ]] || fail "a scratch folder was left behind"
 
+# The realism figures against the real places (sites.reference) on tiles of 40: the whole grid's.
+reference=(--set sites.reference="$SOURCE/tests/data/geonames_capcorse.geojson" --until sites)
+"$TP" -q run "${reference[@]}" -o real_whole
+"$TP" -q run "${reference[@]}" --set input.tile_size=40 -o real_tiles
+/usr/bin/python3 - <<'PY' || fail "sites.reference: the realism figures differ on tiles"
+import json
+w, t = (json.load(open(f + "/run.json"))["summary"] for f in ("real_whole", "real_tiles"))
+assert w["realism"] == t["realism"], (w["realism"], t["realism"])
+assert w["realism"]["places"] >= 10 and 0.5 < w["realism"]["skill"]["auc"] < 1, w["realism"]
+assert w["sites"]["warnings"] == t["sites"]["warnings"]
+PY
+
 # Refused before any stage, exit 2, no folder: the later stages, and what the tiles do not compute yet.
 expect_refused r3 "/hydro/classify: not computed on tiles yet" "$TP" run "${tiled[@]}" --set input.tile_size=64 --set hydro.classify=true -o r3
 expect_refused r4 "/hydro/flow mfd: not computed on tiles yet" "$TP" run "${tiled[@]}" --set input.tile_size=64 --set hydro.flow=mfd -o r4
 expect_refused r7 "/roads/existing: not computed on tiles yet" \
   "$TP" run "${tiled[@]}" --set input.tile_size=64 --set roads.existing="$SOURCE/tests/data/geonames_capcorse.geojson" -o r7
 expect_refused r8 "/roads/corridor/enabled: not computed on tiles yet" "$TP" run "${tiled[@]}" --set input.tile_size=64 --set roads.corridor.enabled=true -o r8
-expect_refused r6 "/sites/reference: the realism figures are not computed on tiles yet" \
-  "$TP" run "${tiled[@]}" --set input.tile_size=64 --set sites.reference="$SOURCE/tests/data/geonames_capcorse.geojson" -o r6
 gdal_calc.py --quiet -A "$SAMPLES/spDataLarge_srtm_zion.tif" --outfile nodata.tif --calc "A*0+65535" --NoDataValue 65535 --type UInt16
 expect_refused r5 "nodata.tif: holds no data" "$TP" run --set dem="$WORK/nodata.tif" "${tiled[@]}" --set input.tile_size=64 -o r5
 echo "run by tiles: ok"
