@@ -86,6 +86,20 @@ struct ColumnTransform {
   void run() { lower_envelope(northing, f, d, v, z); }
 };
 
+/// The columns' transform of `squared` (the rows' squared distances, `cols` a row, row-major)
+/// into the distances in metres, `out` laid out the same.
+void column_distances(const std::vector<double>& northing, int cols, const std::vector<double>& squared, std::vector<float>& out) {
+  const int rows = int(northing.size());
+  tbb::parallel_for(tbb::blocked_range<int>(0, cols, 4), [&](const tbb::blocked_range<int>& range) {
+    ColumnTransform t(northing, rows);
+    for (int c = range.begin(); c < range.end(); ++c) {
+      for (int r = 0; r < rows; ++r) t.f[std::size_t(r)] = squared[std::size_t(r) * std::size_t(cols) + std::size_t(c)];
+      t.run();
+      for (int r = 0; r < rows; ++r) out[std::size_t(r) * std::size_t(cols) + std::size_t(c)] = float(std::sqrt(t.d[std::size_t(r)]));
+    }
+  });
+}
+
 void write_all(int fd, const void* data, std::size_t bytes, off_t at, const std::string& path) {
   const char* p = static_cast<const char*>(data);
   while (bytes > 0) {
@@ -162,16 +176,8 @@ std::vector<float> distance_to_m(const std::vector<std::uint8_t>& feature, const
       std::copy(t.d.begin(), t.d.end(), row_d2.begin() + std::ptrdiff_t(std::size_t(r) * std::size_t(cols)));
     }
   });
-  const std::vector<double> northing = northings(metrics, rows);
   std::vector<float> out(n);
-  tbb::parallel_for(tbb::blocked_range<int>(0, cols, 16), [&](const tbb::blocked_range<int>& range) {
-    ColumnTransform t(northing, rows);
-    for (int c = range.begin(); c < range.end(); ++c) {
-      for (int r = 0; r < rows; ++r) t.f[std::size_t(r)] = row_d2[std::size_t(r) * std::size_t(cols) + std::size_t(c)];
-      t.run();
-      for (int r = 0; r < rows; ++r) out[std::size_t(r) * std::size_t(cols) + std::size_t(c)] = float(std::sqrt(t.d[std::size_t(r)]));
-    }
-  });
+  column_distances(northings(metrics, rows), cols, row_d2, out);
   return out;
 }
 
@@ -231,14 +237,7 @@ DistanceStrips::DistanceStrips(const CellMetrics& metrics, int cols, int rows, i
         out.resize(in.size());
         read_all(squared[std::size_t(k)], in.data(), in.size() * sizeof(double), off_t(cell_at(c0, w, 0) * sizeof(double)),
                  squared_paths[std::size_t(k)]);
-        tbb::parallel_for(tbb::blocked_range<int>(0, w, 4), [&](const tbb::blocked_range<int>& range) {
-          ColumnTransform t(northing, rows);
-          for (int c = range.begin(); c < range.end(); ++c) {
-            for (int r = 0; r < rows; ++r) t.f[std::size_t(r)] = in[std::size_t(r) * std::size_t(w) + std::size_t(c)];
-            t.run();
-            for (int r = 0; r < rows; ++r) out[std::size_t(r) * std::size_t(w) + std::size_t(c)] = float(std::sqrt(t.d[std::size_t(r)]));
-          }
-        });
+        column_distances(northing, w, in, out);
         write_all(files_[std::size_t(k)], out.data(), out.size() * sizeof(float), off_t(cell_at(c0, w, 0) * sizeof(float)), paths_[std::size_t(k)]);
         step.update((double(k) + double(c0 + w) / cols) / features);
         if (c0 + w == cols) ::close(squared[std::size_t(k)]), squared[std::size_t(k)] = -1;  // its disk space back before the next feature's
