@@ -117,10 +117,13 @@ Skill skill(const Raster<float>& density, const DensityResult& terms, const std:
 }
 
 void SkillCounter::add_land(const Scores& s) {
+  if (finished_) throw processing_error("density: a land cell counted after the skill");
   for (std::size_t k = 0; k < 4; ++k) ranks_[k].add(&s[k], 1);
 }
 
 Skill SkillCounter::skill(const std::vector<Scores>& places, const std::vector<double>& populations) {
+  if (finished_) throw processing_error("density: the skill taken twice");
+  finished_ = true;
   for (LandRanks& r : ranks_) r.finish();
   std::array<double, 4> sum{}, total{}, weighted{}, weight{};
   for (std::size_t p = 0; p < places.size(); ++p)

@@ -61,10 +61,12 @@ Scores scores_at(const Raster<float>& density, const DensityResult& terms, std::
 class SkillCounter {
  public:
   void add_land(const Scores& s);
+  /// Once, after the last add_land.
   Skill skill(const std::vector<Scores>& places, const std::vector<double>& populations);
 
  private:
   std::array<LandRanks, 4> ranks_;
+  bool finished_ = false;
 };
 
 }  // namespace terrapolis::density

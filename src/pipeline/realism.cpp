@@ -14,6 +14,8 @@
 #include "core/error.hpp"
 #include "core/geodesy.hpp"
 #include "density/calibration.hpp"
+#include "io/crs.hpp"
+#include "io/mask_io.hpp"
 #include "pipeline/by_tiles.hpp"
 #include "pipeline/places.hpp"
 #include "pipeline/stage_options.hpp"
@@ -111,30 +113,37 @@ RealismGrid on_whole_grid(RunState& s, density::DensityOptions options, const st
 /// counted (density::SkillCounter) and the land cells counted per row; a place's land and the k-th
 /// land cell read back by windows.
 RealismGrid by_tiles(RunState& s, density::DensityOptions options, const std::string& reference, Progress& progress) {
-  s.by_tiles->reserve();
   const TiledInput& in = *s.by_tiles;
-  options.terrain_terms = true;
-  auto windows = std::make_shared<const RunDensityWindows>(in.dem_path, in.read, s.folder.string(), s.scenario, options);
   const int cols = s.grid.cols, rows = s.grid.rows;
   const Georef georef = s.grid.georef;
-  const LandWindow land_of = [windows](int c0, int r0, int w, int h) {
-    const density::WindowInputs window = windows->read()(c0, r0, w, h, true);
-    std::vector<std::uint8_t> land = density::water_cells(window.dem, window.options);
-    for (std::size_t i = 0; i < land.size(); ++i) land[i] = !land[i] && !std::isnan(window.dem[i]);
+  // Land: data, not water (the density's cell kinds), from the DEM and the inland water alone.
+  auto dem = std::make_shared<const DemWindowReader>(in.dem_path, in.read);
+  const LandWindow land_of = [dem, options, water = (s.folder / "inland_water.vrt").string()](int c0, int r0, int w, int h) {
+    density::DensityOptions o = options;
+    const Dem window = dem->read(c0, r0, w, h);
+    o.water_mask = read_mask(water, window.georef(), w, h);
+    std::vector<std::uint8_t> land = density::water_cells(window, o);
+    for (std::size_t i = 0; i < land.size(); ++i) land[i] = !land[i] && !std::isnan(window[i]);
     return land;
   };
   RealismGrid g;
   g.places = read_places(reference, georef, cols, rows, land_of, g.dropped);
-  density::SkillCounter counter;
+  if (g.places.empty()) return g;  // no figure reads the land then
+  density::SkillCounter counter;  // its tables before the limit is counted again
+  s.by_tiles->reserve();
+  options.terrain_terms = true;
+  const RunDensityWindows windows(in.dem_path, in.read, s.folder.string(), s.scenario, options);
+  const GridLocator locator(georef);
   constexpr float nan_f = std::numeric_limits<float>::quiet_NaN();
   std::vector<density::Scores> at(g.places.size(), density::Scores{nan_f, nan_f, nan_f, nan_f});
   auto below = std::make_shared<std::vector<std::uint64_t>>(std::size_t(rows) + 1, 0);  // land cells per row, then before each row
   const ScratchFolder scratch((s.folder / ".scratch").string());
   density::run_tiled_density(
-      cols, rows, georef, windows->read(), windows->options(), in.tiles.tile_size, in.tiles.limit_mb(), scratch.path(),
+      cols, rows, georef, windows.read(), windows.options(), in.tiles.tile_size, in.tiles.limit_mb(), scratch.path(),
       [&](int, int, const density::DensityResult& tile) {
-        const GeoTransform &t = tile.density.georef().transform, &grid = georef.transform;
-        const int c0 = int(std::lround((t[0] - grid[0]) / grid[1])), r0 = int(std::lround((t[3] - grid[3]) / grid[5]));
+        const GeoTransform& t = tile.density.georef().transform;
+        const std::array<double, 2> corner = locator.crs_to_pixel(t[0], t[3]);  // the tile's first cell in the grid
+        const int c0 = int(std::lround(corner[0])), r0 = int(std::lround(corner[1]));
         const Raster<float>& altitude = tile.term(density::TerrainTerm::altitude);  // NaN off land
         for (int y = 0; y < tile.density.rows(); ++y)
           for (int x = 0; x < tile.density.cols(); ++x)
@@ -147,7 +156,7 @@ RealismGrid by_tiles(RunState& s, density::DensityOptions options, const std::st
       progress, in.reserved_mb);
   std::vector<double> populations;
   for (const auto& p : g.places) populations.push_back(p.population);
-  if (!g.places.empty()) g.skill = counter.skill(at, populations);
+  g.skill = counter.skill(at, populations);
   for (int r = 0; r < rows; ++r) (*below)[std::size_t(r) + 1] += (*below)[std::size_t(r)];
   g.land_cells = below->back();
   g.land_cell_centre = [below, land_of, georef, cols](std::uint64_t k) {
