@@ -291,10 +291,10 @@ TiledAccess travel_time_by_tiles(const Georef& georef, int cols, int rows, int t
   std::vector<std::uint8_t> done;
   // Searches tile t on its frames' times so far: its window (the tile and two cells around) read,
   // the neighbours' frame cells in it as seeds, its destinations at 0.
-  auto search = [&](std::size_t t, AccessWindow& w, Area& area, int& wc0, int& wr0) {
+  auto search = [&](std::size_t t, AccessWindow& w, Area& area) {
     const int tx = int(t % std::size_t(across)), ty = int(t / std::size_t(across));
     const int x0 = tx * tile_size, y0 = ty * tile_size, x1 = x0 + frames[t].w, y1 = y0 + frames[t].h;
-    wc0 = std::max(0, x0 - 2), wr0 = std::max(0, y0 - 2);
+    const int wc0 = std::max(0, x0 - 2), wr0 = std::max(0, y0 - 2);
     const int wc1 = std::min(cols, x1 + 2), wr1 = std::min(rows, y1 + 2);
     w = read(wc0, wr0, wc1 - wc0, wr1 - wr0);
     area = {x0 - wc0, y0 - wr0, x1 - wc0, y1 - wr0};
@@ -334,8 +334,7 @@ TiledAccess travel_time_by_tiles(const Georef& georef, int cols, int rows, int t
     if (item.key != pending[item.tile]) continue;
     pending[item.tile] = INFINITY;
     const std::size_t t = item.tile;
-    int wc0 = 0, wr0 = 0;
-    search(t, w, area, wc0, wr0);
+    search(t, w, area);
     Frame& f = frames[t];
     if (f.minutes.empty()) f.minutes.assign(f.size(), INFINITY), f.id.assign(f.size(), -1);
     const int tx = int(t % std::size_t(across)), ty = int(t / std::size_t(across));
@@ -368,8 +367,7 @@ TiledAccess travel_time_by_tiles(const Georef& georef, int cols, int rows, int t
   }
   // Every frame holds its final times: each tile searched once more, in order, and written.
   for (std::size_t t = 0; t < tiles; ++t) {
-    int wc0 = 0, wr0 = 0;
-    search(t, w, area, wc0, wr0);
+    search(t, w, area);
     const int tx = int(t % std::size_t(across)), ty = int(t / std::size_t(across));
     Georef g = georef;
     g.transform[0] += tx * tile_size * g.transform[1] + ty * tile_size * g.transform[2];

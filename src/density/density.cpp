@@ -410,12 +410,11 @@ Raster<float> topographic_position(const Dem& dem, const Grid& g, const DiscPlan
 void terrain_terms(const Dem& dem, const Grid& g, const DensityOptions& options, const WholeTerrainFigures* whole, DensityResult& result,
                    Progress& progress) {
   ProgressStep step(progress, "density: terrain terms");
-  const std::size_t n = dem.size();
-  const bool rivers_known = whole ? whole->rivers_known : options.rivers.size() == n;
-  const bool any_water = whole ? whole->any_water : g.any_water;
+  const bool rivers_known = options.rivers.size() == dem.size();
   if (!whole && options.rivers.size() != 0 && !rivers_known) throw bad_input("rivers: not on the DEM's grid");
+  // No distance without a feature: its term is then 0, as exp(-infinity) would be.
   std::vector<float> own_water, own_river;  // on the whole grid; a window's come with `whole`
-  if (!whole && any_water) own_water = distance_to_m(water_cells(dem, options), g.metrics, g.cols, g.rows);
+  if (!whole && g.any_water) own_water = distance_to_m(water_cells(dem, options), g.metrics, g.cols, g.rows);
   if (!whole && rivers_known) own_river = distance_to_m(river_mask(options.rivers), g.metrics, g.cols, g.rows);
   const std::vector<float>& to_water = whole ? whole->to_water : own_water;
   const std::vector<float>& to_river = whole ? whole->to_river : own_river;
@@ -441,8 +440,8 @@ void terrain_terms(const Dem& dem, const Grid& g, const DensityOptions& options,
         if (g.kind[i] != land) continue;
         term(TerrainTerm::altitude)[i] = dem[i];
         term(TerrainTerm::slope)[i] = slope_deg(dem, g.metrics, x, r);
-        term(TerrainTerm::coast_near)[i] = any_water ? float(std::exp(-double(to_water[i]) / 10000.0)) : 0.0f;
-        term(TerrainTerm::river_near)[i] = rivers_known ? float(std::exp(-double(to_river[i]) / 2000.0)) : 0.0f;
+        term(TerrainTerm::coast_near)[i] = to_water.empty() ? 0.0f : float(std::exp(-double(to_water[i]) / 10000.0));
+        term(TerrainTerm::river_near)[i] = to_river.empty() ? 0.0f : float(std::exp(-double(to_river[i]) / 2000.0));
       }
   });
   if (whole && !whole->ranks) return;
@@ -624,6 +623,12 @@ std::vector<std::uint8_t> water_cells(const Dem& dem, const DensityOptions& opti
   std::vector<std::uint8_t> wet = cell_kinds(dem, options);
   for (std::uint8_t& k : wet) k = k == water;
   return wet;
+}
+
+std::vector<std::uint8_t> land_cells(const Dem& dem, const DensityOptions& options) {
+  std::vector<std::uint8_t> cells = cell_kinds(dem, options);
+  for (std::uint8_t& k : cells) k = k == land;
+  return cells;
 }
 
 std::vector<std::uint8_t> river_mask(const Raster<std::uint8_t>& rivers) {

@@ -165,6 +165,8 @@ bool needs_terrain_terms(const DensityOptions& options);
 /// The features of the terrain terms' distances, 1 on a feature cell: the water (at or below the
 /// sea level, nodata when it is sea, the water mask) and the rivers (non-zero, not nodata).
 std::vector<std::uint8_t> water_cells(const Dem& dem, const DensityOptions& options);
+/// 1 on the land: data, not water (the cells the terrain terms and the realism figures read).
+std::vector<std::uint8_t> land_cells(const Dem& dem, const DensityOptions& options);
 std::vector<std::uint8_t> river_mask(const Raster<std::uint8_t>& rivers);
 
 }  // namespace terrapolis::density

@@ -68,6 +68,18 @@ struct RowTransform {
   }
 };
 
+/// The rows' transform of rows [row0, row0 + rows) of `feature` (`cols` a row, row-major, the
+/// band's first row first) into `squared`, laid out the same.
+void row_distances(const std::uint8_t* feature, const CellMetrics& metrics, int row0, int rows, int cols, std::vector<double>& squared) {
+  tbb::parallel_for(tbb::blocked_range<int>(0, rows, 8), [&](const tbb::blocked_range<int>& range) {
+    RowTransform t(std::size_t(std::max(cols, 0)));
+    for (int r = range.begin(); r < range.end(); ++r) {
+      t.run(feature + std::size_t(r) * std::size_t(cols), metrics.width_m[std::size_t(row0 + r)]);
+      std::copy(t.d.begin(), t.d.end(), squared.begin() + std::ptrdiff_t(std::size_t(r) * std::size_t(cols)));
+    }
+  });
+}
+
 /// The grid's northings: the column transform's sample positions.
 std::vector<double> northings(const CellMetrics& metrics, int rows) {
   std::vector<double> northing(static_cast<std::size_t>(rows), 0.0);
@@ -150,7 +162,6 @@ void LandRanks::add(const float* values, std::size_t n) {
     }
 }
 
-
 void LandRanks::finish() {
   ranks_.assign(counts_.size(), 0.0f);
   const double n = double(total_);
@@ -169,13 +180,7 @@ float LandRanks::rank(float v) const { return std::isnan(v) ? v : ranks_[key(v)]
 std::vector<float> distance_to_m(const std::vector<std::uint8_t>& feature, const CellMetrics& metrics, int cols, int rows) {
   const std::size_t n = std::size_t(cols) * std::size_t(rows);
   std::vector<double> row_d2(n);
-  tbb::parallel_for(tbb::blocked_range<int>(0, rows, 8), [&](const tbb::blocked_range<int>& range) {
-    RowTransform t(std::size_t(std::max(cols, 0)));
-    for (int r = range.begin(); r < range.end(); ++r) {
-      t.run(&feature[std::size_t(r) * std::size_t(cols)], metrics.width_m[std::size_t(r)]);
-      std::copy(t.d.begin(), t.d.end(), row_d2.begin() + std::ptrdiff_t(std::size_t(r) * std::size_t(cols)));
-    }
-  });
+  row_distances(feature.data(), metrics, 0, rows, cols, row_d2);
   std::vector<float> out(n);
   column_distances(northings(metrics, rows), cols, row_d2, out);
   return out;
@@ -207,13 +212,7 @@ DistanceStrips::DistanceStrips(const CellMetrics& metrics, int cols, int rows, i
           const std::vector<std::uint8_t>& mask = masks[std::size_t(k)];
           if (mask.size() != std::size_t(n) * std::size_t(cols)) throw processing_error("density: a band of the distances' features is not on the grid");
           if (std::any_of(mask.begin(), mask.end(), [](std::uint8_t m) { return m != 0; })) any_[std::size_t(k)] = true;
-          tbb::parallel_for(tbb::blocked_range<int>(0, n, 8), [&](const tbb::blocked_range<int>& range) {
-            RowTransform t(std::size_t(std::max(cols, 0)));
-            for (int r = range.begin(); r < range.end(); ++r) {
-              t.run(&mask[std::size_t(r) * std::size_t(cols)], metrics.width_m[std::size_t(r0 + r)]);
-              std::copy(t.d.begin(), t.d.end(), d2.begin() + std::ptrdiff_t(std::size_t(r) * std::size_t(cols)));
-            }
-          });
+          row_distances(mask.data(), metrics, r0, n, cols, d2);
           for (int c0 = 0; c0 < cols; c0 += strip_) {
             const int w = std::min(strip_, cols - c0);
             segment.resize(std::size_t(w) * std::size_t(n));

@@ -3,6 +3,7 @@
 #include "density/tiled_density.hpp"
 
 #include <algorithm>
+#include <functional>
 #include <memory>
 #include <cmath>
 #include <string>
@@ -42,16 +43,19 @@ double plan_bytes(const DiscPlan& plan, int rows) {
   return bytes;
 }
 
-/// The distances to the water and, when known, the rivers, by bands of full rows (DistanceStrips).
-std::unique_ptr<DistanceStrips> whole_grid_distances(const CellMetrics& metrics, int cols, int rows, const ReadWindowInputs& read, bool rivers,
-                                                     const std::string& scratch_dir, double budget_bytes, Progress& progress) {
+/// The distances to the water (feature 0) and the rivers (1, none when not given), by bands of
+/// full rows (DistanceStrips); `also` sees each band read.
+std::unique_ptr<DistanceStrips> whole_grid_distances(const CellMetrics& metrics, int cols, int rows, const ReadWindowInputs& read,
+                                                     const std::function<void(const WindowInputs&)>& also, const std::string& scratch_dir,
+                                                     double budget_bytes, Progress& progress) {
   return std::make_unique<DistanceStrips>(
-      metrics, cols, rows, rivers ? 2 : 1, scratch_dir, budget_bytes,
+      metrics, cols, rows, 2, scratch_dir, budget_bytes,
       [&](int r0, int n) {
-        WindowInputs in = read(0, r0, cols, n, true);
-        std::vector<std::vector<std::uint8_t>> masks{water_cells(in.dem, in.options)};
-        if (rivers) masks.push_back(river_mask(in.options.rivers));
-        return masks;
+        const WindowInputs in = read(0, r0, cols, n, true);
+        also(in);
+        const bool rivers = in.options.rivers.size() == in.dem.size();
+        return std::vector<std::vector<std::uint8_t>>{water_cells(in.dem, in.options),
+                                                       rivers ? river_mask(in.options.rivers) : std::vector<std::uint8_t>(in.dem.size(), 0)};
       },
       progress);
 }
@@ -103,29 +107,28 @@ TiledDensityReport run_tiled_density(int cols, int rows, const Georef& georef, c
   report.across = grid.across();
   SilentProgress quiet;  // per-tile steps would flood the console: one step per pass instead
 
-  // 1. The land's altitude range (the plain's sums are taken relative to its middle).
+  // 1. The land's altitude range (the plain's sums are taken relative to its middle): by tiles, or,
+  // with the terrain terms, on the bands the distances to water and rivers read over the whole
+  // grid (in a budget of a tile's window when no limit is given).
   std::array<float, 2> range{std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity()};
-  {
+  const auto add_range = [&](const WindowInputs& in) {
+    const std::array<float, 2> part = land_range(in.dem, in.options);
+    range = {std::min(range[0], part[0]), std::max(range[1], part[1])};
+  };
+  std::unique_ptr<DistanceStrips> distances;
+  std::optional<std::array<LandRanks, kRankedTerms.size()>> ranks;  // 4 MB each: only with the terms
+  if (terms) {
+    ranks.emplace();
+    const double side = report.tile_size + 2.0 * std::max(widest[0], widest[1]);
+    const double budget = memory_limit_mb > 0 ? (memory_limit_mb - reserved_mb) * 1e6 - report.global_bytes : cell_bytes * side * side;
+    distances = whole_grid_distances(metrics, cols, rows, read, add_range, scratch_dir, budget, progress);
+  } else {
     ProgressStep step(progress, "density by tiles: altitudes");
     for (int t = 0; t < grid.count(); ++t) {
       const TileRect r = grid.rect(t);
-      const WindowInputs in = read(r.col0, r.row0, r.cols, r.rows, true);
-      const std::array<float, 2> tile = land_range(in.dem, in.options);
-      range = {std::min(range[0], tile[0]), std::max(range[1], tile[1])};
+      add_range(read(r.col0, r.row0, r.cols, r.rows, true));
       step.update(double(t + 1) / grid.count());
     }
-  }
-  // With the terrain terms, the distances to water and rivers over the whole grid, in a budget of
-  // a tile's window when no limit is given.
-  std::unique_ptr<DistanceStrips> distances;
-  std::optional<std::array<LandRanks, kRankedTerms.size()>> ranks;  // 8 MB each: only with the terms
-  bool rivers_known = false;
-  if (terms) {
-    ranks.emplace();
-    rivers_known = read(0, 0, 1, 1, true).options.rivers.size() == 1;
-    const double side = report.tile_size + 2.0 * std::max(widest[0], widest[1]);
-    const double budget = memory_limit_mb > 0 ? (memory_limit_mb - reserved_mb) * 1e6 - report.global_bytes : cell_bytes * side * side;
-    distances = whole_grid_distances(metrics, cols, rows, read, rivers_known, scratch_dir, budget, progress);
   }
   // 2. The coast and plateau maxima over habitable land (and the land ranks' counts), then 3. each
   // tile divided by them.
@@ -145,9 +148,8 @@ TiledDensityReport run_tiled_density(int cols, int rows, const Georef& georef, c
       if (terms) {
         WholeTerrainFigures& t = whole.terrain.emplace();
         t.near = positions[0].from_row(r0), t.far = positions[1].from_row(r0);
-        t.any_water = distances->any(0), t.rivers_known = rivers_known;
-        if (t.any_water) t.to_water = distances->window(0, c0, r0, c1 - c0, r1 - r0);
-        if (rivers_known) t.to_river = distances->window(1, c0, r0, c1 - c0, r1 - r0);
+        if (distances->any(0)) t.to_water = distances->window(0, c0, r0, c1 - c0, r1 - r0);
+        if (distances->any(1)) t.to_river = distances->window(1, c0, r0, c1 - c0, r1 - r0);
         if (maxima) t.ranks = &*ranks;
       }
       use(t, compute_density_window(in.dem, in.hydrometry, in.options, whole, quiet), whole.core);

@@ -16,9 +16,9 @@ namespace terrapolis::density {
 /// What a window's terrain terms take from the whole grid.
 struct WholeTerrainFigures {
   DiscPlan near, far;                    ///< the topographic positions' discs (position_discs), from the window's first row
-  bool any_water = false;                ///< the whole grid has water (else coast_near is 0)
-  bool rivers_known = false;             ///< rivers were given (else river_near is 0)
-  std::vector<float> to_water, to_river; ///< the distances of the window's cells (its core's at least), metres
+  /// The distances of the window's cells, metres; empty when the whole grid has no water, no river
+  /// (the term is then 0).
+  std::vector<float> to_water, to_river;
   /// The ranks of altitude, slope and the two positions among the whole grid's land; null: the
   /// first pass, which leaves those terms unranked so that the tiles can count them.
   const std::array<LandRanks, kRankedTerms.size()>* ranks = nullptr;
@@ -99,8 +99,8 @@ int density_tile_size_for(int cols, int rows, int halo_rows, int halo_cols, doub
 /// `tile_size` (0: from `memory_limit_mb` less `reserved_mb`), one tile at a time (each computed in parallel):
 /// three reads of each tile (altitude range, coast and plateau maxima, then the tile), two
 /// computations. `options` carries no raster (read gives each window's). With the terrain terms,
-/// the distances to water and rivers are computed first by bands of rows (DistanceStrips, in
-/// `scratch_dir`), and the second pass counts the land ranks.
+/// the first pass reads bands of full rows instead, for the altitude range and the distances to
+/// water and rivers (DistanceStrips, in `scratch_dir`), and the second pass counts the land ranks.
 TiledDensityReport run_tiled_density(int cols, int rows, const Georef& georef, const ReadWindowInputs& read,
                                      const DensityOptions& options, int tile_size, double memory_limit_mb, const std::string& scratch_dir,
                                      const WriteDensityTile& write, Progress& progress, double reserved_mb = 0);

@@ -122,9 +122,7 @@ RealismGrid by_tiles(RunState& s, density::DensityOptions options, const std::st
     density::DensityOptions o = options;
     const Dem window = dem->read(c0, r0, w, h);
     o.water_mask = read_mask(water, window.georef(), w, h);
-    std::vector<std::uint8_t> land = density::water_cells(window, o);
-    for (std::size_t i = 0; i < land.size(); ++i) land[i] = !land[i] && !std::isnan(window[i]);
-    return land;
+    return density::land_cells(window, o);
   };
   RealismGrid g;
   g.places = read_places(reference, georef, cols, rows, land_of, g.dropped);
