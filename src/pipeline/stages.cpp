@@ -641,7 +641,7 @@ void network_summary(const json& figures, SummaryText& out) {
 
 /// roads.corridor.enabled: corridors.geojson and the land take and volumes for the summary (null when off).
 json corridor_hook(RunState& s, const roads::TerrainField& terrain, const std::vector<roads::Road>& built,
-                   const std::vector<std::uint8_t>& existing) {
+                   const roads::GivenCells& existing) {
   CorridorSettings c = s.settings.corridor;
   if (!c.enabled) return nullptr;
   if (!c.side_angles.empty())
@@ -708,9 +708,10 @@ json existing_figures(const roads::ExistingRoads& e, const roads::NetworkResult&
 
 /// The network's roads by windows of the DEM's mosaic (roads::route_network_by_windows): each link
 /// searched on a window of the DEM and of inland_water.vrt around it, within the memory limit
-/// shared by the links routed at once. `frame` receives the grid's frame the layers are drawn on.
+/// shared by the links routed at once. `frame` receives the grid's frame the layers are drawn on,
+/// `existing` the given roads (roads.existing) drawn on it.
 roads::NetworkResult roads_by_windows(RunState& s, const std::vector<roads::Link>& links, std::optional<roads::TerrainField>& frame,
-                                      Progress& progress, const Log& log) {
+                                      std::optional<roads::ExistingRoads>& existing, Progress& progress, const Log& log) {
   const RoadsSettings& settings = s.settings.roads;
   s.by_tiles->reserve();
   const TiledInput& in = *s.by_tiles;
@@ -722,10 +723,11 @@ roads::NetworkResult roads_by_windows(RunState& s, const std::vector<roads::Link
   log.detail("roads by windows: windows of at most " + std::to_string(w.window.max_cells) + " cells and " + std::to_string(w.max_nodes) +
              " search nodes a road, " + std::to_string(parallel) + " roads at once");
   frame.emplace(roads::TerrainField::frame(w.grid));
+  existing = existing_roads(s, *frame, log);
   const roads::RoadGraph graph(*frame, settings.model, settings.routing.graph);
   roads::RoutingOptions routing = settings.routing;
   routing.max_nodes = std::min(routing.max_nodes, w.max_nodes);
-  return roads::route_network_by_windows(*frame, graph, links, routing, progress, {w.grid, w.read, w.window});
+  return roads::route_network_by_windows(*frame, graph, links, routing, progress, {w.grid, w.read, w.window}, existing ? &*existing : nullptr);
 }
 
 void roads_run(RunState& s, Progress& progress, const Log& log) {
@@ -735,7 +737,7 @@ void roads_run(RunState& s, Progress& progress, const Log& log) {
   std::optional<roads::ExistingRoads> existing;
   roads::NetworkResult r;
   if (s.by_tiles) {
-    r = roads_by_windows(s, links, terrain, progress, log);
+    r = roads_by_windows(s, links, terrain, existing, progress, log);
   } else {
     terrain.emplace(road_terrain(s));
     add_road_layers(*terrain, settings, s.plugins, s.dem, progress, log);
@@ -796,7 +798,6 @@ void roads_prepare(const Scenario& scenario, const RasterHeader& grid, Settings&
   s.corridor = corridor_settings(scenario);
   if (tile_settings(scenario).given()) {  // by windows (roads_by_windows): what reads the whole grid is refused
     const auto refuse = [](const std::string& what) { throw bad_input(what + ": not computed on tiles yet (input.tile_size, input.memory_limit_mb)"); };
-    if (!s.roads.existing.empty()) refuse("/roads/existing");
     if (!s.roads.vegetation.empty()) refuse("/roads/vegetation");
     if (s.corridor.enabled) refuse("/roads/corridor/enabled");
     if (s.roads.routing.router != roads::Router::galin) refuse("/roads/router");

@@ -374,7 +374,7 @@ Corridors road_corridors(const TerrainField& terrain, const std::vector<Road>& r
 namespace {
 
 /// The stretches of a road off the given roads: maximal runs of segments not on them (on_existing).
-std::vector<RoadGeometry> new_stretches(const RoadGeometry& road, const TerrainField& t, const std::vector<std::uint8_t>& existing) {
+std::vector<RoadGeometry> new_stretches(const RoadGeometry& road, const TerrainField& t, const GivenCells& existing) {
   auto cell = [&](const GridPoint& p) {
     const int c = t.clamp_col(int(std::lround(p.col))), r = t.clamp_row(int(std::lround(p.row)));
     return std::uint32_t(t.index(c, r));
@@ -401,7 +401,7 @@ std::vector<RoadGeometry> new_stretches(const RoadGeometry& road, const TerrainF
 }  // namespace
 
 Corridors road_corridors(const TerrainField& terrain, const std::vector<Road>& roads, const CorridorOptions& options,
-                         const std::vector<std::uint8_t>& existing) {
+                         const GivenCells& existing) {
   if (existing.empty()) return road_corridors(terrain, roads, options);
   std::vector<RoadGeometry> stretches;
   std::vector<std::size_t> road_of;

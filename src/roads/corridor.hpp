@@ -12,6 +12,7 @@
 #include "core/raster.hpp"
 #include "io/vector_io.hpp"
 #include "roads/earthworks.hpp"
+#include "roads/network_sections.hpp"
 #include "roads/road_class.hpp"
 
 namespace terrapolis::roads {
@@ -104,12 +105,12 @@ Corridors corridors(const TerrainField& terrain, const std::vector<const RoadGeo
 struct Road;
 /// The corridors of routed roads, each at its class's widths (the roads and path commands, the run).
 Corridors road_corridors(const TerrainField& terrain, const std::vector<Road>& roads, const CorridorOptions& options);
-/// The same for the new parts of the roads only (roads.existing): `existing` per cell 1 on a given
-/// road (NetworkResult::existing); a segment whose two ends lie on such cells has its earthworks
+/// The same for the new parts of the roads only (roads.existing): `existing` the given roads'
+/// cells (NetworkResult::existing); a segment whose two ends lie on such cells has its earthworks
 /// already and is left out, each road's other stretches get their corridors (sections numbered
 /// along the road; a road's totals add up its stretches'). Empty `existing`: road_corridors.
 Corridors road_corridors(const TerrainField& terrain, const std::vector<Road>& roads, const CorridorOptions& options,
-                         const std::vector<std::uint8_t>& existing);
+                         const GivenCells& existing);
 
 /// corridors.geojson: per section an "earthworks" polygon (surface sections) and a "carriageway"
 /// polygon, with road, section, structure, part, length_m, area_ha (geodesic), half-widths,

@@ -61,17 +61,26 @@ void simplify(const std::vector<GridPoint>& pts, std::size_t i, std::size_t j, d
 
 }  // namespace
 
-bool on_existing(const TerrainField& t, const std::vector<std::uint8_t>& existing, std::uint32_t a, std::uint32_t b) {
-  if (existing.empty() || (!existing[a] && !existing[b])) return false;
-  auto near = [&](std::uint32_t cell) {
-    if (existing[cell]) return true;
+GivenCells::GivenCells(const std::vector<CellChain>& chains)
+    : GivenCells([&] {
+        std::vector<std::uint32_t> all;
+        for (const CellChain& chain : chains) all.insert(all.end(), chain.cells.begin(), chain.cells.end());
+        return all;
+      }()) {}
+
+bool on_existing(const TerrainField& t, const GivenCells& existing, std::uint32_t a, std::uint32_t b) {
+  if (existing.empty()) return false;
+  const bool on_a = existing.holds(a), on_b = existing.holds(b);
+  if (!on_a && !on_b) return false;
+  auto near = [&](std::uint32_t cell, bool on) {
+    if (on) return true;
     const int col = t.col_of(cell), row = t.row_of(cell);
     for (int dr = -1; dr <= 1; ++dr)
       for (int dc = -1; dc <= 1; ++dc)
-        if (t.inside(col + dc, row + dr) && existing[t.index(col + dc, row + dr)]) return true;
+        if (t.inside(col + dc, row + dr) && existing.holds(std::uint32_t(t.index(col + dc, row + dr)))) return true;
     return false;
   };
-  return near(a) && near(b);
+  return near(a, on_a) && near(b, on_b);
 }
 
 std::vector<std::array<double, 2>> chain_line(const TerrainField& t, const std::vector<std::uint32_t>& cells) {
@@ -85,7 +94,7 @@ std::vector<std::array<double, 2>> chain_line(const TerrainField& t, const std::
 }
 
 RoadNetworkLayout network_layout(const TerrainField& t, const std::vector<CellChain>& chains, const std::vector<RoadClass>& classes,
-                                 const std::vector<std::uint8_t>& existing) {
+                                 const GivenCells& existing) {
   // Every step of every chain, as an undirected edge with the roads using it.
   std::vector<Edge> steps;
   for (std::size_t r = 0; r < chains.size(); ++r)

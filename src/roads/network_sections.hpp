@@ -2,6 +2,7 @@
 // (Galin et al. 2011: roads merge into trunks and branch at junctions).
 // SPDX-License-Identifier: MIT
 #pragma once
+#include <algorithm>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -21,6 +22,24 @@ struct CellChain {
 };
 /// The chain of a path of cells joined by arcs (`structures`: one per arc, or empty for surface arcs).
 CellChain cell_chain(const TerrainField& terrain, const std::vector<Cell>& path, const std::vector<Structure>& structures = {});
+
+/// The cells of the given roads (roads.existing), grid indices, sorted and distinct: sparse, so that
+/// a grid larger than memory (roads by windows) holds only the roads' cells.
+class GivenCells {
+ public:
+  GivenCells() = default;
+  explicit GivenCells(std::vector<std::uint32_t> cells) : cells_(std::move(cells)) {
+    std::sort(cells_.begin(), cells_.end());
+    cells_.erase(std::unique(cells_.begin(), cells_.end()), cells_.end());
+  }
+  /// The cells of `chains`.
+  explicit GivenCells(const std::vector<CellChain>& chains);
+  bool empty() const { return cells_.empty(); }
+  bool holds(std::uint32_t cell) const { return std::binary_search(cells_.begin(), cells_.end(), cell); }
+
+ private:
+  std::vector<std::uint32_t> cells_;
+};
 
 /// One piece of the network between two breakpoints (a junction, a road's end, or where the set of
 /// roads using it or the structure changes), written once whatever the number of roads on it.
@@ -49,18 +68,18 @@ struct RoadNetworkLayout {
 };
 
 /// Sections and junctions of the roads' chains (`classes[i]` the class of road i). Deterministic:
-/// sections are numbered in the order of their first edge by cell index. `existing`: per cell 1
-/// on a given road (roads.existing), or empty; a step on them (on_existing) is existing, and a
+/// sections are numbered in the order of their first edge by cell index. `existing`: the cells of
+/// the given roads (roads.existing), or empty; a step on them (on_existing) is existing, and a
 /// section also breaks where that changes.
 RoadNetworkLayout network_layout(const TerrainField& terrain, const std::vector<CellChain>& chains, const std::vector<RoadClass>& classes,
-                                 const std::vector<std::uint8_t>& existing = {});
+                                 const GivenCells& existing = {});
 
-/// Whether the step between cells `a` and `b` (grid indices) lies on the given roads (`existing`:
-/// per cell 1 on one, roads.existing): one of the two cells is theirs and the other is theirs or
+/// Whether the step between cells `a` and `b` (grid indices) lies on the given roads (`existing`,
+/// roads.existing): one of the two cells is theirs and the other is theirs or
 /// touches one of theirs. The tolerance of one cell absorbs how differently a given line and a
 /// route along it cross the cells (a staircase drawn the other way round); a road one cell beside
 /// a given one, touching none of its cells, is new.
-bool on_existing(const TerrainField& terrain, const std::vector<std::uint8_t>& existing, std::uint32_t a, std::uint32_t b);
+bool on_existing(const TerrainField& terrain, const GivenCells& existing, std::uint32_t a, std::uint32_t b);
 
 /// A chain of cells as a line through their centres in the DEM's CRS, its staircase drawn as
 /// straight runs within half a cell (Douglas-Peucker).

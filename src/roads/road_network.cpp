@@ -181,13 +181,13 @@ class BuiltRoads {
   double existing_share(const CellChain& chain) const {
     return existing_.empty() ? 0 : share_on(chain, [&](std::uint32_t a, std::uint32_t b) { return on_existing(t_, existing_, a, b); });
   }
-  /// Adds a given road (roads.existing) before the first link: as a road built, and marked.
-  void add_existing(const CellChain& chain, RoadClass c) {
-    if (existing_.empty()) existing_.assign(t_.size(), 0);
-    for (std::uint32_t cell : chain.cells) existing_[cell] = 1;
-    add(chain, c);
+  /// Adds the given roads (roads.existing) before the first link: as roads built, in their order
+  /// (the same state at any thread count), and marked.
+  void add_existing(const ExistingRoads& given) {
+    for (std::size_t k = 0; k < given.chains.size(); ++k) add(given.chains[k], given.classes[k]);
+    existing_ = GivenCells(given.chains);
   }
-  const std::vector<std::uint8_t>& existing() const { return existing_; }
+  const GivenCells& existing() const { return existing_; }
   /// Adds a road: its surface cells become cheaper for the next roads; all its cells are joined.
   void add(const CellChain& chain, RoadClass c) {
     for (std::size_t i = 0; i < chain.structures.size(); ++i) {
@@ -240,7 +240,7 @@ class BuiltRoads {
   CellValues<std::uint8_t> class_;
   CellValues<std::uint32_t> parent_;
   std::vector<std::uint32_t> changes_;
-  std::vector<std::uint8_t> existing_;  ///< cells of the given roads (empty: none)
+  GivenCells existing_;  ///< cells of the given roads (empty: none)
   ArcDiscount view_;
 };
 
@@ -328,9 +328,7 @@ class NetworkRouter {
     for (std::size_t a = 0; a < base.surface_arcs(); ++a)
       reach_ = std::max({reach_, std::abs(base.arcs()[a].dcol), std::abs(base.arcs()[a].drow)});
     attempts_.resize(order_.size());
-    // The given roads, built before the first link (in their order: the same state at any thread count).
-    if (existing)
-      for (std::size_t k = 0; k < existing->chains.size(); ++k) built_.add_existing(existing->chains[k], existing->classes[k]);
+    if (existing) built_.add_existing(*existing);
     step_.emplace(progress, "roads");
   }
 
@@ -521,11 +519,12 @@ NetworkResult route_network(const TerrainField& t, const RoadGraph& base, const 
 }
 
 NetworkResult route_network_by_windows(const TerrainField& frame, const RoadGraph& base, const std::vector<Link>& links,
-                                       const RoutingOptions& options, Progress& progress, const NetworkWindows& windows) {
+                                       const RoutingOptions& options, Progress& progress, const NetworkWindows& windows,
+                                       const ExistingRoads* existing) {
   if (frame.holds_values()) throw processing_error("roads by windows: a frame (TerrainField::frame) is expected");
   if (double(frame.grid_cols()) * double(frame.grid_rows()) >= 4294967295.0)
     throw bad_input("roads by windows: grids of 2^32 cells or more are not supported");
-  NetworkRouter router(frame, base, links, options, progress, nullptr, &windows);
+  NetworkRouter router(frame, base, links, options, progress, existing, &windows);
   return router.run();
 }
 

@@ -103,7 +103,7 @@ struct NetworkResult {
   /// the largest window's answer ("from-to"; WindowedRoad::limited).
   std::vector<std::string> limited;
   RoadNetworkLayout layout;              ///< the roads' shared sections and junctions
-  std::vector<std::uint8_t> existing;    ///< per cell 1 on a given road (empty without roads.existing)
+  GivenCells existing;                   ///< the given roads' cells (empty without roads.existing)
   std::size_t searches = 0;              ///< links routed, attempts routed again included (depends on the threads)
 };
 NetworkResult route_network(const TerrainField& terrain, const RoadGraph& graph, const std::vector<Link>& links,

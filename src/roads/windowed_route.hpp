@@ -111,9 +111,10 @@ struct NetworkWindows {
 };
 /// route_network by windows: `frame` is TerrainField::frame(windows.grid) (the roads' cells are its
 /// indices, the layers are drawn on it), `base` a graph on it (its model and options; the searches
-/// build theirs on each window). The same roads as route_network on the whole grid. Given roads
-/// (roads.existing) are not taken.
+/// build theirs on each window). The same roads as route_network on the whole grid, given roads
+/// (roads.existing, drawn on the frame) included: they are kept per road cell as the roads built.
 NetworkResult route_network_by_windows(const TerrainField& frame, const RoadGraph& base, const std::vector<Link>& links,
-                                       const RoutingOptions& options, Progress& progress, const NetworkWindows& windows);
+                                       const RoutingOptions& options, Progress& progress, const NetworkWindows& windows,
+                                       const ExistingRoads* existing = nullptr);
 
 }  // namespace terrapolis::roads

@@ -8,6 +8,7 @@
 #include <random>
 
 #include "core/error.hpp"
+#include "roads/existing_roads.hpp"
 #include "roads/windowed_route.hpp"
 #include "support/georefs.hpp"
 
@@ -328,4 +329,67 @@ TEST(RoadByWindows, ANetworkByWindowsIsTheWholeGridsNetwork) {
     EXPECT_LE(largest, window.max_cells) << trial;
   }
   EXPECT_GE(limited_runs, 1);  // the limit bit somewhere: the counter was tested at its bound
+}
+
+TEST(RoadByWindows, GivenRoadsByWindowsGiveTheWholeGridsNetwork) {
+  // roads.existing by windows: the given lines drawn on the frame are the whole grid's chains, kept
+  // per road cell as the roads built before the first link; the links reuse them, and the layers
+  // (which sections are on them, each road's new and existing metres) are the whole grid's.
+  std::mt19937_64 rng(23);
+  double on_given = 0;
+  for (int trial = 0; trial < 4; ++trial) {
+    const int cols = 200, rows = 160;
+    const Dem dem = landscape(rng, cols, rows, trial % 2 ? test::geographic(45.0, 1.0 / 1200) : test::projected(10.0), false);
+    CostModel model = default_cost_model();
+    model.bridge.enabled = model.tunnel.enabled = false;
+    const TerrainField whole(dem, 0.0, 10.0, model.road_radius_m);
+    const RoadGraph whole_graph(whole, model, GraphOptions{});
+    std::vector<Link> links;
+    std::vector<Cell> ends;
+    for (int k = 0; k < 6; ++k) {
+      const Cell a{int(rng() % cols), int(rng() % rows)}, b{int(rng() % cols), int(rng() % rows)};
+      ends.push_back(a), ends.push_back(b);
+      links.push_back({k, k + 1, dem.georef().cell_centre(a.col, a.row), dem.georef().cell_centre(b.col, b.row),
+                       k < 2 ? RoadClass::national : RoadClass::departmental});
+    }
+    // Given lines from link ends through a bend to other link ends, one a national, one local, and
+    // one leaving the grid (cut where it leaves).
+    VectorLayer given;
+    given.geometry = GeometryType::line_string;
+    given.crs = dem.georef().crs;
+    given.fields = {{"highway", FieldType::string}};
+    const char* tags[] = {"primary", "residential", "secondary"};
+    for (int k = 0; k < 3; ++k) {
+      const Cell a = ends[rng() % ends.size()], b = ends[rng() % ends.size()];
+      Feature f;
+      f.parts.push_back({dem.georef().cell_centre(a.col, a.row), dem.georef().cell_centre((a.col + b.col) / 2 + 9, (a.row + b.row) / 2 - 7),
+                         dem.georef().cell_centre(b.col, b.row)});
+      if (k == 2) f.parts[0].push_back(dem.georef().cell_centre(cols + 40, b.row));
+      f.values = {std::string(tags[k])};
+      given.features.push_back(std::move(f));
+    }
+    RoutingOptions options;
+    options.lookahead = 2;
+    SilentProgress silent;
+    const ExistingRoads on_whole = rasterise_roads(whole, given);
+    const NetworkResult expected = route_network(whole, whole_graph, links, options, silent, &on_whole);
+    const TerrainGrid grid{dem.georef(), cols, rows, whole.has_bathymetry()};
+    const TerrainField frame = TerrainField::frame(grid);
+    const RoadGraph frame_graph(frame, model, GraphOptions{});
+    const ReadTerrainWindow read = [&](int c0, int r0, int w, int h) {
+      return TerrainField(window_of(dem, c0, r0, w, h), c0, r0, grid, 0.0, 10.0, model.road_radius_m);
+    };
+    WindowOptions window;
+    window.margin_cells = window_margin_cells(model.road_radius_m, 0, whole.min_cell_m());
+    const ExistingRoads on_frame = rasterise_roads(frame, given);
+    ASSERT_EQ(on_whole.chains.size(), on_frame.chains.size());
+    for (std::size_t k = 0; k < on_whole.chains.size(); ++k) EXPECT_EQ(on_whole.chains[k].cells, on_frame.chains[k].cells) << trial;
+    EXPECT_EQ(on_whole.length_m, on_frame.length_m) << trial;
+    const NetworkResult got = route_network_by_windows(frame, frame_graph, links, options, silent, {grid, read, window}, &on_frame);
+    EXPECT_TRUE(got.limited.empty()) << trial;
+    EXPECT_EQ(layers_text(whole, expected), layers_text(frame, got)) << trial;
+    EXPECT_TRUE(got.layout.with_existing);
+    for (const Road& r : got.roads) on_given += r.existing_share;
+  }
+  EXPECT_GT(on_given, 0.5);  // the links ran on the given roads: the test compared what they change
 }
