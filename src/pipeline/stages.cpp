@@ -639,14 +639,15 @@ void network_summary(const json& figures, SummaryText& out) {
 
 // ---- roads (Galin et al. 2010, Peytavie 2010 ch. 4; Belhadj 2007 Alg. 16; docs/roads.md) ----
 
-/// roads.corridor.enabled: corridors.geojson and the land take and volumes for the summary (null when off).
-json corridor_hook(RunState& s, const roads::TerrainField& terrain, const std::vector<roads::Road>& built,
-                   const roads::GivenCells& existing) {
+/// roads.corridor.enabled: corridors.geojson and the land take and volumes for the summary (null
+/// when off). `windows`: a run by tiles, `terrain` the grid's frame (roads::CorridorWindows).
+json corridor_hook(RunState& s, const roads::TerrainField& terrain, const std::vector<roads::Road>& built, const roads::GivenCells& existing,
+                   const roads::CorridorWindows* windows) {
   CorridorSettings c = s.settings.corridor;
   if (!c.enabled) return nullptr;
   if (!c.side_angles.empty())
     c.options.side_angles_deg = read_resampled(c.side_angles, s.dem.georef(), s.dem.cols(), s.dem.rows(), Resampling::nearest);
-  const roads::Corridors corridors = roads::road_corridors(terrain, built, c.options, existing);  // the new stretches only
+  const roads::Corridors corridors = roads::road_corridors(terrain, built, c.options, existing, windows);  // the new stretches only
   s.write("roads", "corridors.geojson", roads::corridors_layer(terrain, corridors), Style::corridors);
   json out = {{"land_take_ha", round_to(corridors.run.land_take_ha, 0.01)}, {"cut_m3", round_to(corridors.run.cut_m3, 1)},
               {"fill_m3", round_to(corridors.run.fill_m3, 1)}};
@@ -706,45 +707,58 @@ json existing_figures(const roads::ExistingRoads& e, const roads::NetworkResult&
           {"on_existing_km", round_to(on_km, 0.01)}};
 }
 
-/// The network's roads by windows of the DEM's mosaic (roads::route_network_by_windows): each link
-/// searched on a window of the DEM and of inland_water.vrt around it, within the memory limit
-/// shared by the links routed at once. `frame` receives the grid's frame the layers are drawn on,
-/// `existing` the given roads (roads.existing) drawn on it.
-roads::NetworkResult roads_by_windows(RunState& s, const std::vector<roads::Link>& links, std::optional<roads::TerrainField>& frame,
-                                      std::optional<roads::ExistingRoads>& existing, Progress& progress, const Log& log) {
-  const RoadsSettings& settings = s.settings.roads;
-  s.by_tiles->reserve();
-  const TiledInput& in = *s.by_tiles;
-  const DemWindowReader dem(in.dem_path, in.read), lakes(saved(s, "inland_water.vrt"), ReadOptions{});
-  const std::size_t parallel = settings.routing.lookahead > 0
-                                   ? settings.routing.lookahead
-                                   : std::max<std::size_t>(1, tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
-  const RoadWindows w = road_windows(dem, lakes, s.grid.georef, s.scenario, settings.model, 0, in.tiles.limit_mb() - in.reserved_mb, parallel);
-  log.detail("roads by windows: windows of at most " + std::to_string(w.window.max_cells) + " cells and " + std::to_string(w.max_nodes) +
-             " search nodes a road, " + std::to_string(parallel) + " roads at once");
-  frame.emplace(roads::TerrainField::frame(w.grid));
-  existing = existing_roads(s, *frame, log);
-  const roads::RoadGraph graph(*frame, settings.model, settings.routing.graph);
-  roads::RoutingOptions routing = settings.routing;
-  routing.max_nodes = std::min(routing.max_nodes, w.max_nodes);
-  return roads::route_network_by_windows(*frame, graph, links, routing, progress, {w.grid, w.read, w.window}, existing ? &*existing : nullptr);
-}
+/// The roads stage's windows in a run by tiles: the DEM's mosaic and inland_water.vrt read by
+/// windows (pipeline::road_windows) within the memory limit, shared by the links routed at once;
+/// their margin holds the corridors' reach when they are drawn. Built in place: `windows` refers
+/// to the readers.
+struct RunRoadWindows {
+  DemWindowReader dem, lakes;
+  std::size_t parallel;
+  RoadWindows windows;
+  roads::TerrainField frame;
+  RunRoadWindows(RunState& s, const TiledInput& in)
+      : dem(in.dem_path, in.read),
+        lakes(saved(s, "inland_water.vrt"), ReadOptions{}),
+        parallel(s.settings.roads.routing.lookahead > 0
+                     ? s.settings.roads.routing.lookahead
+                     : std::max<std::size_t>(1, tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism))),
+        windows(road_windows(dem, lakes, s.grid.georef, s.scenario, s.settings.roads.model,
+                             s.settings.corridor.enabled ? roads::corridor_reach_m(s.settings.corridor.options) : 0.0,
+                             in.tiles.limit_mb() - in.reserved_mb, parallel)),
+        frame(roads::TerrainField::frame(windows.grid)) {}
+  /// The network's roads (roads::route_network_by_windows): each link searched on a window of the
+  /// DEM and of the inland water around it, on the given roads (drawn on `frame`) and the roads before it.
+  roads::NetworkResult route(const RoadsSettings& settings, const std::vector<roads::Link>& links, const roads::ExistingRoads* existing,
+                             Progress& progress) const {
+    const roads::RoadGraph graph(frame, settings.model, settings.routing.graph);
+    roads::RoutingOptions routing = settings.routing;
+    routing.max_nodes = std::min(routing.max_nodes, windows.max_nodes);
+    return roads::route_network_by_windows(frame, graph, links, routing, progress, {windows.grid, windows.read, windows.window}, existing);
+  }
+};
 
 void roads_run(RunState& s, Progress& progress, const Log& log) {
   const RoadsSettings& settings = s.settings.roads;
   const std::vector<roads::Link> links = network::road_links(*s.network, &*s.cities);
-  std::optional<roads::TerrainField> terrain;
+  std::optional<RunRoadWindows> by_windows;  // a run by tiles: the layers are drawn on its frame
+  std::optional<roads::TerrainField> whole;
   std::optional<roads::ExistingRoads> existing;
   roads::NetworkResult r;
   if (s.by_tiles) {
-    r = roads_by_windows(s, links, terrain, existing, progress, log);
+    s.by_tiles->reserve();
+    by_windows.emplace(s, *s.by_tiles);
+    log.detail("roads by windows: windows of at most " + std::to_string(by_windows->windows.window.max_cells) + " cells and " +
+               std::to_string(by_windows->windows.max_nodes) + " search nodes a road, " + std::to_string(by_windows->parallel) + " roads at once");
+    existing = existing_roads(s, by_windows->frame, log);
+    r = by_windows->route(settings, links, existing ? &*existing : nullptr, progress);
   } else {
-    terrain.emplace(road_terrain(s));
-    add_road_layers(*terrain, settings, s.plugins, s.dem, progress, log);
-    const roads::RoadGraph graph(*terrain, settings.model, settings.routing.graph);
-    existing = existing_roads(s, *terrain, log);
-    r = roads::route_network(*terrain, graph, links, settings.routing, progress, existing ? &*existing : nullptr);
+    whole.emplace(road_terrain(s));
+    add_road_layers(*whole, settings, s.plugins, s.dem, progress, log);
+    const roads::RoadGraph graph(*whole, settings.model, settings.routing.graph);
+    existing = existing_roads(s, *whole, log);
+    r = roads::route_network(*whole, graph, links, settings.routing, progress, existing ? &*existing : nullptr);
   }
+  const roads::TerrainField* terrain = by_windows ? &by_windows->frame : &*whole;
   // Links routed ahead in parallel are routed again when the roads before them change what they saw.
   log.detail(std::to_string(links.size()) + " links, " + std::to_string(r.searches) + " searches");
   for (const auto& f : r.failed) log.warn("no road: " + f);
@@ -762,7 +776,9 @@ void roads_run(RunState& s, Progress& progress, const Log& log) {
   if (!r.layout.junctions.empty())
     s.write("roads", "junctions.geojson", roads::junctions_layer(*terrain, r.layout), Style::junctions);
   s.write("roads", "road_sections.geojson", roads::sections_layer(*terrain, r.roads), Style::road_sections);
-  const json corridor = s.by_tiles ? json(nullptr) : corridor_hook(s, *terrain, r.roads, r.existing);
+  std::optional<roads::CorridorWindows> corridor_windows;
+  if (by_windows) corridor_windows = roads::CorridorWindows{by_windows->windows.read, by_windows->windows.window.margin_cells};
+  const json corridor = corridor_hook(s, *terrain, r.roads, r.existing, corridor_windows ? &*corridor_windows : nullptr);
   std::map<std::string, double> km;
   double bridge_m = 0, tunnel_m = 0, over_limit_m = 0, water_m = 0, network_km = 0;
   for (const auto& road : r.roads) {
@@ -796,10 +812,10 @@ void roads_load(RunState&) {}  // the access stage reads the saved layers
 void roads_prepare(const Scenario& scenario, const RasterHeader& grid, Settings& s) {
   s.roads = roads_settings(scenario);
   s.corridor = corridor_settings(scenario);
-  if (tile_settings(scenario).given()) {  // by windows (roads_by_windows): what reads the whole grid is refused
+  if (tile_settings(scenario).given()) {  // by windows (RunRoadWindows): what reads the whole grid is refused
     const auto refuse = [](const std::string& what) { throw bad_input(what + ": not computed on tiles yet (input.tile_size, input.memory_limit_mb)"); };
     if (!s.roads.vegetation.empty()) refuse("/roads/vegetation");
-    if (s.corridor.enabled) refuse("/roads/corridor/enabled");
+    if (!s.corridor.side_angles.empty()) refuse("/roads/corridor/side_angles");
     if (s.roads.routing.router != roads::Router::galin) refuse("/roads/router");
   }
   check_file("/roads/corridor/side_angles", s.corridor.side_angles);

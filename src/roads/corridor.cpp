@@ -238,8 +238,22 @@ EarthworkOptions earthwork_options(const CorridorOptions& c, Raster<float>& slop
   return o;
 }
 
+namespace {
+
+/// The window of the grid (`frame`'s) holding a road's points and `w.margin_cells` around them.
+TerrainField window_around(const CorridorWindows& w, const TerrainField& frame, const RoadGeometry& road) {
+  double c0 = kInfinity, r0 = kInfinity, c1 = -kInfinity, r1 = -kInfinity;
+  for (const GridPoint& p : road.points) c0 = std::min(c0, p.col), r0 = std::min(r0, p.row), c1 = std::max(c1, p.col), r1 = std::max(r1, p.row);
+  const int a = std::max(0, int(std::floor(c0)) - w.margin_cells), b = std::max(0, int(std::floor(r0)) - w.margin_cells);
+  const int c = std::min(frame.grid_cols() - 1, int(std::ceil(c1)) + w.margin_cells);
+  const int d = std::min(frame.grid_rows() - 1, int(std::ceil(r1)) + w.margin_cells);
+  return w.read(a, b, c - a + 1, d - b + 1);
+}
+
+}  // namespace
+
 Corridors corridors(const TerrainField& terrain, const std::vector<const RoadGeometry*>& roads, const CorridorOptions& options,
-                    const std::vector<RoadClass>& classes) {
+                    const std::vector<RoadClass>& classes, const CorridorWindows* windows) {
   if (!classes.empty() && classes.size() != roads.size()) throw processing_error("corridor: one class per road");
   Raster<float> slopes;
   std::array<EarthworkOptions, 4> by_class;
@@ -251,9 +265,12 @@ Corridors corridors(const TerrainField& terrain, const std::vector<const RoadGeo
   std::vector<Polygon> road_zones;  // every road's zone, united road by road
   for (std::size_t ri = 0; ri < roads.size(); ++ri) {
     const RoadGeometry& road = *roads[ri];
+    std::optional<TerrainField> window;
+    if (windows && !road.points.empty()) window.emplace(window_around(*windows, terrain, road));
+    const TerrainField& t = window ? *window : terrain;
     const std::size_t c = classes.empty() ? std::size_t(RoadClass::departmental) : std::min(std::size_t(classes[ri]), by_class.size() - 1);
     const EarthworkOptions& o = by_class[c];
-    const auto sections = road_sections(terrain, road);
+    const auto sections = road_sections(t, road);
     std::vector<Polygon> zones;
     std::size_t first = 0;  // the section's first point in the road
     for (std::size_t si = 0; si < sections.size(); ++si) {
@@ -264,7 +281,7 @@ Corridors corridors(const TerrainField& terrain, const std::vector<const RoadGeo
       s.length_m = sections[si].length_m;
       s.half_width_m = o.half_width_m;
       s.carriageway_half_width_m = options.half_width_m > 0 ? options.half_width_m : 0.5 * options.widths[c].carriageway_m;
-      section_corridor(terrain, o, road, first, sections[si].points, s);
+      section_corridor(t, o, road, first, sections[si].points, s);
       add(out.roads[ri], s.totals);
       zones.insert(zones.end(), s.zone.begin(), s.zone.end());
       first += sections[si].points.size() - 1;
@@ -364,13 +381,6 @@ std::string corridor_summary(const Corridors& c, double seconds) {
   return out + line;
 }
 
-Corridors road_corridors(const TerrainField& terrain, const std::vector<Road>& roads, const CorridorOptions& options) {
-  std::vector<const RoadGeometry*> geometries;
-  std::vector<RoadClass> classes;
-  for (const Road& r : roads) geometries.push_back(&r.geometry), classes.push_back(r.road_class);
-  return corridors(terrain, geometries, options, classes);
-}
-
 namespace {
 
 /// The stretches of a road off the given roads: maximal runs of segments not on them (on_existing).
@@ -401,8 +411,13 @@ std::vector<RoadGeometry> new_stretches(const RoadGeometry& road, const TerrainF
 }  // namespace
 
 Corridors road_corridors(const TerrainField& terrain, const std::vector<Road>& roads, const CorridorOptions& options,
-                         const GivenCells& existing) {
-  if (existing.empty()) return road_corridors(terrain, roads, options);
+                         const GivenCells& existing, const CorridorWindows* windows) {
+  if (existing.empty()) {
+    std::vector<const RoadGeometry*> geometries;
+    std::vector<RoadClass> classes;
+    for (const Road& r : roads) geometries.push_back(&r.geometry), classes.push_back(r.road_class);
+    return corridors(terrain, geometries, options, classes, windows);
+  }
   std::vector<RoadGeometry> stretches;
   std::vector<std::size_t> road_of;
   std::vector<RoadClass> classes;
@@ -414,7 +429,7 @@ Corridors road_corridors(const TerrainField& terrain, const std::vector<Road>& r
     }
   std::vector<const RoadGeometry*> geometries;
   for (const RoadGeometry& g : stretches) geometries.push_back(&g);
-  Corridors out = corridors(terrain, geometries, options, classes);
+  Corridors out = corridors(terrain, geometries, options, classes, windows);
   std::vector<CorridorTotals> per_road(roads.size());
   for (std::size_t k = 0; k < out.roads.size(); ++k) add(per_road[road_of[k]], out.roads[k]);
   std::vector<std::size_t> next_section(roads.size(), 0);

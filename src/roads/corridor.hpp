@@ -99,18 +99,28 @@ EarthworkOptions earthwork_options(const CorridorOptions& options, Raster<float>
 /// share of the road's length, so the figures do not depend on the DEM's resolution (the
 /// levelled DEM of earthworks() gives the same volumes where its cells are small against R).
 /// `classes`: each road's class (the widths), departmental for all when empty.
+///
+/// Roads on a grid larger than memory (a run by tiles): with `windows`, `terrain` is the grid's
+/// frame (TerrainField::frame) and each road's corridor reads a window of the grid holding the
+/// road's points and `margin_cells` around them, one road at a time. A margin of
+/// window_margin_cells(0, corridor_reach_m(options), ...) holds every cell a cross-section reads, so
+/// the corridors are the whole grid's; the roads' own windows had that margin, so a road's window
+/// is no larger than the largest its search read. A map of side angles is not read by windows.
+struct CorridorWindows {
+  ReadTerrainWindow read;
+  int margin_cells = 0;
+};
 Corridors corridors(const TerrainField& terrain, const std::vector<const RoadGeometry*>& roads, const CorridorOptions& options,
-                    const std::vector<RoadClass>& classes = {});
+                    const std::vector<RoadClass>& classes = {}, const CorridorWindows* windows = nullptr);
 
 struct Road;
-/// The corridors of routed roads, each at its class's widths (the roads and path commands, the run).
-Corridors road_corridors(const TerrainField& terrain, const std::vector<Road>& roads, const CorridorOptions& options);
-/// The same for the new parts of the roads only (roads.existing): `existing` the given roads'
+/// The corridors of routed roads, each at its class's widths (the roads and path commands, the run),
+/// of their new parts only when roads were given (roads.existing): `existing` the given roads'
 /// cells (NetworkResult::existing); a segment whose two ends lie on such cells has its earthworks
 /// already and is left out, each road's other stretches get their corridors (sections numbered
-/// along the road; a road's totals add up its stretches'). Empty `existing`: road_corridors.
+/// along the road; a road's totals add up its stretches'). `windows`: as corridors().
 Corridors road_corridors(const TerrainField& terrain, const std::vector<Road>& roads, const CorridorOptions& options,
-                         const GivenCells& existing);
+                         const GivenCells& existing = {}, const CorridorWindows* windows = nullptr);
 
 /// corridors.geojson: per section an "earthworks" polygon (surface sections) and a "carriageway"
 /// polygon, with road, section, structure, part, length_m, area_ha (geodesic), half-widths,

@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -40,6 +41,12 @@ struct WaterCount {
   void add(const Dem& window, double sea_level_m);
   bool bathymetry() const { return water > 0 && 2 * deep > water; }
 };
+
+class TerrainField;
+/// The road terrain of a grid's cells [col0, col0 + cols) x [row0, row0 + rows) (TerrainField's
+/// window constructor), with whatever the caller layers on it: how roads and their corridors read
+/// a grid larger than memory.
+using ReadTerrainWindow = std::function<TerrainField(int col0, int row0, int cols, int rows)>;
 
 /// Ground and water of a DEM for the road search. Water cells are cells at or below the sea level
 /// and nodata cells. Their depth is sea_level - elevation when the DEM carries bathymetry (more

@@ -13,10 +13,6 @@
 
 namespace terrapolis::roads {
 
-/// The road terrain of the grid's cells [col0, col0 + cols) x [row0, row0 + rows) (TerrainField's
-/// window constructor), with whatever the caller layers on it.
-using ReadTerrainWindow = std::function<TerrainField(int col0, int row0, int cols, int rows)>;
-
 struct WindowOptions {
   /// The most cells a window may hold: the memory the road may take, at kWindowBytesPerCell
   /// (0: the whole grid if need be).

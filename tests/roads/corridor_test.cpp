@@ -5,13 +5,16 @@
 
 #include <cmath>
 #include <numbers>
+#include <random>
 
 #include "core/error.hpp"
 #include "core/geodesy.hpp"
 #include "io/raster_io.hpp"
 #include "roads/corridor.hpp"
 #include "roads/cost_model.hpp"
+#include "roads/windowed_route.hpp"
 #include "roads_fixtures.hpp"
+#include "support/georefs.hpp"
 
 using namespace terrapolis;
 using namespace terrapolis::roads;
@@ -85,7 +88,7 @@ TEST(Corridor, MaterialsFromTheThesisTable) {
 
 TEST(Corridor, FlatPlaneGivesLengthTimesTwoRAndNoVolume) {
   const double cell = 1.0;
-  const Dem dem = test::make_dem(60, 40, cell, [](int, int) { return 100.0; });
+  const Dem dem = roads::test::make_dem(60, 40, cell, [](int, int) { return 100.0; });
   const TerrainField terrain(dem, 0.0, 10.0, 0.0);
   const RoadGeometry road = straight_road(20.0, 10, 50, [](double) { return 100.0; });
   const Corridors c = corridors(terrain, {&road}, options(30));
@@ -106,7 +109,7 @@ TEST(Corridor, ContourRoadOnAnInclinedPlaneGivesTheAnalyticWidthAndVolumes) {
   // A hillside rising tan(beta) = 0.2 southwards; the road along a contour (level deck).
   const double cell = 0.5, tan_beta = 0.2, r = 4;
   const int cols = 80, rows = 80;
-  const Dem dem = test::make_dem(cols, rows, cell, [&](int, int row) { return 100.0 + tan_beta * row * cell; });
+  const Dem dem = roads::test::make_dem(cols, rows, cell, [&](int, int row) { return 100.0 + tan_beta * row * cell; });
   const TerrainField terrain(dem, 0.0, 10.0, 0.0);
   const double row = 40.0, deck = 100.0 + tan_beta * row * cell;
   // From edge to edge of the grid, so that every cell's nearest point is within the road.
@@ -144,7 +147,7 @@ TEST(Corridor, ContourRoadOnAnInclinedPlaneGivesTheAnalyticWidthAndVolumes) {
 TEST(Corridor, EmbankmentAcrossATrenchGivesTheAnalyticFill) {
   // A flat plain at 100 m cut by a trench 10 m wide and h = 5 m deep, crossed by a level road.
   const double cell = 0.5, r = 4, h = 5, width = 10, angle = 30;
-  const Dem dem = test::make_dem(160, 100, cell, [&](int col, int) { return col >= 60 && col < 80 ? 100.0 - h : 100.0; });
+  const Dem dem = roads::test::make_dem(160, 100, cell, [&](int col, int) { return col >= 60 && col < 80 ? 100.0 - h : 100.0; });
   const TerrainField terrain(dem, 0.0, 10.0, 0.0);
   const RoadGeometry road = straight_road(50.0, -0.5, 159.5, [](double) { return 100.0; });
   const CorridorOptions o = options(angle);
@@ -205,7 +208,7 @@ TEST(Corridor, GeodesicAreasAndPerRoadFiguresOnARealDem) {
 }
 
 TEST(Corridor, BridgesAndTunnelsHaveNoEarthworks) {
-  const Dem dem = test::make_dem(60, 40, 1.0, [](int, int r) { return 100.0 + 0.3 * r; });
+  const Dem dem = roads::test::make_dem(60, 40, 1.0, [](int, int r) { return 100.0 + 0.3 * r; });
   const TerrainField terrain(dem, 0.0, 10.0, 0.0);
   RoadGeometry road = straight_road(20.0, 5, 55, [](double) { return 100.0 + 0.3 * 20; });
   for (auto& s : road.segments) s = Structure::bridge;
@@ -221,7 +224,7 @@ TEST(Corridor, BridgesAndTunnelsHaveNoEarthworks) {
 TEST(Corridor, SideAngleMapAndVegetation) {
   // The contour road of the inclined plane; rock (63.4 deg) north of the road, the default south.
   const double cell = 0.5, tan_beta = 0.2, r = 4;
-  const Dem dem = test::make_dem(80, 80, cell, [&](int, int row) { return 100.0 + tan_beta * row * cell; });
+  const Dem dem = roads::test::make_dem(80, 80, cell, [&](int, int row) { return 100.0 + tan_beta * row * cell; });
   TerrainField terrain(dem, 0.0, 10.0, 0.0);
   const RoadGeometry road = straight_road(40.0, 0, 79, [&](double) { return 100.0 + tan_beta * 40 * cell; });
   CorridorOptions o = options(30);
@@ -261,7 +264,7 @@ TEST(Corridor, HairpinAndOverlappingRoadsCountTheirGroundOnce) {
   // 2 m, and the half-turn (radius 3 m < r) sweeps a half-disc of radius 3 + 4 m; the union is
   // the 14 m x 40 m band and the half-disc, 560 + 49 pi / 2 m2 (the ring of the old offsets
   // crossed itself there).
-  const Dem dem = test::make_dem(80, 50, 1.0, [](int, int) { return 100.0; });
+  const Dem dem = roads::test::make_dem(80, 50, 1.0, [](int, int) { return 100.0; });
   const TerrainField terrain(dem, 0.0, 10.0, 0.0);
   const RoadGeometry road = hairpin(10, 50, 20, 3);
   const Corridors c = corridors(terrain, {&road}, options(30));
@@ -287,7 +290,7 @@ TEST(Corridor, HairpinAndOverlappingRoadsCountTheirGroundOnce) {
 
 TEST(Corridor, WidthsFollowTheRoadClass) {
   // On a plane the zone is the platform: 40 m x the class's platform width; the carriageway its own.
-  const Dem dem = test::make_dem(60, 60, 1.0, [](int, int) { return 100.0; });
+  const Dem dem = roads::test::make_dem(60, 60, 1.0, [](int, int) { return 100.0; });
   const TerrainField terrain(dem, 0.0, 10.0, 0.0);
   const RoadGeometry road = straight_road(30.0, 10, 50, [](double) { return 100.0; });
   CorridorOptions o;  // the per-class defaults, no override
@@ -307,4 +310,90 @@ TEST(Corridor, WidthsFollowTheRoadClass) {
   o.widths[3] = {8, 6};  // a platform narrower than its carriageway
   Raster<float> slopes;
   EXPECT_THROW(earthwork_options(o, slopes, RoadClass::local), Error);
+}
+
+namespace {
+
+/// The corridors as text (every section's figures and polygons, the land take), for a comparison
+/// byte for byte.
+std::string corridors_text(const Corridors& c) {
+  std::string s;
+  char buf[128];
+  const auto rings = [&](const std::vector<Polygon>& polygons) {
+    for (const Polygon& p : polygons)
+      for (const Ring& ring : p.rings)
+        for (const auto& v : ring) s += (std::snprintf(buf, sizeof buf, "%.17g %.17g;", v[0], v[1]), buf);
+    s += "\n";
+  };
+  for (const SectionCorridor& x : c.sections) {
+    s += (std::snprintf(buf, sizeof buf, "%zu %zu %.17g %.17g %.17g %.17g|", x.road, x.section, x.totals.cut_m3, x.totals.fill_m3,
+                        x.max_half_width_m, x.walled_m), buf);
+    rings(x.zone), rings(x.carriageway);
+  }
+  rings(c.land_take);
+  return s + (std::snprintf(buf, sizeof buf, "%.17g %.17g %.17g", c.run.land_take_ha, c.run.cut_m3, c.run.fill_m3), buf);
+}
+
+}  // namespace
+
+TEST(Corridor, ByWindowsAroundEachRoadTheWholeGridsCorridors) {
+  // A run by tiles reads each road's corridor on a window holding the road and the corridor's reach
+  // (CorridorWindows): the sections, volumes and land take are the whole grid's, on projected and
+  // geographic grids, roads cutting and filling through rough hills up to the grid's edge. With no
+  // margin the cross-sections stop at the window's edge: the figures differ (the test can fail).
+  std::mt19937_64 rng(31);
+  std::uniform_real_distribution<double> u(0, 1);
+  int differs_without_margin = 0;
+  for (int trial = 0; trial < 4; ++trial) {
+    const int cols = 120, rows = 90;
+    struct Bump { double c, r, h, s; };
+    std::vector<Bump> bumps;
+    for (int i = 0; i < 12; ++i) bumps.push_back({u(rng) * cols, u(rng) * rows, (u(rng) - 0.4) * 40, 3 + 8 * u(rng)});
+    Dem dem(cols, rows, trial % 2 ? terrapolis::test::geographic(46.0, 1.0 / 3600) : terrapolis::test::projected(25.0));
+    for (int r = 0; r < rows; ++r)
+      for (int c = 0; c < cols; ++c) {
+        double z = 50;
+        for (const Bump& b : bumps) z += b.h * std::exp(-((c - b.c) * (c - b.c) + (r - b.r) * (r - b.r)) / (2 * b.s * b.s));
+        dem(c, r) = float(z);
+      }
+    const TerrainField whole(dem, 0.0, 10.0, 0.0);
+    std::vector<RoadGeometry> roads;
+    for (int k = 0; k < 4; ++k) {  // polylines at a level deck, the last one reaching the grid's edge
+      const double c0 = 2 + u(rng) * (cols - 4), r0 = 2 + u(rng) * (rows - 4);
+      const double c1 = k == 3 ? cols - 1 : 2 + u(rng) * (cols - 4), r1 = 2 + u(rng) * (rows - 4);
+      const double deck = 50 + 10 * u(rng);
+      RoadGeometry g;
+      const int n = int(2 * std::hypot(c1 - c0, r1 - r0)) + 2;
+      for (int i = 0; i <= n; ++i) {
+        g.points.push_back({c0 + (c1 - c0) * i / n, r0 + (r1 - r0) * i / n});
+        g.z.push_back(deck);
+      }
+      g.segments.assign(g.points.size() - 1, Structure::road);
+      roads.push_back(std::move(g));
+    }
+    std::vector<const RoadGeometry*> pointers;
+    for (const RoadGeometry& g : roads) pointers.push_back(&g);
+    CorridorOptions o = options(30);
+    o.max_height_m = 6;
+    const std::string expected = corridors_text(corridors(whole, pointers, o));
+    const TerrainGrid grid{dem.georef(), cols, rows, whole.has_bathymetry()};
+    const TerrainField frame = TerrainField::frame(grid);
+    std::size_t reads = 0;
+    const ReadTerrainWindow read = [&](int c0, int r0, int w, int h) {
+      ++reads;
+      Georef g = dem.georef();
+      g.transform[0] += c0 * g.transform[1];
+      g.transform[3] += r0 * g.transform[5];
+      Dem window(w, h, g);
+      for (int r = 0; r < h; ++r)
+        for (int c = 0; c < w; ++c) window(c, r) = dem(c0 + c, r0 + r);
+      return TerrainField(window, c0, r0, grid, 0.0, 10.0, 0.0);
+    };
+    const CorridorWindows windows{read, window_margin_cells(0, corridor_reach_m(o), whole.min_cell_m())};
+    EXPECT_EQ(expected, corridors_text(corridors(frame, pointers, o, {}, &windows))) << trial;
+    EXPECT_EQ(reads, roads.size()) << trial;  // a window a road
+    const CorridorWindows no_margin{read, 0};
+    differs_without_margin += expected != corridors_text(corridors(frame, pointers, o, {}, &no_margin));
+  }
+  EXPECT_GE(differs_without_margin, 2);
 }
