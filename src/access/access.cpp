@@ -328,6 +328,20 @@ TiledAccess travel_time_by_tiles(const Georef& georef, int cols, int rows, int t
   ProgressStep step(progress, "access");
   AccessWindow w;
   Area area;
+  // Each search's result is written at once: a tile's last search saw its neighbours' final frames
+  // (a change to any of them would have queued it again), so its last write is final.
+  std::vector<std::size_t> unreachable(tiles, 0);
+  std::vector<bool> searched(tiles, false);
+  auto write_tile = [&](std::size_t t) {
+    const int tx = int(t % std::size_t(across)), ty = int(t / std::size_t(across));
+    Georef g = georef;
+    g.transform[0] += tx * tile_size * g.transform[1] + ty * tile_size * g.transform[2];
+    g.transform[3] += tx * tile_size * g.transform[4] + ty * tile_size * g.transform[5];
+    AccessResult tile = area_result(w.dem, w.passable, area, g, best, nearest, done);
+    unreachable[t] = tile.unreachable_land;
+    searched[t] = true;
+    write(tx * tile_size, ty * tile_size, std::move(tile));
+  };
   while (!queue.empty()) {
     const Item item = queue.top();
     queue.pop();
@@ -335,6 +349,7 @@ TiledAccess travel_time_by_tiles(const Georef& georef, int cols, int rows, int t
     pending[item.tile] = INFINITY;
     const std::size_t t = item.tile;
     search(t, w, area);
+    write_tile(t);
     Frame& f = frames[t];
     if (f.minutes.empty()) f.minutes.assign(f.size(), INFINITY), f.id.assign(f.size(), -1);
     const int tx = int(t % std::size_t(across)), ty = int(t / std::size_t(across));
@@ -365,16 +380,11 @@ TiledAccess travel_time_by_tiles(const Georef& georef, int cols, int rows, int t
       }
     step.update(0.5 * double(report.tile_runs) / double(report.tile_runs + queue.size() + 1));
   }
-  // Every frame holds its final times: each tile searched once more, in order, and written.
+  // The tiles no time reached (no destination, no neighbour's frame ever changed towards them):
+  // searched from no seed, for their unreachable land.
   for (std::size_t t = 0; t < tiles; ++t) {
-    search(t, w, area);
-    const int tx = int(t % std::size_t(across)), ty = int(t / std::size_t(across));
-    Georef g = georef;
-    g.transform[0] += tx * tile_size * g.transform[1] + ty * tile_size * g.transform[2];
-    g.transform[3] += tx * tile_size * g.transform[4] + ty * tile_size * g.transform[5];
-    AccessResult tile = area_result(w.dem, w.passable, area, g, best, nearest, done);
-    report.unreachable_land += tile.unreachable_land;
-    write(tx * tile_size, ty * tile_size, std::move(tile));
+    if (!searched[t]) search(t, w, area), write_tile(t);
+    report.unreachable_land += unreachable[t];
     step.update(0.5 + 0.5 * double(t + 1) / double(tiles));
   }
   for (const Frame& f : frames) report.frame_bytes += f.minutes.size() * (sizeof(double) + sizeof(std::int32_t));

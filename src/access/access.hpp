@@ -83,7 +83,7 @@ using WriteAccessTile = std::function<void(int col0, int row0, AccessResult&& ti
 
 struct TiledAccess {
   std::size_t tiles = 0;
-  std::size_t tile_runs = 0;         ///< searches of a tile (each tile at least once, the last to write it)
+  std::size_t tile_runs = 0;         ///< searches of a tile (each tile at least once), each written
   std::size_t unreachable_land = 0;  ///< as AccessResult's
   std::size_t frame_bytes = 0;       ///< what the tiles' frames hold between searches
 };
@@ -94,7 +94,8 @@ struct TiledAccess {
 /// the only state kept between searches); a tile whose neighbours' frames improve is searched
 /// again, the earliest change first, until no frame changes. Times only fall, and each tile's
 /// search is exact on its frame's times, so they end as the whole grid's, bit for bit; the ids
-/// too (ties go to the smaller id). Then each tile is searched once more and written, in order.
+/// too (ties go to the smaller id). Each search's tile is written at once (`write`: a tile may be
+/// written several times, the last is final: that search saw its neighbours' final frames).
 TiledAccess travel_time_by_tiles(const Georef& georef, int cols, int rows, int tile_size, const ReadAccessWindow& read,
                                  const std::vector<Destination>& destinations, const AccessOptions& options, const WriteAccessTile& write,
                                  Progress& progress);

@@ -219,7 +219,8 @@ TEST(Access, ByTilesTheWholeGridsTimesAndIds) {
         }
     };
     const TiledAccess tiled = travel_time_by_tiles(dem.georef(), cols, rows, tile, read, towns, options, write, quiet);
-    EXPECT_EQ(std::size_t(written), tiled.tiles) << trial;
+    EXPECT_EQ(std::size_t(written), tiled.tile_runs) << trial;  // each search written, the last of each tile final
+    EXPECT_GE(tiled.tile_runs, tiled.tiles) << trial;
     EXPECT_EQ(tiled.unreachable_land, whole.unreachable_land) << trial;
     for (std::size_t i = 0; i < dem.size(); ++i) {
       ASSERT_EQ(std::isnan(whole.minutes[i]), std::isnan(minutes[i])) << trial << " cell " << i << " tile " << tile;
