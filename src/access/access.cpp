@@ -383,7 +383,10 @@ TiledAccess travel_time_by_tiles(const Georef& georef, int cols, int rows, int t
   // The tiles no time reached (no destination, no neighbour's frame ever changed towards them):
   // searched from no seed, for their unreachable land.
   for (std::size_t t = 0; t < tiles; ++t) {
-    if (!searched[t]) search(t, w, area), write_tile(t);
+    if (!searched[t]) {
+      search(t, w, area);
+      write_tile(t);
+    }
     report.unreachable_land += unreachable[t];
     step.update(0.5 + 0.5 * double(t + 1) / double(tiles));
   }

@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "core/error.hpp"
+#include "io/gdal_util.hpp"
 
 namespace terrapolis {
 namespace {
@@ -27,6 +28,16 @@ void add_polygons(const OGRGeometry& g, std::vector<Polygon>& out) {
   }  // lines and points: a union of polygons has none of area
 }
 
+/// The polygons of `g` (a polygon, or the polygons of a collection) appended to `out`, copied.
+void add_polygons(const OGRGeometry& g, OGRMultiPolygon& out) {
+  const OGRwkbGeometryType type = wkbFlatten(g.getGeometryType());
+  if (type == wkbPolygon) {
+    out.addGeometry(&g);
+  } else if (type == wkbMultiPolygon || type == wkbGeometryCollection) {
+    for (const OGRGeometry* part : *g.toGeometryCollection()) add_polygons(*part, out);
+  }
+}
+
 }  // namespace
 
 std::vector<Polygon> polygon_union(const std::vector<Polygon>& polygons) {
@@ -45,7 +56,22 @@ std::vector<Polygon> polygon_union(const std::vector<Polygon>& polygons) {
   }
   std::vector<Polygon> out;
   if (all.IsEmpty()) return out;
-  const std::unique_ptr<OGRGeometry> united(all.UnionCascaded());
+  const detail::QuietGdal quiet;  // GEOS's complaint about an invalid piece: repaired below
+  std::unique_ptr<OGRGeometry> united(all.UnionCascaded());
+  if (!united) {
+    // GEOS refuses a union with an invalid piece (a ring that touches or crosses itself, e.g. a
+    // swept quadrilateral folded at the scale of rounding): each invalid one made valid (GEOS's
+    // MakeValid keeps every part of its area), then united again.
+    OGRMultiPolygon valid;
+    for (const OGRGeometry* g : all) {
+      if (g->IsValid()) {
+        valid.addGeometry(g);
+      } else if (const std::unique_ptr<OGRGeometry> repaired(g->MakeValid()); repaired) {
+        add_polygons(*repaired, valid);
+      }
+    }
+    united.reset(valid.UnionCascaded());
+  }
   if (!united) throw processing_error("polygon union: GEOS could not unite the polygons");
   add_polygons(*united, out);
   return out;

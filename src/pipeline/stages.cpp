@@ -716,7 +716,8 @@ struct RunRoadWindows {
   std::size_t parallel;
   RoadWindows windows;
   roads::TerrainField frame;
-  RunRoadWindows(RunState& s, const TiledInput& in)
+  /// `held_mb`: what the roads stage holds beside the windows (the given roads).
+  RunRoadWindows(RunState& s, const TiledInput& in, double held_mb)
       : dem(in.dem_path, in.read),
         lakes(saved(s, "inland_water.vrt"), ReadOptions{}),
         parallel(s.settings.roads.routing.lookahead > 0
@@ -724,8 +725,10 @@ struct RunRoadWindows {
                      : std::max<std::size_t>(1, tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism))),
         windows(road_windows(dem, lakes, s.grid.georef, s.scenario, s.settings.roads.model,
                              s.settings.corridor.enabled ? roads::corridor_reach_m(s.settings.corridor.options) : 0.0,
-                             in.tiles.limit_mb() - in.reserved_mb, parallel)),
+                             in.tiles.limit_mb() - in.reserved_mb - held_mb, parallel)),
         frame(roads::TerrainField::frame(windows.grid)) {}
+  RunRoadWindows(const RunRoadWindows&) = delete;  // `windows` refers to the readers
+  RunRoadWindows& operator=(const RunRoadWindows&) = delete;
   /// The network's roads (roads::route_network_by_windows): each link searched on a window of the
   /// DEM and of the inland water around it, on the given roads (drawn on `frame`) and the roads before it.
   roads::NetworkResult route(const RoadsSettings& settings, const std::vector<roads::Link>& links, const roads::ExistingRoads* existing,
@@ -746,10 +749,16 @@ void roads_run(RunState& s, Progress& progress, const Log& log) {
   roads::NetworkResult r;
   if (s.by_tiles) {
     s.by_tiles->reserve();
-    by_windows.emplace(s, *s.by_tiles);
+    // The given roads first, on the grid's frame (the bathymetry rule does not change their cells):
+    // what they hold comes off the windows' share of the limit.
+    existing = existing_roads(s, roads::TerrainField::frame({s.grid.georef, s.grid.cols, s.grid.rows, false}), log);
+    std::size_t given_cells = 0;
+    if (existing)
+      for (const roads::CellChain& chain : existing->chains) given_cells += chain.cells.size();
+    by_windows.emplace(s, *s.by_tiles, double(given_cells) * roads::kRoadCellBytes / 1e6);
     log.detail("roads by windows: windows of at most " + std::to_string(by_windows->windows.window.max_cells) + " cells and " +
-               std::to_string(by_windows->windows.max_nodes) + " search nodes a road, " + std::to_string(by_windows->parallel) + " roads at once");
-    existing = existing_roads(s, by_windows->frame, log);
+               std::to_string(by_windows->windows.max_nodes) + " search nodes a road, " + std::to_string(by_windows->parallel) + " roads at once" +
+               (existing ? ", " + std::to_string(given_cells) + " cells of given roads" : ""));
     r = by_windows->route(settings, links, existing ? &*existing : nullptr, progress);
   } else {
     whole.emplace(road_terrain(s));
@@ -777,7 +786,8 @@ void roads_run(RunState& s, Progress& progress, const Log& log) {
     s.write("roads", "junctions.geojson", roads::junctions_layer(*terrain, r.layout), Style::junctions);
   s.write("roads", "road_sections.geojson", roads::sections_layer(*terrain, r.roads), Style::road_sections);
   std::optional<roads::CorridorWindows> corridor_windows;
-  if (by_windows) corridor_windows = roads::CorridorWindows{by_windows->windows.read, by_windows->windows.window.margin_cells};
+  if (by_windows)
+    corridor_windows = roads::CorridorWindows{by_windows->windows.read, by_windows->windows.window.margin_cells, false};
   const json corridor = corridor_hook(s, *terrain, r.roads, r.existing, corridor_windows ? &*corridor_windows : nullptr);
   std::map<std::string, double> km;
   double bridge_m = 0, tunnel_m = 0, over_limit_m = 0, water_m = 0, network_km = 0;
@@ -814,6 +824,8 @@ void roads_prepare(const Scenario& scenario, const RasterHeader& grid, Settings&
   s.corridor = corridor_settings(scenario);
   if (tile_settings(scenario).given()) {  // by windows (RunRoadWindows): what reads the whole grid is refused
     const auto refuse = [](const std::string& what) { throw bad_input(what + ": not computed on tiles yet (input.tile_size, input.memory_limit_mb)"); };
+    // GDAL's warper sizes its resampling kernel per chunk: a layer warped onto windows is not the
+    // whole grid's, bit for bit (a fixed XSCALE/YSCALE from the whole grid would be).
     if (!s.roads.vegetation.empty()) refuse("/roads/vegetation");
     if (!s.corridor.side_angles.empty()) refuse("/roads/corridor/side_angles");
     if (s.roads.routing.router != roads::Router::galin) refuse("/roads/router");

@@ -215,7 +215,9 @@ double repose_angle_deg(const std::string& material) {
 double corridor_reach_m(const CorridorOptions& options) {
   double half = options.half_width_m;
   for (const ClassWidths& w : options.widths) half = std::max(half, 0.5 * w.platform_m);
-  return half + options.max_height_m / std::tan(std::clamp(options.side_angle_deg, 1.0, 89.0) * kRad);
+  // The side slope earthwork_options uses, unclamped (an angle out of (0, 90) is refused there).
+  const double angle = options.side_angle_deg;
+  return half + (angle > 0 && angle < 90 ? options.max_height_m / std::tan(angle * kRad) : 0.0);
 }
 
 EarthworkOptions earthwork_options(const CorridorOptions& c, Raster<float>& slopes, RoadClass road_class) {
@@ -255,12 +257,13 @@ TerrainField window_around(const CorridorWindows& w, const TerrainField& frame, 
 Corridors corridors(const TerrainField& terrain, const std::vector<const RoadGeometry*>& roads, const CorridorOptions& options,
                     const std::vector<RoadClass>& classes, const CorridorWindows* windows) {
   if (!classes.empty() && classes.size() != roads.size()) throw processing_error("corridor: one class per road");
+  if (windows && options.side_angles_deg.size() > 0) throw bad_input("corridor: a map of side angles is not read by windows");
   Raster<float> slopes;
   std::array<EarthworkOptions, 4> by_class;
   for (std::size_t c = 0; c < by_class.size(); ++c) by_class[c] = earthwork_options(options, slopes, RoadClass(c));
   const Crs& crs = terrain.georef().crs;
   Corridors out;
-  out.vegetation = terrain.has_vegetation();
+  out.vegetation = windows ? windows->vegetation : terrain.has_vegetation();
   out.roads.resize(roads.size());
   std::vector<Polygon> road_zones;  // every road's zone, united road by road
   for (std::size_t ri = 0; ri < roads.size(); ++ri) {

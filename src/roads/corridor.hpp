@@ -105,10 +105,12 @@ EarthworkOptions earthwork_options(const CorridorOptions& options, Raster<float>
 /// road's points and `margin_cells` around them, one road at a time. A margin of
 /// window_margin_cells(0, corridor_reach_m(options), ...) holds every cell a cross-section reads, so
 /// the corridors are the whole grid's; the roads' own windows had that margin, so a road's window
-/// is no larger than the largest its search read. A map of side angles is not read by windows.
+/// is no larger than the largest its search read. A map of side angles is not read by windows
+/// (refused: bad_input).
 struct CorridorWindows {
   ReadTerrainWindow read;
   int margin_cells = 0;
+  bool vegetation = false;  ///< the windows carry a vegetation layer (Corridors::vegetation)
 };
 Corridors corridors(const TerrainField& terrain, const std::vector<const RoadGeometry*>& roads, const CorridorOptions& options,
                     const std::vector<RoadClass>& classes = {}, const CorridorWindows* windows = nullptr);

@@ -8,8 +8,8 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
+#include <map>
 #include <numbers>
-#include <unordered_map>
 
 #include "core/error.hpp"
 #include "core/random.hpp"
@@ -117,28 +117,56 @@ std::optional<Road> route_road(const TerrainField& t, const RoadGraph& graph, Ce
 
 namespace {
 
-/// Values per grid cell: a dense array when the terrain holds the whole grid, else a map of the
-/// cells set (roads by windows: the grid may be far larger than memory, the roads are not).
-template <class T>
-class CellValues {
+/// What the network keeps per grid cell: the cost factor of the roads on it, the most important
+/// class among them, and its parent in the union-find of the cells the roads join. Dense arrays
+/// when the terrain holds the whole grid; else one ordered map of the road cells (roads by windows:
+/// the grid may be far larger than memory, the roads are not), whose cells in a box are found row
+/// by row, a range of grid indices each.
+class RoadCellTable {
  public:
-  CellValues(std::size_t cells, T fill, bool dense) : fill_(fill), dense_(dense) {
-    if (dense) values_.assign(cells, fill);
+  static constexpr std::uint8_t kNone = 0xff;
+  static constexpr std::uint32_t kRoot = 0xffffffffu;  ///< a cell that is its own parent
+  struct Entry {
+    float factor = 1;
+    std::uint8_t road_class = kNone;
+    std::uint32_t parent = kRoot;
+  };
+  RoadCellTable(std::size_t cells, bool dense) : dense_(dense) {
+    if (dense) factor_.assign(cells, 1.0f), class_.assign(cells, kNone), parent_.assign(cells, kRoot);
   }
-  T get(std::uint32_t cell) const {
-    if (dense_) return values_[cell];
+  Entry get(std::uint32_t cell) const {
+    if (dense_) return {factor_[cell], class_[cell], parent_[cell]};
     const auto it = map_.find(cell);
-    return it == map_.end() ? fill_ : it->second;
+    return it == map_.end() ? Entry{} : it->second;
   }
-  void set(std::uint32_t cell, T v) { dense_ ? void(values_[cell] = v) : void(map_[cell] = v); }
-  const std::vector<T>& dense() const { return values_; }
-  const std::unordered_map<std::uint32_t, T>& sparse() const { return map_; }
+  void set_class(std::uint32_t cell, std::uint8_t c, float factor) {
+    if (dense_) {
+      class_[cell] = c, factor_[cell] = factor;
+    } else {
+      Entry& e = map_[cell];
+      e.road_class = c, e.factor = factor;
+    }
+  }
+  void set_parent(std::uint32_t cell, std::uint32_t p) { dense_ ? void(parent_[cell] = p) : void(map_[cell].parent = p); }
+  /// The dense factors (empty when sparse), for ArcDiscount on the whole grid.
+  const std::vector<float>& dense_factors() const { return factor_; }
+  /// Calls f(col, row, factor) for each road cell of the box [c0, c1] x [r0, r1] of a grid `cols`
+  /// wide whose factor is below 1 (sparse only).
+  template <class F>
+  void for_each_factor_in(int c0, int r0, int c1, int r1, int cols, F f) const {
+    for (int r = r0; r <= r1; ++r) {
+      const std::uint32_t row = std::uint32_t(r) * std::uint32_t(cols);
+      for (auto it = map_.lower_bound(row + std::uint32_t(c0)); it != map_.end() && it->first <= row + std::uint32_t(c1); ++it)
+        if (it->second.factor < 1) f(int(it->first - row), r, it->second.factor);
+    }
+  }
 
  private:
-  T fill_;
   bool dense_;
-  std::vector<T> values_;
-  std::unordered_map<std::uint32_t, T> map_;
+  std::vector<float> factor_;
+  std::vector<std::uint8_t> class_;
+  std::vector<std::uint32_t> parent_;
+  std::map<std::uint32_t, Entry> map_;
 };
 
 /// The roads built so far, as the next searches see them: per cell the most important class on it
@@ -147,30 +175,30 @@ class CellValues {
 class BuiltRoads {
  public:
   BuiltRoads(const TerrainField& t, const std::array<double, 4>& discount)
-      : t_(t), discount_(discount), factor_(t.size(), 1.0f, t.holds_values()), class_(t.size(), kNone, t.holds_values()),
-        parent_(t.size(), kRoot, t.holds_values()) {
-    view_.factor = factor_.dense();  // floor 1: no road yet
+      : t_(t), discount_(discount), cells_(t.size(), t.holds_values()) {
+    view_.factor = cells_.dense_factors();  // floor 1: no road yet
   }
   const ArcDiscount* discount() const { return view_.floor < 1 ? &view_ : nullptr; }
   double floor() const { return view_.floor; }
   /// The factors over a window's cells (its indices) into `out`, for a search by windows.
   void factors_over(const TerrainField& window, std::vector<float>& out) const {
     out.assign(window.size(), 1.0f);
-    for (const auto& [cell, f] : factor_.sparse())
-      if (const int col = t_.col_of(cell), row = t_.row_of(cell); window.inside(col, row)) out[window.index(col, row)] = f;
+    cells_.for_each_factor_in(window.col0(), window.row0(), window.col0() + window.cols() - 1, window.row0() + window.rows() - 1, t_.cols(),
+                              [&](int col, int row, float f) {
+                                if (window.inside(col, row)) out[window.index(col, row)] = f;
+                              });
   }
   /// The factors over the grid's cells [c0, c1] x [r0, r1] into `out` (row-major), for the reach bound.
   void factors_over(int c0, int r0, int c1, int r1, std::vector<float>& out) const {
     const std::size_t cols = std::size_t(c1 - c0 + 1);
     out.assign(cols * std::size_t(r1 - r0 + 1), 1.0f);
-    for (const auto& [cell, f] : factor_.sparse())
-      if (const int col = t_.col_of(cell), row = t_.row_of(cell); col >= c0 && col <= c1 && row >= r0 && row <= r1)
-        out[std::size_t(row - r0) * cols + std::size_t(col - c0)] = f;
+    cells_.for_each_factor_in(c0, r0, c1, r1, t_.cols(),
+                              [&](int col, int row, float f) { out[std::size_t(row - r0) * cols + std::size_t(col - c0)] = f; });
   }
   /// The cells whose factor changed, in the order the roads were added (a search routed when the
   /// log held n cells saw every change before n).
   const std::vector<std::uint32_t>& changes() const { return changes_; }
-  bool on_road(std::uint32_t cell) const { return class_.get(cell) != kNone; }
+  bool on_road(std::uint32_t cell) const { return cells_.get(cell).road_class != RoadCellTable::kNone; }
   bool joined(std::uint32_t a, std::uint32_t b) { return find(a) == find(b); }
   /// Share of the chain's length (m) on cells already carrying a road at both ends of a step, or
   /// on the given roads (on_existing).
@@ -194,19 +222,17 @@ class BuiltRoads {
       unite(chain.cells[i], chain.cells[i + 1]);
       if (chain.structures[i] != Structure::road || c == RoadClass::maritime) continue;
       for (std::uint32_t cell : {chain.cells[i], chain.cells[i + 1]}) {
-        if (class_.get(cell) <= std::uint8_t(c)) continue;
-        class_.set(cell, std::uint8_t(c));
+        const RoadCellTable::Entry e = cells_.get(cell);
+        if (e.road_class <= std::uint8_t(c)) continue;
         const float f = float(1.0 - discount_[std::size_t(c)]);
-        if (f != factor_.get(cell)) changes_.push_back(cell);
-        factor_.set(cell, f);
+        if (f != e.factor) changes_.push_back(cell);
+        cells_.set_class(cell, std::uint8_t(c), f);
         view_.floor = std::min(view_.floor, double(f));  // the smallest factor on the grid
       }
     }
   }
 
  private:
-  static constexpr std::uint8_t kNone = 0xff;
-  static constexpr std::uint32_t kRoot = 0xffffffffu;  ///< a cell that is its own parent
   template <class On>
   double share_on(const CellChain& chain, On on) const {
     double shared = 0, total = 0;
@@ -219,26 +245,24 @@ class BuiltRoads {
   }
   GridPoint point(std::uint32_t cell) const { return {double(t_.col_of(cell)), double(t_.row_of(cell))}; }
   std::uint32_t parent(std::uint32_t x) const {
-    const std::uint32_t p = parent_.get(x);
-    return p == kRoot ? x : p;
+    const std::uint32_t p = cells_.get(x).parent;
+    return p == RoadCellTable::kRoot ? x : p;
   }
   std::uint32_t find(std::uint32_t x) {
     while (parent(x) != x) {
       const std::uint32_t up = parent(parent(x));
-      parent_.set(x, up);
+      cells_.set_parent(x, up);
       x = up;
     }
     return x;
   }
   void unite(std::uint32_t a, std::uint32_t b) {
     a = find(a), b = find(b);
-    if (a != b) parent_.set(std::max(a, b), std::min(a, b));
+    if (a != b) cells_.set_parent(std::max(a, b), std::min(a, b));
   }
   const TerrainField& t_;
   std::array<double, 4> discount_;
-  CellValues<float> factor_;
-  CellValues<std::uint8_t> class_;
-  CellValues<std::uint32_t> parent_;
+  RoadCellTable cells_;
   std::vector<std::uint32_t> changes_;
   GivenCells existing_;  ///< cells of the given roads (empty: none)
   ArcDiscount view_;

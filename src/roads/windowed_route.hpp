@@ -33,6 +33,10 @@ struct WindowOptions {
 /// the search's per-cell arrays (nodes, arc caches, relaxed distances: about 30). The nodes the
 /// search stores come on top (RoutingOptions::max_nodes; pipeline::road_windows counts 48 bytes each).
 inline constexpr double kWindowBytesPerCell = 60;
+/// Bytes a cell of a road held by the network by windows takes: its entry in the road cells' ordered
+/// map (about 64), its chain's cell and step, the log of changed factors and, for a given road
+/// (roads.existing), its place in GivenCells and the result's copy.
+inline constexpr double kRoadCellBytes = 96;
 /// Bytes a search node takes (RoutingOptions::max_nodes counts them): node slots of 16 bytes and arc
 /// costs cached 4 to a unit; with their share of the queue about 32 bytes each, and 16 more for the
 /// long arcs' cost cache that follows it (4 floats a unit, TargetSearch).

@@ -127,6 +127,8 @@ no_leftovers "$WORK"
 # Refused before any stage, exit 2, no folder: the later stages, and what the tiles do not compute yet.
 expect_refused r3 "/hydro/classify: not computed on tiles yet" "$TP" run "${tiled[@]}" --set input.tile_size=64 --set hydro.classify=true -o r3
 expect_refused r4 "/hydro/flow mfd: not computed on tiles yet" "$TP" run "${tiled[@]}" --set input.tile_size=64 --set hydro.flow=mfd -o r4
+expect_refused r9 "/roads/vegetation: not computed on tiles yet" "$TP" run "${tiled[@]}" --set input.tile_size=64 \
+  --set roads.vegetation="$SAMPLES/spDataLarge_srtm_zion.tif" -o r9
 expect_refused r8 "/roads/corridor/side_angles: not computed on tiles yet" "$TP" run "${tiled[@]}" --set input.tile_size=64 \
   --set roads.corridor.enabled=true --set roads.corridor.side_angles="$SAMPLES/spDataLarge_srtm_zion.tif" -o r8
 gdal_calc.py --quiet -A "$SAMPLES/spDataLarge_srtm_zion.tif" --outfile nodata.tif --calc "A*0+65535" --NoDataValue 65535 --type UInt16
