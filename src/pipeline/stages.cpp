@@ -2,7 +2,6 @@
 // SPDX-License-Identifier: MIT
 #include "pipeline/stages.hpp"
 
-#include <tbb/global_control.h>
 
 #include <algorithm>
 #include <cmath>
@@ -720,9 +719,7 @@ struct RunRoadWindows {
   RunRoadWindows(RunState& s, const TiledInput& in, double held_mb)
       : dem(in.dem_path, in.read),
         lakes(saved(s, "inland_water.vrt"), ReadOptions{}),
-        parallel(s.settings.roads.routing.lookahead > 0
-                     ? s.settings.roads.routing.lookahead
-                     : std::max<std::size_t>(1, tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism))),
+        parallel(roads::links_at_once(s.settings.roads.routing)),
         windows(road_windows(dem, lakes, s.grid.georef, s.scenario, s.settings.roads.model,
                              s.settings.corridor.enabled ? roads::corridor_reach_m(s.settings.corridor.options) : 0.0,
                              in.tiles.limit_mb() - in.reserved_mb - held_mb, parallel)),

@@ -270,6 +270,11 @@ class BuiltRoads {
 
 }  // namespace
 
+std::size_t links_at_once(const RoutingOptions& options) {
+  return options.lookahead > 0 ? options.lookahead
+                               : std::max<std::size_t>(1, tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+}
+
 CostModel class_model(CostModel model, double max_grade_pct, double min_radius_m) {
   const double deg = std::atan(max_grade_pct / 100) * 180 / std::numbers::pi;
   for (StructureCosts* s : {&model.road, &model.bridge, &model.tunnel}) s->slope_deg.threshold = std::min(s->slope_deg.threshold, deg);
@@ -357,9 +362,7 @@ class NetworkRouter {
   }
 
   NetworkResult run() {
-    const std::size_t lookahead = options_.lookahead > 0
-                                      ? options_.lookahead
-                                      : std::max<std::size_t>(1, tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+    const std::size_t lookahead = links_at_once(options_);
     NetworkResult result;
     for (std::size_t head = 0; head < order_.size();) {
       const std::vector<std::size_t> todo = next_batch(head, lookahead);

@@ -45,6 +45,9 @@ struct RoutingOptions {
   std::size_t lookahead = 0;
 };
 
+/// How many links route_network routes at once: RoutingOptions::lookahead, or the worker threads.
+std::size_t links_at_once(const RoutingOptions& options);
+
 /// The cost model of a road class: every slope threshold at most the class's grade, its curve radius.
 CostModel class_model(CostModel model, double max_grade_pct, double min_radius_m);
 
