@@ -2,7 +2,6 @@
 // SPDX-License-Identifier: MIT
 #include "pipeline/stages.hpp"
 
-
 #include <algorithm>
 #include <cmath>
 #include <map>
