@@ -2,6 +2,7 @@
 #include "access/access.hpp"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <map>
@@ -251,6 +252,32 @@ struct Frame {
   std::vector<std::int32_t> id;
   bool all() const { return w <= 4 || h <= 4; }
   std::size_t size() const { return all() ? std::size_t(w) * std::size_t(h) : std::size_t(4 * w + 4 * (h - 4)); }
+  /// Stores the tile's searched times and ids (`dem`'s window, the tile its `area`) on the frame;
+  /// returns, for each neighbour [dy + 1][dx + 1], the earliest time among the changed cells its
+  /// window reads (INFINITY: none changed).
+  using Changes = std::array<std::array<double, 3>, 3>;
+  Changes store(const Raster<float>& dem, const Area& area, const std::vector<double>& best, const std::vector<std::int32_t>& nearest,
+                const std::vector<std::uint8_t>& done) {
+    if (minutes.empty()) minutes.assign(size(), INFINITY), id.assign(size(), -1);
+    Changes changed;
+    for (auto& row : changed) row.fill(INFINITY);
+    for (int r = 0; r < h; ++r)
+      for (int c = 0; c < w; ++c) {
+        const int k = slot(c, r);
+        if (k < 0) continue;
+        const std::size_t i = dem.index(area.c0 + c, area.r0 + r);
+        const double m = done[i] ? best[i] : INFINITY;
+        const std::int32_t cell_id = done[i] ? nearest[i] : -1;
+        if (m == minutes[std::size_t(k)] && cell_id == id[std::size_t(k)]) continue;
+        minutes[std::size_t(k)] = m, id[std::size_t(k)] = cell_id;
+        for (int dy = -1; dy <= 1; ++dy)  // the neighbours whose windows hold this cell
+          for (int dx = -1; dx <= 1; ++dx) {
+            if ((dx < 0 && c >= 2) || (dx > 0 && c < w - 2) || (dy < 0 && r >= 2) || (dy > 0 && r < h - 2)) continue;
+            changed[std::size_t(dy + 1)][std::size_t(dx + 1)] = std::min(changed[std::size_t(dy + 1)][std::size_t(dx + 1)], m);
+          }
+      }
+    return changed;
+  }
   /// The slot of the tile's cell (c, r), or -1 when it is not on the frame.
   int slot(int c, int r) const {
     if (all() || r < 2) return r * w + c;
@@ -334,10 +361,7 @@ TiledAccess travel_time_by_tiles(const Georef& georef, int cols, int rows, int t
   std::vector<bool> searched(tiles, false);
   auto write_tile = [&](std::size_t t) {
     const int tx = int(t % std::size_t(across)), ty = int(t / std::size_t(across));
-    Georef g = georef;
-    g.transform[0] += tx * tile_size * g.transform[1] + ty * tile_size * g.transform[2];
-    g.transform[3] += tx * tile_size * g.transform[4] + ty * tile_size * g.transform[5];
-    AccessResult tile = area_result(w.dem, w.passable, area, g, best, nearest, done);
+    AccessResult tile = area_result(w.dem, w.passable, area, georef.window(tx * tile_size, ty * tile_size), best, nearest, done);
     unreachable[t] = tile.unreachable_land;
     searched[t] = true;
     write(tx * tile_size, ty * tile_size, std::move(tile));
@@ -350,33 +374,15 @@ TiledAccess travel_time_by_tiles(const Georef& georef, int cols, int rows, int t
     const std::size_t t = item.tile;
     search(t, w, area);
     write_tile(t);
-    Frame& f = frames[t];
-    if (f.minutes.empty()) f.minutes.assign(f.size(), INFINITY), f.id.assign(f.size(), -1);
     const int tx = int(t % std::size_t(across)), ty = int(t / std::size_t(across));
-    double changed[3][3];
-    for (auto& row : changed) std::fill(std::begin(row), std::end(row), double(INFINITY));
-    for (int r = 0; r < f.h; ++r)
-      for (int c = 0; c < f.w; ++c) {
-        const int k = f.slot(c, r);
-        if (k < 0) continue;
-        const std::size_t i = w.dem.index(area.c0 + c, area.r0 + r);
-        const double m = done[i] ? best[i] : INFINITY;
-        const std::int32_t id = done[i] ? nearest[i] : -1;
-        if (m == f.minutes[std::size_t(k)] && id == f.id[std::size_t(k)]) continue;
-        f.minutes[std::size_t(k)] = m, f.id[std::size_t(k)] = id;
-        // The neighbours whose windows hold this cell.
-        for (int dy = -1; dy <= 1; ++dy)
-          for (int dx = -1; dx <= 1; ++dx) {
-            if ((dx < 0 && c >= 2) || (dx > 0 && c < f.w - 2) || (dy < 0 && r >= 2) || (dy > 0 && r < f.h - 2)) continue;
-            changed[dy + 1][dx + 1] = std::min(changed[dy + 1][dx + 1], m);
-          }
-      }
+    const Frame::Changes changed = frames[t].store(w.dem, area, best, nearest, done);
     for (int dy = -1; dy <= 1; ++dy)
       for (int dx = -1; dx <= 1; ++dx) {
         const int nx = tx + dx, ny = ty + dy;
-        if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= across || ny >= down || changed[dy + 1][dx + 1] == INFINITY) continue;
+        const double m = changed[std::size_t(dy + 1)][std::size_t(dx + 1)];
+        if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= across || ny >= down || m == INFINITY) continue;
         const std::size_t n = std::size_t(ny) * std::size_t(across) + std::size_t(nx);
-        if (changed[dy + 1][dx + 1] < pending[n]) pending[n] = changed[dy + 1][dx + 1], queue.push({pending[n], n});
+        if (m < pending[n]) pending[n] = m, queue.push({pending[n], n});
       }
     step.update(0.5 * double(report.tile_runs) / double(report.tile_runs + queue.size() + 1));
   }

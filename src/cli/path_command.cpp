@@ -166,7 +166,6 @@ class PathCommand final : public Command {
     if (!evaluate_.empty()) refuse("--evaluate");
     if (options_.routing().router != roads::Router::galin) refuse("--router bezier");
     if (!options_.earthworks.empty()) refuse("--earthworks");
-    if (!options_.settings().vegetation.empty()) refuse("--vegetation");
     if (!plugins.empty()) refuse("--plugin");
     if (!options_.scenario().path("/roads/corridor/side_angles").empty()) refuse("--side-angles");
     if (!pipeline::inland_water_settings(options_.scenario()).reservoirs.empty()) refuse("water.reservoirs");
@@ -189,7 +188,8 @@ class PathCommand final : public Command {
         pipeline::inland_water_mosaic(reader, pipeline::inland_water_settings(scenario), tiles, scratch, context.progress, context.log),
         ReadOptions{});
     const double budget_mb = tiles.limit_mb() - reserve_reader_memory(tiles.limit_mb());
-    const pipeline::RoadWindows w = pipeline::road_windows(reader, lakes, h.georef, scenario, model, roads::corridor_reach_m(corridor), budget_mb, 1);
+    const pipeline::RoadWindows w = pipeline::road_windows(reader, lakes, h.georef, scenario, model, roads::corridor_reach_m(corridor), budget_mb, 1,
+                                                           options_.settings().vegetation);
     roads::RoutingOptions bounded = routing;
     bounded.max_nodes = std::min(routing.max_nodes, w.max_nodes);
     for (const auto& [opt, c] : {std::pair{"--from", a}, std::pair{"--to", b}}) {  // as on the whole DEM: an end in the sea refused

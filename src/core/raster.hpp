@@ -42,6 +42,13 @@ struct Georef {
     const double c = col + 0.5, r = row + 0.5;
     return {transform[0] + c * transform[1] + r * transform[2], transform[3] + c * transform[4] + r * transform[5]};
   }
+  /// The georeferencing of a window of the grid whose first cell is (col0, row0).
+  Georef window(int col0, int row0) const {
+    Georef g = *this;
+    g.transform[0] = transform[0] + col0 * transform[1] + row0 * transform[2];
+    g.transform[3] = transform[3] + col0 * transform[4] + row0 * transform[5];
+    return g;
+  }
 };
 
 /// A 2-D grid of values with its georeferencing. Float rasters hold nodata as NaN in memory;

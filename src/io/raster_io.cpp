@@ -361,7 +361,31 @@ Dem read_dem(const std::string& path, const ReadOptions& options) {
   return dem;
 }
 
-Raster<float> read_resampled(const std::string& path, const Georef& like, int cols, int rows, Resampling resampling, int band) {
+WarpScale warp_scale(const std::string& path, const Georef& like, int cols, int rows) {
+  auto src = open_raster(path);
+  const OGRSpatialReference* srs = src->GetSpatialRef();
+  if (!srs || srs->IsEmpty()) throw bad_input(path + ": has no CRS; cannot place it on the DEM's grid");
+  std::array<double, 6> src_gt{};
+  if (src->GetGeoTransform(src_gt.data()) != CE_None) throw bad_input(path + ": has no geotransform; cannot place it on the DEM's grid");
+  char* src_wkt = nullptr;
+  srs->exportToWkt(&src_wkt);
+  void* transformer = GDALCreateGenImgProjTransformer3(src_wkt, src_gt.data(), like.crs.wkt.c_str(), like.transform.data());
+  CPLFree(src_wkt);
+  if (!transformer) throw bad_input(path + ": cannot be placed on the DEM's grid");
+  // The grid's centre and a square of 16 cells from it, into source pixels.
+  constexpr double kSide = 16;
+  const double cx = 0.5 * cols, cy = 0.5 * rows;
+  double x[3] = {cx, cx + kSide, cx}, y[3] = {cy, cy, cy + kSide}, z[3] = {0, 0, 0};
+  int ok[3] = {0, 0, 0};
+  GDALGenImgProjTransform(transformer, TRUE, 3, x, y, z, ok);
+  GDALDestroyGenImgProjTransformer(transformer);
+  if (!ok[0] || !ok[1] || !ok[2]) throw bad_input(path + ": the DEM's centre does not fall on it");
+  const double span_x = std::fabs(x[1] - x[0]) + std::fabs(x[2] - x[0]), span_y = std::fabs(y[1] - y[0]) + std::fabs(y[2] - y[0]);
+  return {span_x > 0 ? kSide / span_x : 1.0, span_y > 0 ? kSide / span_y : 1.0};
+}
+
+Raster<float> read_resampled(const std::string& path, const Georef& like, int cols, int rows, Resampling resampling, int band,
+                             const WarpScale* scale) {
   auto src = open_raster(path);
   if (band < 1 || band > src->GetRasterCount()) throw bad_input(path + ": band " + std::to_string(band) + " does not exist");
   const OGRSpatialReference* srs = src->GetSpatialRef();
@@ -396,6 +420,13 @@ Raster<float> read_resampled(const std::string& path, const Georef& like, int co
   wo->padfDstNoDataReal = static_cast<double*>(CPLMalloc(sizeof(double)));
   wo->padfDstNoDataReal[0] = std::numeric_limits<double>::quiet_NaN();
   wo->papszWarpOptions = CSLSetNameValue(wo->papszWarpOptions, "INIT_DEST", "NO_DATA");
+  if (scale) {
+    char value[32];
+    std::snprintf(value, sizeof value, "%.17g", scale->x);
+    wo->papszWarpOptions = CSLSetNameValue(wo->papszWarpOptions, "XSCALE", value);
+    std::snprintf(value, sizeof value, "%.17g", scale->y);
+    wo->papszWarpOptions = CSLSetNameValue(wo->papszWarpOptions, "YSCALE", value);
+  }
   switch (resampling) {
     case Resampling::nearest: wo->eResampleAlg = GRA_NearestNeighbour; break;
     case Resampling::bilinear: wo->eResampleAlg = GRA_Bilinear; break;
@@ -513,10 +544,7 @@ DemWindowReader::DemWindowReader(const std::string& path, ReadOptions options)
 DemWindowReader::~DemWindowReader() = default;
 
 Dem DemWindowReader::read(int col0, int row0, int cols, int rows) const {
-  Georef georef = header_.georef;
-  const GeoTransform& gt = header_.georef.transform;
-  georef.transform[0] = gt[0] + col0 * gt[1] + row0 * gt[2];
-  georef.transform[3] = gt[3] + col0 * gt[4] + row0 * gt[5];
+  const Georef georef = header_.georef.window(col0, row0);
   Dem window(cols, rows, georef, std::numeric_limits<float>::quiet_NaN());
   const int c0 = std::max(col0, 0), r0 = std::max(row0, 0);
   const int c1 = std::min(col0 + cols, header_.cols), r1 = std::min(row0 + rows, header_.rows);

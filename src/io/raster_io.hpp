@@ -61,9 +61,22 @@ Dem read_dem(const std::string& path, const ReadOptions& options = {});
 /// GDAL resampling methods offered for layers read onto a DEM's grid.
 enum class Resampling { nearest, bilinear, cubic, average, mode };
 
+/// GDAL's warp scale (its XSCALE and YSCALE: destination cells per source cell along each axis),
+/// which sizes the resampling kernel when a layer is downsampled.
+struct WarpScale {
+  double x = 1, y = 1;
+};
+
 /// Reads band `band` of any GDAL raster warped onto the grid of `like` (NaN where nodata/outside).
+/// `scale`: a kernel size fixed for the whole warp (warp_scale), or nullptr for GDAL's own, which it
+/// sets for each chunk it warps: a window of a grid is then not the whole grid's, bit for bit.
 Raster<float> read_resampled(const std::string& path, const Georef& like, int cols, int rows,
-                             Resampling resampling = Resampling::bilinear, int band = 1);
+                             Resampling resampling = Resampling::bilinear, int band = 1, const WarpScale* scale = nullptr);
+
+/// The warp scale of `path` onto the grid of `like` (`cols` x `rows`) at the grid's centre: from the
+/// source cells a square of destination cells spans there, as GDAL measures a square chunk. One scale
+/// for a grid and all its windows makes each window's warp the grid's.
+WarpScale warp_scale(const std::string& path, const Georef& like, int cols, int rows);
 
 struct WriteOptions {
   bool cog = false;        ///< Cloud Optimized GeoTIFF layout (GDAL's COG driver)

@@ -3,6 +3,7 @@
 #include "pipeline/inland_water.hpp"
 
 #include <algorithm>
+#include <optional>
 
 #include <cmath>
 
@@ -56,7 +57,8 @@ roads::TerrainField road_terrain(const Dem& dem, const Scenario& scenario, const
 }
 
 RoadWindows road_windows(const DemWindowReader& dem, const DemWindowReader& lakes, const Georef& georef, const Scenario& scenario,
-                         const roads::CostModel& model, double reach_m, double budget_mb, std::size_t parallel) {
+                         const roads::CostModel& model, double reach_m, double budget_mb, std::size_t parallel,
+                         const std::string& vegetation) {
   const RasterHeader& h = dem.header();
   if (!(budget_mb > 0)) throw bad_input("the memory limit leaves nothing for the roads' windows once the process is counted");
   const double sea_level = scenario.resolved["water"]["sea_level_m"].get<double>();
@@ -67,22 +69,30 @@ RoadWindows road_windows(const DemWindowReader& dem, const DemWindowReader& lake
   const int band = int(std::clamp(budget / 8 / (4.0 * h.cols), 1.0, double(h.rows)));
   for (int r = 0; r < h.rows; r += band) count.add(dem.read(0, r, h.cols, std::min(band, h.rows - r)), sea_level);
   out.grid.bathymetry = count.bathymetry();
-  out.window.max_cells = std::size_t(0.5 * budget / roads::kWindowBytesPerCell);
+  // The vegetation layer: 4 bytes a cell held, 4 more while it is warped.
+  out.window.max_cells = std::size_t(0.5 * budget / (roads::kWindowBytesPerCell + (vegetation.empty() ? 0 : 8)));
   out.max_nodes = std::size_t(0.5 * budget / roads::kSearchBytesPerNode);
   // The road radius in the grid's smallest cells, as a TerrainField of the grid counts it.
   out.window.margin_cells = roads::window_margin_cells(model.road_radius_m, reach_m, roads::TerrainField::frame(out.grid).min_cell_m());
-  out.read = [&dem, &lakes, grid = out.grid, sea_level, model](int c0, int r0, int cols, int rows) {
+  std::optional<WarpScale> scale;  // the whole grid's (add_road_layers): each window's warp is the grid's
+  if (!vegetation.empty()) scale = warp_scale(vegetation, georef, h.cols, h.rows);
+  out.read = [&dem, &lakes, grid = out.grid, sea_level, model, vegetation, scale](int c0, int r0, int cols, int rows) {
     const Dem window = dem.read(c0, r0, cols, rows);
     const Raster<std::uint8_t> mask = saved_water_mask(lakes.read(c0, r0, cols, rows));
-    return roads::TerrainField(window, c0, r0, grid, sea_level, model.unknown_water_depth_m, model.road_radius_m, &mask);
+    roads::TerrainField t(window, c0, r0, grid, sea_level, model.unknown_water_depth_m, model.road_radius_m, &mask);
+    if (scale) t.set_vegetation(read_resampled(vegetation, window.georef(), cols, rows, Resampling::bilinear, 1, &*scale));
+    return t;
   };
   return out;
 }
 
 void add_road_layers(roads::TerrainField& terrain, const RoadsSettings& settings, const plugin::PluginSet& plugins, const Dem& dem,
                      Progress& progress, const Log& log) {
-  if (!settings.vegetation.empty())
-    terrain.set_vegetation(read_resampled(settings.vegetation, dem.georef(), dem.cols(), dem.rows(), Resampling::bilinear));
+  if (!settings.vegetation.empty()) {
+    // One kernel over the grid (warp_scale), as on the windows of a run by tiles (road_windows).
+    const WarpScale scale = warp_scale(settings.vegetation, dem.georef(), dem.cols(), dem.rows());
+    terrain.set_vegetation(read_resampled(settings.vegetation, dem.georef(), dem.cols(), dem.rows(), Resampling::bilinear, 1, &scale));
+  }
   plugin::add_to_terrain(plugin::road_terms(plugins, dem, progress, log), terrain);
 }
 

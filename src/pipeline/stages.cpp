@@ -721,7 +721,7 @@ struct RunRoadWindows {
         parallel(roads::links_at_once(s.settings.roads.routing)),
         windows(road_windows(dem, lakes, s.grid.georef, s.scenario, s.settings.roads.model,
                              s.settings.corridor.enabled ? roads::corridor_reach_m(s.settings.corridor.options) : 0.0,
-                             in.tiles.limit_mb() - in.reserved_mb - held_mb, parallel)),
+                             in.tiles.limit_mb() - in.reserved_mb - held_mb, parallel, s.settings.roads.vegetation)),
         frame(roads::TerrainField::frame(windows.grid)) {}
   RunRoadWindows(const RunRoadWindows&) = delete;  // `windows` refers to the readers
   RunRoadWindows& operator=(const RunRoadWindows&) = delete;
@@ -783,7 +783,7 @@ void roads_run(RunState& s, Progress& progress, const Log& log) {
   s.write("roads", "road_sections.geojson", roads::sections_layer(*terrain, r.roads), Style::road_sections);
   std::optional<roads::CorridorWindows> corridor_windows;
   if (by_windows)
-    corridor_windows = roads::CorridorWindows{by_windows->windows.read, by_windows->windows.window.margin_cells, false};
+    corridor_windows = roads::CorridorWindows{by_windows->windows.read, by_windows->windows.window.margin_cells, !settings.vegetation.empty()};
   const json corridor = corridor_hook(s, *terrain, r.roads, r.existing, corridor_windows ? &*corridor_windows : nullptr);
   std::map<std::string, double> km;
   double bridge_m = 0, tunnel_m = 0, over_limit_m = 0, water_m = 0, network_km = 0;
@@ -820,9 +820,6 @@ void roads_prepare(const Scenario& scenario, const RasterHeader& grid, Settings&
   s.corridor = corridor_settings(scenario);
   if (tile_settings(scenario).given()) {  // by windows (RunRoadWindows): what reads the whole grid is refused
     const auto refuse = [](const std::string& what) { throw bad_input(what + ": not computed on tiles yet (input.tile_size, input.memory_limit_mb)"); };
-    // GDAL's warper sizes its resampling kernel per chunk: a layer warped onto windows is not the
-    // whole grid's, bit for bit (a fixed XSCALE/YSCALE from the whole grid would be).
-    if (!s.roads.vegetation.empty()) refuse("/roads/vegetation");
     if (!s.corridor.side_angles.empty()) refuse("/roads/corridor/side_angles");
     if (s.roads.routing.router != roads::Router::galin) refuse("/roads/router");
   }

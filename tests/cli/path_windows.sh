@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # `terrapolis path --memory-limit` (docs/roads.md, "One road on a region larger than memory"): the
 # road searched on windows of the DEM, grown until the bound proves it the whole grid's, is the
-# whole-grid road byte for byte (road, sections, corridor), on a file and on a 3 x 3 VRT of tiles;
+# whole-grid road byte for byte (road, sections, corridor, with a vegetation layer too), on a file
+# and on a 3 x 3 VRT of tiles;
 # what reads the whole DEM, and a limit too small for the road, refused before anything is written.
 # SPDX-License-Identifier: MIT
 source "$(dirname "$0")/lib.sh" "$@"
@@ -28,13 +29,23 @@ zends=(--from -113.15,37.45 --to -112.93,37.2)
 "$TP" -q path zion.vrt "${zends[@]}" zwin.geojson --corridor zwin_c.geojson --memory-limit $limit
 cmp -s zwhole.geojson zwin.geojson || fail "the road on the VRT's windows differs from the whole grid's"
 cmp -s zwhole_c.geojson zwin_c.geojson || fail "the corridor on the VRT's windows differs from the whole grid's"
+# A forest layer in UTM 12N at 30 m (downsampled onto the 3" grid: GDAL's kernel wider than a
+# cell), warped onto each window with the whole grid's kernel: the same road, corridor and clearing.
+# (On the file itself: the VRT's geotransform differs from the file's in its last bits, which
+# moves the warped positions by as much.)
+gdalwarp -q -t_srs EPSG:32612 -tr 30 30 -r bilinear "$zion" zutm.tif
+gdal_calc.py --quiet -A zutm.tif --outfile forest.tif --type Float32 --calc "clip((A - 1500) / 800.0, 0, 1)"
+"$TP" -q path "$zion" "${zends[@]}" fwhole.geojson --corridor fwhole_c.geojson --vegetation forest.tif
+"$TP" -q path "$zion" "${zends[@]}" fwin.geojson --corridor fwin_c.geojson --vegetation forest.tif --memory-limit $limit
+cmp -s fwhole.geojson fwin.geojson || fail "--vegetation: the road on windows differs from the whole grid's"
+cmp -s fwhole_c.geojson fwin_c.geojson || fail "--vegetation: the corridor on windows differs from the whole grid's"
+cmp -s fwhole.geojson zwhole.geojson && fail "--vegetation changed nothing: the test compares nothing it prices"
 no_leftovers .
 [[ ! -e .inland_water ]] || fail "the inland water's tiles were left behind"
 
 refuse() { expect_refused bad.geojson "$1" "$TP" -q path zion.vrt "${zends[@]}" bad.geojson --memory-limit $limit "${@:2}"; }
 refuse "--earthworks: reads the whole DEM" --earthworks bad.tif
 refuse "--evaluate: reads the whole DEM" --evaluate zwhole.geojson
-refuse "--vegetation: reads the whole DEM" --vegetation "$zion"
 refuse "--router bezier: reads the whole DEM" --router bezier
 expect_refused bad.geojson "--from: the point is in the sea" \
   "$TP" -q path "$corsica" --from 9.0,43.15 --to 9.42,42.70 bad.geojson --memory-limit $limit

@@ -3,7 +3,7 @@
 # terrain, hydro and density stages read the DEM by windows and write one GeoTIFF a tile and a VRT
 # per raster, the same cells as the run on the whole grid, the same streams and figures; the sites
 # stage reads the density's tiles by bands and blocks, the roads stage searches each link on a
-# window of the DEM (on the given roads too; the corridors on a window around each road), the access stage its travel times by tiles; the settlements, the network, the
+# window of the DEM (on the given roads and the vegetation too; the corridors on a window around each road), the access stage its travel times by tiles; the settlements, the network, the
 # roads, the catchments and preview.png are the whole grid's bytes, the realism figures the whole grid's; memory bounded by the limit;
 # what is not computed on tiles yet refused before any stage.
 # SPDX-License-Identifier: MIT
@@ -94,20 +94,25 @@ for l in cities.geojson network.geojson roads.geojson; do cmp -s "places_whole/$
 
 # The roads as they are (roads.existing: every other road of the whole run) on tiles of 50: the
 # links reuse them by windows as on the whole grid, the corridors of the new stretches read a window
-# around each road; the same layers, the given roads as read, figures.
+# around each road, the forest cleared and priced on each window; the same layers, the given roads
+# as read, figures.
 /usr/bin/python3 -c '
 import json
 g = json.load(open("whole/roads.geojson"))
 json.dump({"type": "FeatureCollection", "features": g["features"][::2]}, open("given.geojson", "w"))'
-given=(--set roads.existing="$WORK/given.geojson" --set roads.corridor.enabled=true --until roads)
+# A forest layer in another CRS (UTM 32N, 250 m cells: downsampled onto the 15" grid), warped onto
+# each window with the whole grid's kernel.
+gdalwarp -q -t_srs EPSG:32632 -tr 250 250 -r bilinear "$SAMPLES/gebco2022_15s_north_corsica_capcorse.asc" utm.tif
+gdal_calc.py --quiet -A utm.tif --outfile forest.tif --type Float32 --calc "clip((A - 40) / 400.0, 0, 1)"
+given=(--set roads.existing="$WORK/given.geojson" --set roads.corridor.enabled=true --set roads.vegetation="$WORK/forest.tif" --until roads)
 "$TP" -q run "${tiled[@]}" "${given[@]}" -o given_whole
 "$TP" -q run "${tiled[@]}" "${given[@]}" --set input.tile_size=50 -o given_tiles
 for l in existing_roads.geojson roads.geojson sections.geojson junctions.geojson road_sections.geojson corridors.geojson; do
   cmp -s "given_whole/$l" "given_tiles/$l" || fail "roads.existing: $l differs on tiles"
 done
 same_summary given_whole given_tiles || fail "roads.existing: the run's figures differ on tiles"
-/usr/bin/python3 -c 'import json; r = json.load(open("given_tiles/run.json"))["summary"]["roads"]; assert r["on_existing_km"] > 1 and r["corridor"]["cut_m3"] > 0, r' ||
-  fail "roads.existing on tiles: the new roads do not run on the given ones, or no earthworks"
+/usr/bin/python3 -c 'import json; r = json.load(open("given_tiles/run.json"))["summary"]["roads"]; assert r["on_existing_km"] > 1 and r["corridor"]["cut_m3"] > 0 and r["corridor"]["cleared_ha"] > 0, r' ||
+  fail "roads.existing on tiles: the new roads do not run on the given ones, or no earthworks or clearing"
 
 # The realism figures against the real places (sites.reference) on tiles of 40: the whole grid's.
 reference=(--set sites.reference="$SOURCE/tests/data/geonames_capcorse.geojson" --until sites)
@@ -127,8 +132,6 @@ no_leftovers "$WORK"
 # Refused before any stage, exit 2, no folder: the later stages, and what the tiles do not compute yet.
 expect_refused r3 "/hydro/classify: not computed on tiles yet" "$TP" run "${tiled[@]}" --set input.tile_size=64 --set hydro.classify=true -o r3
 expect_refused r4 "/hydro/flow mfd: not computed on tiles yet" "$TP" run "${tiled[@]}" --set input.tile_size=64 --set hydro.flow=mfd -o r4
-expect_refused r9 "/roads/vegetation: not computed on tiles yet" "$TP" run "${tiled[@]}" --set input.tile_size=64 \
-  --set roads.vegetation="$SAMPLES/spDataLarge_srtm_zion.tif" -o r9
 expect_refused r8 "/roads/corridor/side_angles: not computed on tiles yet" "$TP" run "${tiled[@]}" --set input.tile_size=64 \
   --set roads.corridor.enabled=true --set roads.corridor.side_angles="$SAMPLES/spDataLarge_srtm_zion.tif" -o r8
 gdal_calc.py --quiet -A "$SAMPLES/spDataLarge_srtm_zion.tif" --outfile nodata.tif --calc "A*0+65535" --NoDataValue 65535 --type UInt16

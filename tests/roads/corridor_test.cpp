@@ -381,10 +381,7 @@ TEST(Corridor, ByWindowsAroundEachRoadTheWholeGridsCorridors) {
     std::size_t reads = 0;
     const ReadTerrainWindow read = [&](int c0, int r0, int w, int h) {
       ++reads;
-      Georef g = dem.georef();
-      g.transform[0] += c0 * g.transform[1];
-      g.transform[3] += r0 * g.transform[5];
-      Dem window(w, h, g);
+      Dem window(w, h, dem.georef().window(c0, r0));
       for (int r = 0; r < h; ++r)
         for (int c = 0; c < w; ++c) window(c, r) = dem(c0 + c, r0 + r);
       return TerrainField(window, c0, r0, grid, 0.0, 10.0, 0.0);
