@@ -194,9 +194,7 @@ TEST(Access, ByTilesTheWholeGridsTimesAndIds) {
 
     const int tile = trial == 0 ? 2 : 2 + int(rng() % 36);
     const ReadAccessWindow read = [&](int c0, int r0, int w, int h) {
-      Georef g = dem.georef();
-      g.transform[0] += c0 * g.transform[1];
-      g.transform[3] += r0 * g.transform[5];
+      const Georef g = dem.georef().window(c0, r0);
       AccessWindow out{Raster<float>(w, h, g), Raster<std::uint8_t>(w, h, g), {}};
       for (int r = 0; r < h; ++r)
         for (int c = 0; c < w; ++c) {

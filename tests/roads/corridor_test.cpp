@@ -15,6 +15,7 @@
 #include "roads/windowed_route.hpp"
 #include "roads_fixtures.hpp"
 #include "support/georefs.hpp"
+#include "support/windows.hpp"
 
 using namespace terrapolis;
 using namespace terrapolis::roads;
@@ -381,10 +382,7 @@ TEST(Corridor, ByWindowsAroundEachRoadTheWholeGridsCorridors) {
     std::size_t reads = 0;
     const ReadTerrainWindow read = [&](int c0, int r0, int w, int h) {
       ++reads;
-      Dem window(w, h, dem.georef().window(c0, r0));
-      for (int r = 0; r < h; ++r)
-        for (int c = 0; c < w; ++c) window(c, r) = dem(c0 + c, r0 + r);
-      return TerrainField(window, c0, r0, grid, 0.0, 10.0, 0.0);
+      return TerrainField(terrapolis::test::window_of(dem, c0, r0, w, h), c0, r0, grid, 0.0, 10.0, 0.0);
     };
     const CorridorWindows windows{read, window_margin_cells(0, corridor_reach_m(o), whole.min_cell_m())};
     EXPECT_EQ(expected, corridors_text(corridors(frame, pointers, o, {}, &windows))) << trial;

@@ -11,6 +11,7 @@
 #include "roads/existing_roads.hpp"
 #include "roads/windowed_route.hpp"
 #include "support/georefs.hpp"
+#include "support/windows.hpp"
 
 using namespace terrapolis;
 using namespace terrapolis::roads;
@@ -36,16 +37,7 @@ Dem landscape(std::mt19937_64& rng, int cols, int rows, const Georef& georef, bo
   return dem;
 }
 
-/// The window [col0, col0 + cols) x [row0, row0 + rows) of a DEM, as a copy of its own cells.
-Dem window_of(const Dem& dem, int col0, int row0, int cols, int rows) {
-  Georef g = dem.georef();
-  g.transform[0] += col0 * g.transform[1];
-  g.transform[3] += row0 * g.transform[5];
-  Dem w(cols, rows, g);
-  for (int r = 0; r < rows; ++r)
-    for (int c = 0; c < cols; ++c) w(c, r) = dem(col0 + c, row0 + r);
-  return w;
-}
+using test::window_of;
 
 CostModel test_model(std::mt19937_64& rng) {
   CostModel m = default_cost_model();
