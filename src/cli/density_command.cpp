@@ -184,8 +184,6 @@ class DensityCommand final : public Command {
   /// folder of tiles), one GeoTIFF a tile and a VRT per output, the whole grid's cells.
   void run_tiled(Context& context, const pipeline::Scenario& scenario, density::DensityOptions options,
                  const pipeline::TileSettings& tiles, const fs::path& dir, OutputSet& outputs) {
-    if (!options.factors.empty() || !scenario.resolved["density"]["layers"].empty())
-      throw bad_input("--layer: user layers are rescaled by their range over the grid, not computed on tiles yet");
     if (!plugins_.specs.empty()) throw bad_input("--plugin: plugins are not run on tiles yet");
     if (rivers_used(options))
       throw bad_input("river_near: this command does not find the rivers on tiles (terrapolis run does): give it weight 0, and no boosted model");
@@ -226,7 +224,7 @@ class DensityCommand final : public Command {
         [&](int t, int across, const density::DensityResult& tile) {
           write_rasters(tile, options, terms(scenario), [&](const std::string& n) { return MosaicFiles{dir.string(), n}.tile(t, across); });
         },
-        context.progress, reserved_mb);
+        context.progress, reserved_mb, pipeline::density_file_bytes_per_cell(scenario));
     for (const char* l : layers)
       if (hydrometry || std::string(l) != "hydrometry") MosaicFiles{dir.string(), l}.finish(report.tiles, report.across);
     hydrometry_tiles.reset();

@@ -661,16 +661,25 @@ DensityResult compute_density_window(const Dem& dem, const Raster<float>& hydrom
   return result;
 }
 
-void to_unit_range(Raster<float>& layer) {
-  float lo = std::numeric_limits<float>::infinity(), hi = -lo;
-  for (std::size_t i = 0; i < layer.size(); ++i)
-    if (!std::isnan(layer[i])) lo = std::min(lo, layer[i]), hi = std::max(hi, layer[i]);
+void ValueRange::add(const Raster<float>& values) {
+  for (std::size_t i = 0; i < values.size(); ++i)
+    if (!std::isnan(values[i])) lo = std::min(lo, values[i]), hi = std::max(hi, values[i]);
+}
+
+void to_unit_range(Raster<float>& layer, const ValueRange& range) {
+  const float lo = range.lo, hi = range.hi;
   const bool rescale = lo < 0 || hi > 1;
   for (std::size_t i = 0; i < layer.size(); ++i) {
     float& v = layer[i];
     if (std::isnan(v)) v = 0;
     else if (rescale) v = hi > lo ? (v - lo) / (hi - lo) : 0.0f;
   }
+}
+
+void to_unit_range(Raster<float>& layer) {
+  ValueRange range;
+  range.add(layer);
+  to_unit_range(layer, range);
 }
 
 }  // namespace terrapolis::density

@@ -5,6 +5,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -154,8 +155,18 @@ double combine(const double* weights, const double* values, std::size_t n);
 DensityResult compute_density(const Dem& dem, const Raster<float>& hydrometry, const DensityOptions& options,
                               Progress& progress);
 
-/// A user layer as the model reads it: used as is when its values already lie in [0,1],
-/// otherwise rescaled linearly from its [min, max] over the grid; NaN (no data) reads as 0.
+/// The least and greatest values of a layer over a grid, NaN (no data) left out; added window by
+/// window, a grid read by tiles gets the whole grid's range.
+struct ValueRange {
+  float lo = std::numeric_limits<float>::infinity(), hi = -std::numeric_limits<float>::infinity();
+  void add(const Raster<float>& values);
+};
+
+/// A user layer as the model reads it: used as is when the grid's values already lie in [0,1],
+/// otherwise rescaled linearly from the grid's [min, max] (`range`: the whole grid's when `layer`
+/// is a window of it); NaN (no data) reads as 0.
+void to_unit_range(Raster<float>& layer, const ValueRange& range);
+/// The same, `layer` being the whole grid.
 void to_unit_range(Raster<float>& layer);
 
 

@@ -74,7 +74,8 @@ int density_tile_size_for(int cols, int rows, int halo_rows, int halo_cols, doub
 
 TiledDensityReport run_tiled_density(int cols, int rows, const Georef& georef, const ReadWindowInputs& read,
                                      const DensityOptions& options, int tile_size, double memory_limit_mb, const std::string& scratch_dir,
-                                     const WriteDensityTile& write, Progress& progress, double reserved_mb) {
+                                     const WriteDensityTile& write, Progress& progress, double reserved_mb,
+                                     double input_bytes_per_cell) {
   TiledDensityReport report;
   const CellMetrics metrics = cell_metrics(georef, cols, rows);
   const double r_min = raised_r_min(metrics, options);
@@ -99,7 +100,8 @@ TiledDensityReport run_tiled_density(int cols, int rows, const Georef& georef, c
   };
   std::array<int, 2> widest = {outer.reach_rows() + inner.reach_rows(), outer.reach_cols() + inner.reach_cols()};
   if (terms) widest = {std::max(widest[0], positions[1].reach_rows()), std::max(widest[1], positions[1].reach_cols())};
-  const double cell_bytes = kDensityBytesPerCell + (terms ? kTerrainBytesPerCell : 0) + (options.model ? kBoostedBytesPerCell : 0);
+  const double cell_bytes =
+      kDensityBytesPerCell + (terms ? kTerrainBytesPerCell : 0) + (options.model ? kBoostedBytesPerCell : 0) + input_bytes_per_cell;
   report.tile_size = tile_size > 0 ? std::max(tile_size, 8)
                                    : density_tile_size_for(cols, rows, widest[0], widest[1], report.global_bytes, memory_limit_mb, reserved_mb, cell_bytes);
   const TileGrid grid(cols, rows, report.tile_size);

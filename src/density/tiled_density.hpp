@@ -101,8 +101,11 @@ int density_tile_size_for(int cols, int rows, int halo_rows, int halo_cols, doub
 /// computations. `options` carries no raster (read gives each window's). With the terrain terms,
 /// the first pass reads bands of full rows instead, for the altitude range and the distances to
 /// water and rivers (DistanceStrips, in `scratch_dir`), and the second pass counts the land ranks.
+/// `input_bytes_per_cell`: what `read` holds a window's cell more than the DEM and the water (user
+/// layers, exclusions), counted in the tile size.
 TiledDensityReport run_tiled_density(int cols, int rows, const Georef& georef, const ReadWindowInputs& read,
                                      const DensityOptions& options, int tile_size, double memory_limit_mb, const std::string& scratch_dir,
-                                     const WriteDensityTile& write, Progress& progress, double reserved_mb = 0);
+                                     const WriteDensityTile& write, Progress& progress, double reserved_mb = 0,
+                                     double input_bytes_per_cell = 0);
 
 }  // namespace terrapolis::density

@@ -57,28 +57,23 @@ std::vector<std::size_t> line_cells(const Georef& georef, int cols, int rows, co
   return out;
 }
 
-Lake flood(const Dem& dem, const CellMetrics& metrics, int seed_col, int seed_row, double level_m, const Dam* dam, Progress& progress) {
-  if (!std::isfinite(level_m)) throw bad_input("/level_m: must be a finite elevation in metres");
-  if (!dem.inside(seed_col, seed_row)) throw bad_input("/at: the point lies outside the DEM");
-  const int cols = dem.cols(), rows = dem.rows();
-  Lake lake;
-  lake.level_m = level_m;
-  lake.seed_col = seed_col;
-  lake.seed_row = seed_row;
+namespace {
+
+/// Which sides of a raster (west, north, east, south) are the grid's edges, where the water spills.
+using GridSides = std::array<bool, 4>;
+constexpr GridSides kWholeGrid = {true, true, true, true};
+
+/// Peytavie's propagation from `seed` on `dem` (the whole grid or a window of it), `is_dam` (empty:
+/// no dam) marking the cells raised to `crest_m`. Returns false as soon as the water reaches a side
+/// of `dem` that is not the grid's (the window is too small: `lake` is then incomplete).
+bool spread(const Dem& dem, const CellMetrics& metrics, std::size_t seed, double level_m, const std::vector<std::uint8_t>& is_dam, double crest_m,
+            const GridSides& grid_sides, Lake& lake, Progress& progress) {
+  const int cols = dem.cols();
   lake.mask = dem.like<std::uint8_t>(0);
   lake.mask.nodata = 255;
   for (std::size_t i = 0; i < dem.size(); ++i)
     if (dem.is_nodata(i)) lake.mask[i] = 255;
-  // The dam raises its cells to the crest (never lowers them).
-  std::vector<std::uint8_t> is_dam;
-  if (dam) {
-    if (!std::isfinite(dam->crest_m)) throw bad_input("/crest_m: must be a finite elevation in metres");
-    is_dam.assign(dem.size(), 0);
-    for (std::size_t i : line_cells(dem.georef(), cols, rows, dam->line)) is_dam[i] = 1, ++lake.dam_cells;
-    if (lake.dam_cells == 0) throw bad_input("/dam: the line does not cross the DEM");
-  }
-  auto ground = [&](std::size_t i) { return is_dam.empty() || !is_dam[i] ? double(dem[i]) : std::max(double(dem[i]), dam->crest_m); };
-  const std::size_t seed = dem.index(seed_col, seed_row);
+  auto ground = [&](std::size_t i) { return is_dam.empty() || !is_dam[i] ? double(dem[i]) : std::max(double(dem[i]), crest_m); };
   if (dem.is_nodata(seed)) throw bad_input("/at: the point lies on the DEM's nodata");
   if (!(ground(seed) < level_m)) {
     char msg[160];
@@ -102,6 +97,9 @@ Lake flood(const Dem& dem, const CellMetrics& metrics, int seed_col, int seed_ro
     for (int k = 0; k < 8; ++k) {
       const int nc = c + dcol[k], nr = r + drow[k];
       if (!dem.inside(nc, nr)) {
+        const bool off_grid = (nc < 0 && grid_sides[0]) || (nr < 0 && grid_sides[1]) || (nc >= cols && grid_sides[2]) ||
+                              (nr >= dem.rows() && grid_sides[3]);
+        if (!off_grid) return false;  // a cell of the grid past the window
         lake.spills = true;
         continue;
       }
@@ -113,6 +111,65 @@ Lake flood(const Dem& dem, const CellMetrics& metrics, int seed_col, int seed_ro
     }
     if ((lake.cells & 0xfffff) == 0) step.update(std::min(0.99, double(lake.cells) / double(dem.size())));
   }
+  return true;
+}
+
+/// A spec placed on a grid: its seed cell, its dam in the grid's CRS (empty: none) and its level
+/// (NaN when it is a depth above the seed's ground, which the caller reads).
+struct Placed {
+  int col = 0, row = 0;
+  Dam dam;
+  double level_m = NAN;
+};
+
+Placed place(const Georef& georef, int cols, int rows, const LakeSpec& spec) {
+  check_spec(spec);
+  const GridLocator locator(georef);
+  auto to_crs = [&](double lon, double lat, const char* pointer) {
+    const auto xy = locator.lonlat_to_crs(lon, lat);
+    if (!std::isfinite(xy[0]) || !std::isfinite(xy[1])) throw bad_input(std::string(pointer) + ": cannot be transformed to the DEM's CRS");
+    return xy;
+  };
+  const auto seed_xy = to_crs(spec.lon, spec.lat, "/at");
+  const auto p = to_pixel(georef.transform, seed_xy[0], seed_xy[1]);
+  Placed out;
+  out.col = int(std::floor(p[0])), out.row = int(std::floor(p[1]));
+  if (out.col < 0 || out.row < 0 || out.col >= cols || out.row >= rows) throw bad_input("/at: the point lies outside the DEM");
+  if (!spec.dam_lonlat.empty()) {
+    for (const auto& q : spec.dam_lonlat) out.dam.line.push_back(to_crs(q[0], q[1], "/dam"));
+    out.dam.crest_m = *spec.crest_m;
+    out.level_m = out.dam.crest_m;
+  }
+  if (spec.level_m) out.level_m = *spec.level_m;
+  else if (spec.depth_m) out.level_m = NAN;
+  return out;
+}
+
+/// The level of `spec` placed as `p`, `seed_ground` the DEM at its seed (NaN: nodata).
+double level_of(const LakeSpec& spec, const Placed& p, double seed_ground) {
+  if (!spec.depth_m) return p.level_m;
+  if (std::isnan(seed_ground)) throw bad_input("/at: the point lies on the DEM's nodata");
+  return seed_ground + *spec.depth_m;
+}
+
+}  // namespace
+
+Lake flood(const Dem& dem, const CellMetrics& metrics, int seed_col, int seed_row, double level_m, const Dam* dam, Progress& progress) {
+  if (!std::isfinite(level_m)) throw bad_input("/level_m: must be a finite elevation in metres");
+  if (!dem.inside(seed_col, seed_row)) throw bad_input("/at: the point lies outside the DEM");
+  Lake lake;
+  lake.level_m = level_m;
+  lake.seed_col = seed_col;
+  lake.seed_row = seed_row;
+  // The dam raises its cells to the crest (never lowers them).
+  std::vector<std::uint8_t> is_dam;
+  if (dam) {
+    if (!std::isfinite(dam->crest_m)) throw bad_input("/crest_m: must be a finite elevation in metres");
+    is_dam.assign(dem.size(), 0);
+    for (std::size_t i : line_cells(dem.georef(), dem.cols(), dem.rows(), dam->line)) is_dam[i] = 1, ++lake.dam_cells;
+    if (lake.dam_cells == 0) throw bad_input("/dam: the line does not cross the DEM");
+  }
+  spread(dem, metrics, dem.index(seed_col, seed_row), level_m, is_dam, dam ? dam->crest_m : 0.0, kWholeGrid, lake, progress);
   return lake;
 }
 
@@ -135,28 +192,51 @@ void check_spec(const LakeSpec& spec) {
 }
 
 Lake flood(const Dem& dem, const CellMetrics& metrics, const LakeSpec& spec, Progress& progress) {
-  check_spec(spec);
-  const GridLocator locator(dem.georef());
-  auto to_cell = [&](double lon, double lat, const char* pointer) {
-    const auto xy = locator.lonlat_to_crs(lon, lat);
-    if (!std::isfinite(xy[0]) || !std::isfinite(xy[1])) throw bad_input(std::string(pointer) + ": cannot be transformed to the DEM's CRS");
-    return xy;
-  };
-  const auto seed_xy = to_cell(spec.lon, spec.lat, "/at");
-  const auto p = to_pixel(dem.georef().transform, seed_xy[0], seed_xy[1]);
-  const int col = int(std::floor(p[0])), row = int(std::floor(p[1]));
-  if (!dem.inside(col, row)) throw bad_input("/at: the point lies outside the DEM");
-  Dam dam;
-  const bool with_dam = !spec.dam_lonlat.empty();
-  if (with_dam) {
-    for (const auto& q : spec.dam_lonlat) dam.line.push_back(to_cell(q[0], q[1], "/dam"));
-    dam.crest_m = *spec.crest_m;
+  const Placed p = place(dem.georef(), dem.cols(), dem.rows(), spec);
+  const std::size_t seed = dem.index(p.col, p.row);
+  const double level = level_of(spec, p, dem.is_nodata(seed) ? NAN : double(dem[seed]));
+  return flood(dem, metrics, p.col, p.row, level, p.dam.line.empty() ? nullptr : &p.dam, progress);
+}
+
+WindowLake flood_by_windows(const Georef& grid, int cols, int rows, const ReadWindow& read, const LakeSpec& spec, std::size_t max_cells,
+                            Progress& progress) {
+  const Placed p = place(grid, cols, rows, spec);
+  std::vector<std::size_t> dam_cells;  // on the grid, so that every window raises the grid's cells
+  if (!p.dam.line.empty()) {
+    dam_cells = line_cells(grid, cols, rows, p.dam.line);
+    if (dam_cells.empty()) throw bad_input("/dam: the line does not cross the DEM");
   }
-  double level = dam.crest_m;
-  if (spec.level_m) level = *spec.level_m;
-  else if (spec.depth_m) level = double(dem(col, row)) + *spec.depth_m;  // NaN on nodata: refused below
-  if (spec.depth_m && dem.is_nodata(dem.index(col, row))) throw bad_input("/at: the point lies on the DEM's nodata");
-  return flood(dem, metrics, col, row, level, with_dam ? &dam : nullptr, progress);
+  const CellMetrics metrics = cell_metrics(grid, cols, rows);
+  double level = NAN;
+  // A square around the seed, grown twice as wide each time the water reaches its side, until the
+  // lake and the cells around it lie inside (the propagation then visits the whole grid's cells in
+  // the whole grid's order: the same figures, bit for bit).
+  const auto too_large = [&] {
+    return bad_input("/at: the water spreads over more cells than the memory limit holds (" + std::to_string(max_cells) +
+                     " cells a window); give more memory or a lower level");
+  };
+  for (long half = 128;; half *= 2) {
+    const int c0 = int(std::max<long>(0, p.col - half)), r0 = int(std::max<long>(0, p.row - half));
+    const int c1 = int(std::min<long>(cols, p.col + half + 1)), r1 = int(std::min<long>(rows, p.row + half + 1));
+    if (std::size_t(c1 - c0) * std::size_t(r1 - r0) > max_cells) throw too_large();
+    const Dem dem = read(c0, r0, c1 - c0, r1 - r0);
+    const std::size_t seed = dem.index(p.col - c0, p.row - r0);
+    if (std::isnan(level)) {
+      level = level_of(spec, p, dem.is_nodata(seed) ? NAN : double(dem[seed]));
+      if (!std::isfinite(level)) throw bad_input("/level_m: must be a finite elevation in metres");
+    }
+    std::vector<std::uint8_t> is_dam;
+    if (!dam_cells.empty()) {
+      is_dam.assign(dem.size(), 0);
+      for (std::size_t i : dam_cells)
+        if (const int c = int(i % std::size_t(cols)) - c0, r = int(i / std::size_t(cols)) - r0; dem.inside(c, r)) is_dam[dem.index(c, r)] = 1;
+    }
+    WindowLake out{Lake{}, c0, r0};
+    Lake& lake = out.lake;
+    lake.level_m = level, lake.seed_col = p.col, lake.seed_row = p.row, lake.dam_cells = dam_cells.size();
+    const GridSides sides = {c0 == 0, r0 == 0, c1 == cols, r1 == rows};
+    if (spread(dem, metric_rows(metrics, r0, r1 - r0), seed, level, is_dam, p.dam.crest_m, sides, lake, progress)) return out;
+  }
 }
 
 VectorLayer shoreline_layer(const Lake& lake) {

@@ -3,6 +3,7 @@
 #pragma once
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -60,6 +61,22 @@ void check_spec(const LakeSpec& spec);
 
 /// Floods `dem` as `spec` says (check_spec first). Throws bad_input naming the field at fault as check_spec does.
 Lake flood(const Dem& dem, const CellMetrics& metrics, const LakeSpec& spec, Progress& progress);
+
+/// A lake flooded on a window of a grid read by windows: its rasters cover the window whose first
+/// cell is (`col0`, `row0`) in the grid; its seed is in the grid's cells.
+struct WindowLake {
+  Lake lake;
+  int col0 = 0, row0 = 0;
+};
+/// A window [col0, col0 + cols) x [row0, row0 + rows) of the grid's DEM, on the grid's cells.
+using ReadWindow = std::function<Dem(int col0, int row0, int cols, int rows)>;
+/// flood(spec) on a grid (`grid`, `cols` x `rows`) larger than memory, read by windows: a square
+/// around the seed, twice as wide each time the water reaches its side, until the lake and its
+/// neighbouring cells lie inside (or the grid's edge). The cells, the figures and `spills` are the
+/// whole grid's flood's, bit for bit. Throws bad_input as flood does, and when the water needs a
+/// window of more than `max_cells` cells.
+WindowLake flood_by_windows(const Georef& grid, int cols, int rows, const ReadWindow& read, const LakeSpec& spec, std::size_t max_cells,
+                            Progress& progress);
 
 /// The shoreline: polygons of the flooded cells with `level_m`, `area_km2`, `volume_m3` (of the whole lake).
 VectorLayer shoreline_layer(const Lake& lake);

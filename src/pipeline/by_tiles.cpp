@@ -11,21 +11,66 @@
 #include "hydro/tiled/tiled_hydro.hpp"
 #include "io/mask_io.hpp"
 #include "pipeline/density_folder.hpp"
+#include "pipeline/inland_water.hpp"
 #include "pipeline/stage_options.hpp"
 
 namespace terrapolis::pipeline {
 
-hydro::tiled::TiledFlatWaterReport inland_water_by_tiles(const DemWindowReader& dem, const InlandWaterSettings& water, const TileSettings& tiles,
-                                                         double reserved_mb, const WriteTile<std::uint8_t>& write, Progress& progress) {
-  if (!water.reservoirs.empty()) throw bad_input("/water/reservoirs: not flooded on tiles yet");
+WindowReservoirs::WindowReservoirs(const DemWindowReader& dem, const InlandWaterSettings& water, double budget_mb, Progress& progress,
+                                   const Log& log) {
   const RasterHeader& h = dem.header();
+  const std::size_t max_cells = std::size_t(std::max(0.0, budget_mb) * 1e6 / kFloodBytesPerCell);
+  for (std::size_t k = 0; k < water.reservoirs.size(); ++k) {
+    const std::string pointer = "/water/reservoirs/" + std::to_string(k);
+    lake::WindowLake w;
+    try {
+      w = lake::flood_by_windows(
+          h.georef, h.cols, h.rows, [&](int c0, int r0, int cols, int rows) { return dem.read(c0, r0, cols, rows); }, water.reservoirs[k],
+          max_cells, progress);
+    } catch (const Error& e) {
+      throw bad_input(pointer + e.what());
+    }
+    figures_.push_back(reservoir_figures(w.lake, pointer, log));
+    const Raster<std::uint8_t>& m = w.lake.mask;
+    int x0 = m.cols(), y0 = m.rows(), x1 = -1, y1 = -1;  // the flooded cells' bounding box
+    for (int y = 0; y < m.rows(); ++y)
+      for (int x = 0; x < m.cols(); ++x)
+        if (m(x, y) == 1) x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+    Water& kept = water_.emplace_back();
+    kept.col0 = w.col0 + x0, kept.row0 = w.row0 + y0;
+    kept.mask = hydro::tiled::crop(m, x0, y0, x1 - x0 + 1, y1 - y0 + 1);
+  }
+}
+
+void WindowReservoirs::add_to(Raster<std::uint8_t>& tile, int col0, int row0) const {
+  for (const Water& w : water_)
+    for (int y = std::max(0, w.row0 - row0); y < std::min(tile.rows(), w.row0 + w.mask.rows() - row0); ++y)
+      for (int x = std::max(0, w.col0 - col0); x < std::min(tile.cols(), w.col0 + w.mask.cols() - col0); ++x)
+        if (w.mask(x + col0 - w.col0, y + row0 - w.row0) == 1) tile(x, y) = 1;
+}
+
+double WindowReservoirs::held_mb() const {
+  double bytes = 0;
+  for (const Water& w : water_) bytes += double(w.mask.size());
+  return bytes / 1e6;
+}
+
+hydro::tiled::TiledFlatWaterReport inland_water_by_tiles(const DemWindowReader& dem, const InlandWaterSettings& water, const TileSettings& tiles,
+                                                         const WindowReservoirs& reservoirs, double reserved_mb,
+                                                         const WriteTile<std::uint8_t>& write, Progress& progress) {
+  const RasterHeader& h = dem.header();
+  reserved_mb += reservoirs.held_mb();
   const int side = tiles.tile_size > 0 ? tiles.tile_size : hydro::tiled::flat_water_tile_size_for(h.cols, h.rows, tiles.limit_mb(), reserved_mb);
+  const hydro::tiled::TileGrid grid(h.cols, h.rows, side);
   return hydro::tiled::run_tiled_flat_water(
       h.cols, h.rows, h.georef, [&](int c0, int r0, int cols, int rows) { return dem.read(c0, r0, cols, rows); }, water.flat_water, side,
       [&](int t, int across, const Raster<std::uint8_t>& lakes) {
-        if (water.water_mask.empty()) return write(t, across, lakes);
-        Raster<std::uint8_t> mask = read_mask(water.water_mask, lakes.georef(), lakes.cols(), lakes.rows());
+        if (water.water_mask.empty() && water.reservoirs.empty()) return write(t, across, lakes);
+        Raster<std::uint8_t> mask = water.water_mask.empty() ? lakes.like<std::uint8_t>(0)
+                                                             : read_mask(water.water_mask, lakes.georef(), lakes.cols(), lakes.rows());
         for (std::size_t i = 0; i < mask.size(); ++i) mask[i] = mask[i] || lakes[i];  // as inland_water: 1 water, 0 not
+        const hydro::tiled::TileRect r = grid.rect(t);
+        reservoirs.add_to(mask, r.col0, r.row0);
         write(t, across, mask);
       },
       progress);
@@ -42,8 +87,10 @@ std::string inland_water_mosaic(const DemWindowReader& dem, const InlandWaterSet
                                 const std::string& dir, Progress& progress, const Log& log) {
   const MosaicFiles mosaic{dir, "inland_water"};
   mosaic.create();
+  const double reserved_mb = reserve_reader_memory(tiles.limit_mb());
+  const WindowReservoirs reservoirs(dem, water, tiles.limit_mb() - reserved_mb, progress, log);
   const hydro::tiled::TiledFlatWaterReport report = inland_water_by_tiles(
-      dem, water, tiles, reserve_reader_memory(tiles.limit_mb()),
+      dem, water, tiles, reservoirs, reserved_mb,
       [&](int t, int across, const Raster<std::uint8_t>& tile) { write_raster(mosaic.tile(t, across), tile, WriteOptions{}); }, progress);
   mosaic.finish(report.tiles, report.across);
   log.detail(describe(report));
@@ -70,12 +117,20 @@ std::string describe(const hydro::tiled::TiledBelhadjReport& b) {
   return line;
 }
 
+double density_file_bytes_per_cell(const Scenario& scenario) {
+  const auto& d = scenario.resolved["density"];
+  return 8.0 * double(d["layers"].size()) + 2.0 * double(d["exclusions"].size());
+}
+
 density::ReadWindowInputs density_windows(const DemWindowReader& dem, const Scenario& scenario, const density::DensityOptions& options,
                                           const std::string& inland_water, const ReadHydrometry& hydrometry,
                                           const std::string& accumulation_km2) {
   std::shared_ptr<const DemWindowReader> accumulation;
   if (!accumulation_km2.empty() && density::needs_terrain_terms(options)) accumulation = std::make_shared<const DemWindowReader>(accumulation_km2);
-  return [&dem, &scenario, &options, inland_water, hydrometry, accumulation](int c0, int r0, int cols, int rows, bool dem_only) {
+  const RasterHeader& h = dem.header();
+  std::vector<LayerOnGrid> layers = layers_on_grid(scenario, h.georef, h.cols, h.rows, kLayerBandCells);
+  return [&dem, &scenario, &options, inland_water, hydrometry, accumulation, layers = std::move(layers)](int c0, int r0, int cols, int rows,
+                                                                                                         bool dem_only) {
     density::WindowInputs in;
     in.dem = dem.read(c0, r0, cols, rows);
     in.options = options;
@@ -85,7 +140,7 @@ density::ReadWindowInputs density_windows(const DemWindowReader& dem, const Scen
       if (accumulation) in.options.rivers = river_cells(accumulation->read(c0, r0, cols, rows), scenario);  // for the distances' bands
       return in;
     }
-    read_density_files(scenario, grid, cols, rows, "", in.options);
+    read_density_files(scenario, grid, cols, rows, layers, "", in.options);
     in.hydrometry = hydrometry ? hydrometry(in.dem, c0, r0) : in.dem.like<float>(0.0f);
     return in;
   };

@@ -24,10 +24,38 @@ namespace terrapolis::pipeline {
 template <class T>
 using WriteTile = std::function<void(int tile, int across, const Raster<T>& raster)>;
 
-/// pipeline::inland_water by tiles: the lakes the DEM flattens (hydro::tiled::run_tiled_flat_water)
-/// and water.water_mask, 1 water, 0 not. Reservoirs are refused (bad_input).
+/// The reservoirs (water.reservoirs) of a grid read by windows: each flooded on a window around its
+/// seed (lake::flood_by_windows), the whole grid's cells and figures; its water kept as a mask over
+/// the lake's bounding box.
+class WindowReservoirs {
+ public:
+  /// Floods each reservoir of `water` on windows of `dem` of at most `budget_mb` while it is flooded.
+  WindowReservoirs(const DemWindowReader& dem, const InlandWaterSettings& water, double budget_mb, Progress& progress, const Log& log);
+  /// Marks the reservoirs' water (1) in `tile`, whose first cell is (`col0`, `row0`) in the grid.
+  void add_to(Raster<std::uint8_t>& tile, int col0, int row0) const;
+  /// What the masks hold, MB.
+  double held_mb() const;
+  /// Per reservoir, as pipeline::inland_water's (reservoir_figures).
+  const nlohmann::ordered_json& figures() const { return figures_; }
+
+ private:
+  struct Water {
+    int col0 = 0, row0 = 0;
+    Raster<std::uint8_t> mask;  ///< 1 flooded, over the lake's bounding box
+  };
+  std::vector<Water> water_;
+  nlohmann::ordered_json figures_ = nlohmann::ordered_json::array();
+};
+
+/// Bytes a cell of a window while a reservoir is flooded on it: the DEM (4, and GDAL's copy, 4), the
+/// mask (1), the depths (4), the dam's cells (1) and the propagation's front (8 at most).
+inline constexpr double kFloodBytesPerCell = 22;
+
+/// pipeline::inland_water by tiles: the lakes the DEM flattens (hydro::tiled::run_tiled_flat_water),
+/// water.water_mask and `reservoirs` (flooded by windows first), 1 water, 0 not.
 hydro::tiled::TiledFlatWaterReport inland_water_by_tiles(const DemWindowReader& dem, const InlandWaterSettings& water, const TileSettings& tiles,
-                                       double reserved_mb, const WriteTile<std::uint8_t>& write, Progress& progress);
+                                                         const WindowReservoirs& reservoirs, double reserved_mb,
+                                                         const WriteTile<std::uint8_t>& write, Progress& progress);
 /// The log line of inland_water_by_tiles.
 std::string describe(const hydro::tiled::TiledFlatWaterReport& report);
 /// inland_water_by_tiles written into `dir` (a scratch or staging folder) as inland_water.vrt over
@@ -47,8 +75,14 @@ std::string describe(const hydro::tiled::TiledBelhadjReport& report);
 using ReadHydrometry = std::function<Raster<float>(const Dem& window, int c0, int r0)>;
 /// The density model's inputs by windows (density::run_tiled_density): the DEM, the inland water
 /// (the VRT of inland_water_by_tiles), the scenario's exclusions, `hydrometry`'s (empty: zeros)
-/// and, when the terrain terms are computed, the rivers of `accumulation_km2` (empty: none).
+/// and, when the terrain terms are computed, the rivers of `accumulation_km2` (empty: none). The
+/// user layers are read once over the grid first (layers_on_grid), so a window's are the grid's.
 /// Holds references to `dem`, `scenario` and `options`.
+/// The user layers' range over the grid is read by bands of rows of this many cells (16 MB while read).
+inline constexpr std::size_t kLayerBandCells = std::size_t(1) << 21;
+/// Bytes a cell of a density window more for the scenario's user layers (a float held, GDAL's
+/// warped copy) and exclusions (a byte, its copy), for run_tiled_density's tile size.
+double density_file_bytes_per_cell(const Scenario& scenario);
 density::ReadWindowInputs density_windows(const DemWindowReader& dem, const Scenario& scenario, const density::DensityOptions& options,
                                           const std::string& inland_water, const ReadHydrometry& hydrometry,
                                           const std::string& accumulation_km2 = "");

@@ -36,12 +36,16 @@ InlandWater inland_water(const Dem& dem, const InlandWaterSettings& settings, Pr
     }
     for (std::size_t i = 0; i < l.mask.size(); ++i)
       if (l.mask[i] == 1) water[i] = 1;
-    if (l.spills) log.warn(pointer + ": the water reaches the DEM's edge or nodata");
-    const auto round_to = [](double v, double step) { return std::round(v / step) * step; };
-    out.reservoirs.push_back({{"level_m", round_to(l.level_m, 0.01)}, {"area_km2", round_to(l.area_km2, 1e-4)},
-                              {"volume_m3", std::round(l.volume_m3)}, {"max_depth_m", round_to(l.max_depth_m, 0.01)}});
+    out.reservoirs.push_back(reservoir_figures(l, pointer, log));
   }
   return out;
+}
+
+nlohmann::ordered_json reservoir_figures(const lake::Lake& l, const std::string& pointer, const Log& log) {
+  if (l.spills) log.warn(pointer + ": the water reaches the DEM's edge or nodata");
+  const auto round_to = [](double v, double step) { return std::round(v / step) * step; };
+  return {{"level_m", round_to(l.level_m, 0.01)}, {"area_km2", round_to(l.area_km2, 1e-4)}, {"volume_m3", std::round(l.volume_m3)},
+          {"max_depth_m", round_to(l.max_depth_m, 0.01)}};
 }
 
 Raster<std::uint8_t> saved_water_mask(const Raster<float>& saved) {

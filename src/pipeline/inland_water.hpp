@@ -28,6 +28,10 @@ struct InlandWater {
 /// roads (bridged or avoided) and the access (impassable) read alike.
 InlandWater inland_water(const Dem& dem, const InlandWaterSettings& settings, Progress& progress, const Log& log);
 
+/// A reservoir's figures in the run's summary (hydro.reservoirs: level_m, area_km2, volume_m3,
+/// max_depth_m); warns, naming `pointer`, when its water reaches the DEM's edge or nodata.
+nlohmann::ordered_json reservoir_figures(const lake::Lake& lake, const std::string& pointer, const Log& log);
+
 /// The water cells of a saved inland water raster read back as floats (inland_water.tif or .vrt):
 /// 1 where it holds 1, else 0.
 Raster<std::uint8_t> saved_water_mask(const Raster<float>& saved);

@@ -151,7 +151,7 @@ RealismGrid by_tiles(RunState& s, density::DensityOptions options, const std::st
           if (const auto& p = g.places[k]; tile.density.inside(p.col - c0, p.row - r0))
             at[k] = density::scores_at(tile.density, tile, tile.density.index(p.col - c0, p.row - r0));
       },
-      progress, in.reserved_mb);
+      progress, in.reserved_mb, density_file_bytes_per_cell(s.scenario));
   std::vector<double> populations;
   for (const auto& p : g.places) populations.push_back(p.population);
   g.skill = counter.skill(at, populations);

@@ -132,24 +132,50 @@ density::DensityOptions density_options(const Scenario& scenario) {
   return o;
 }
 
-void read_density_files(const Scenario& scenario, const Dem& dem, const std::string& water_mask, density::DensityOptions& o) {
-  read_density_files(scenario, dem.georef(), dem.cols(), dem.rows(), water_mask, o);
-}
-
-void read_density_files(const Scenario& scenario, const Georef& grid, int cols, int rows, const std::string& water_mask,
-                        density::DensityOptions& o) {
+namespace {
+/// read_density_files on `grid`, the whole grid (`whole` null) or a window of the grid `whole` describes.
+void read_density_files(const Scenario& scenario, const Georef& grid, int cols, int rows, const std::vector<LayerOnGrid>* whole,
+                        const std::string& water_mask, density::DensityOptions& o) {
   const json& d = scenario.resolved["density"];
   std::vector<density::DensityOptions::Factor> layers;
-  for (const auto& layer : d["layers"]) {
+  for (std::size_t k = 0; k < d["layers"].size(); ++k) {
+    const json& layer = d["layers"][k];
     const std::string file = scenario.file(layer["file"].get<std::string>());
-    Raster<float> values = read_resampled(file, grid, cols, rows, Resampling::bilinear);
-    density::to_unit_range(values);
+    const WarpScale scale = whole ? (*whole)[k].scale : warp_scale(file, grid, cols, rows);
+    Raster<float> values = read_resampled(file, grid, cols, rows, Resampling::bilinear, 1, &scale);
+    if (whole) density::to_unit_range(values, (*whole)[k].range);
+    else density::to_unit_range(values);
     layers.push_back({std::filesystem::path(file).filename().string(), std::move(values), layer["weight"].get<double>()});
   }
   o.factors.insert(o.factors.begin(), std::make_move_iterator(layers.begin()), std::make_move_iterator(layers.end()));
   for (const auto& file : d["exclusions"])
     o.exclusion_masks.push_back(read_mask(scenario.file(file.get<std::string>()), grid, cols, rows));
   if (!water_mask.empty()) o.water_mask = read_mask(water_mask, grid, cols, rows);
+}
+}  // namespace
+
+void read_density_files(const Scenario& scenario, const Dem& dem, const std::string& water_mask, density::DensityOptions& o) {
+  read_density_files(scenario, dem.georef(), dem.cols(), dem.rows(), nullptr, water_mask, o);
+}
+
+void read_density_files(const Scenario& scenario, const Georef& window, int cols, int rows, const std::vector<LayerOnGrid>& layers,
+                        const std::string& water_mask, density::DensityOptions& o) {
+  read_density_files(scenario, window, cols, rows, &layers, water_mask, o);
+}
+
+std::vector<LayerOnGrid> layers_on_grid(const Scenario& scenario, const Georef& grid, int cols, int rows, std::size_t band_cells) {
+  std::vector<LayerOnGrid> out;
+  const int band = int(std::clamp(double(band_cells) / cols, 1.0, double(rows)));
+  for (const auto& layer : scenario.resolved["density"]["layers"]) {
+    const std::string file = scenario.file(layer["file"].get<std::string>());
+    LayerOnGrid& l = out.emplace_back();
+    l.scale = warp_scale(file, grid, cols, rows);
+    for (int r = 0; r < rows; r += band) {
+      const int n = std::min(band, rows - r);
+      l.range.add(read_resampled(file, grid.window(0, r), cols, n, Resampling::bilinear, 1, &l.scale));
+    }
+  }
+  return out;
 }
 
 std::vector<std::string> density_files(const Scenario& scenario) {

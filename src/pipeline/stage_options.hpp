@@ -10,6 +10,7 @@
 #include "erode/erosion.hpp"
 #include "hydro/hydro.hpp"
 #include "hydro/river_types.hpp"
+#include "io/raster_io.hpp"
 #include "lake/lake.hpp"
 #include "network/network.hpp"
 #include "pipeline/scenario.hpp"
@@ -60,10 +61,18 @@ density::DensityOptions density_options(const Scenario& scenario);
 /// plugin's), density.exclusions as masks, and `water_mask` (a command: water.water_mask; a run:
 /// its inland_water.tif, which holds it) as the water mask, when not empty.
 void read_density_files(const Scenario& scenario, const Dem& dem, const std::string& water_mask, density::DensityOptions& options);
-/// The same onto a window of the DEM's grid (density by tiles: the layers, rescaled by their
-/// range on the grid read, are refused there).
-void read_density_files(const Scenario& scenario, const Georef& grid, int cols, int rows, const std::string& water_mask,
-                        density::DensityOptions& options);
+/// How the whole grid reads one of density.layers: warped with one kernel scale and rescaled by its
+/// range over the grid, so that a window of the grid reads the whole grid's values.
+struct LayerOnGrid {
+  WarpScale scale;
+  density::ValueRange range;
+};
+/// density.layers over the grid `cols` x `rows` of `grid`, in their order, each read by bands of
+/// rows of at most `band_cells` cells (8 bytes a cell while read).
+std::vector<LayerOnGrid> layers_on_grid(const Scenario& scenario, const Georef& grid, int cols, int rows, std::size_t band_cells);
+/// The same onto a window of the grid (density by tiles), `layers` being layers_on_grid's.
+void read_density_files(const Scenario& scenario, const Georef& window, int cols, int rows, const std::vector<LayerOnGrid>& layers,
+                        const std::string& water_mask, density::DensityOptions& options);
 /// The files read_density_files reads (the water mask, the layers, the exclusions), as paths.
 std::vector<std::string> density_files(const Scenario& scenario);
 /// The sites section, with the scenario's seed.

@@ -232,11 +232,13 @@ void hydro_run_tiles(RunState& s, Progress& progress, const Log& log) {
   log.detail("hydro tiles: " + std::to_string(report.tiles) + " of " + std::to_string(report.tile_size) + " cells a side; " + describe(b));
   const MosaicFiles water = s.mosaic(std::filesystem::path(kInlandWater).stem().string());
   water.create();
+  const WindowReservoirs reservoirs(reader, s.settings.water, in.tiles.limit_mb() - in.reserved_mb, progress, log);
   const hydro::tiled::TiledFlatWaterReport w = inland_water_by_tiles(
-      reader, s.settings.water, in.tiles, in.reserved_mb,
+      reader, s.settings.water, in.tiles, reservoirs, in.reserved_mb,
       [&](int t, int n, const Raster<std::uint8_t>& tile) { s.write_tile("hydro", water, t, n, tile); }, progress);
   s.write_mosaic("hydro", water, w.tiles, w.across, Style::water);
   inland_water_figures(s, w.lakes, w.area_km2);
+  if (!reservoirs.figures().empty()) s.summary["hydro"]["reservoirs"] = reservoirs.figures();
   log.detail(describe(w));
 }
 
@@ -279,7 +281,6 @@ void hydro_prepare(const Scenario& scenario, const RasterHeader&, Settings& s) {
   if (s.hydro.flow != hydro::FlowMethod::d8) refuse("/hydro/flow " + h["flow"].get<std::string>());
   if (s.hydro.hydrometry.method != hydro::HydrometryMethod::belhadj) refuse("/hydro/hydrometry " + h["hydrometry"].get<std::string>());
   if (s.river_types) refuse("/hydro/classify");
-  if (!s.water.reservoirs.empty()) refuse("/water/reservoirs");
 }
 
 void hydro_summary(const json& figures, SummaryText& out) {
@@ -335,7 +336,7 @@ void density_run_tiles(RunState& s, Progress& progress, const Log& log) {
         s.write_tile("density", s.mosaic("buildable"), t, across, d.buildable);
         s.write_tile("density", s.mosaic("density"), t, across, d.density);
       },
-      progress, in.reserved_mb);
+      progress, in.reserved_mb, density_file_bytes_per_cell(s.scenario));
   for (const auto& [name, style] : kDensityRasters) s.write_mosaic("density", s.mosaic(name), report.tiles, report.across, style);
   s.summary["density"] = density_figures(s, report.stats);
   log.detail("density tiles: " + std::to_string(report.tiles) + " of " + std::to_string(report.tile_size) + " cells a side, halo " +
@@ -374,8 +375,6 @@ void density_prepare(const Scenario& scenario, const RasterHeader& grid, Setting
     check_file("/density/exclusions/" + std::to_string(i), scenario.file(density["exclusions"][i].get<std::string>()));
   density::raised_r_min(cell_metrics(grid.georef, grid.cols, grid.rows), s.density);  // r_max against r_min raised to this grid's cells
   if (!tile_settings(scenario).given()) return;
-  // Layers are rescaled by their whole range.
-  if (!density["layers"].empty()) throw bad_input("/density/layers: not computed on tiles yet");
   if (!scenario.resolved["plugins"].empty()) throw bad_input("/plugins: not run on tiles yet");
 }
 

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # A scenario with a reservoir (water.reservoirs) and classified streams (hydro.classify): the
 # reservoir is water for the density, the streams carry river types, and `lake --run` reads the run.
+# On tiles, reservoirs flooded by windows give the whole grid's water and figures.
 # SPDX-License-Identifier: MIT
 source "$(dirname "$0")/lib.sh" "$@"
 cd "$WORK"
@@ -22,6 +23,20 @@ assert ((water == 1) & (buildable == 1)).sum() == 0, "a reservoir cell is builda
 streams = json.load(open(run + "/streams.geojson"))["features"]
 assert all(f["properties"]["river_type"] in ("B", "E", "D", "delta") for f in streams)
 PY
+# By tiles of 50 (input.tile_size): each reservoir flooded on a window around its seed, its water
+# added to the inland water's tiles; the whole grid's water, density, settlements and figures.
+second='{"at": [9.4187, 42.5187], "depth_m": 40}'
+tiled=(--set outputs.preview=false --set "water.reservoirs=[$reservoir, $second]" --until sites)
+"$TP" --quiet run -o res_whole "${tiled[@]}" 2>/dev/null
+"$TP" --quiet run -o res_tiles "${tiled[@]}" --set input.tile_size=50 2>/dev/null
+for r in inland_water buildable density; do same_cells "res_whole/$r.tif" "res_tiles/$r.vrt" || fail "reservoirs: $r differs on tiles"; done
+cmp -s res_whole/cities.geojson res_tiles/cities.geojson || fail "reservoirs: other settlements on tiles"
+/usr/bin/python3 - <<'PY' || fail "reservoirs: the figures differ on tiles"
+import json
+w, t = (json.load(open(f + "/run.json"))["summary"]["hydro"]["reservoirs"] for f in ("res_whole", "res_tiles"))
+assert w == t and len(w) == 2 and w[1]["area_km2"] > w[0]["area_km2"], (w, t)
+PY
+
 # The lake command on the run's own roads and cities.
 "$TP" --quiet lake "$dem" lake --at=9.4187,42.5187 --level 90 --dam "LINESTRING (9.4271 42.4987, 9.4271 42.5388)" --crest 95 --run run
 /usr/bin/python3 -c "

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # `terrapolis run` tile by tile (input.tile_size, input.memory_limit_mb; docs/scale.md): the
-# terrain, hydro and density stages read the DEM by windows and write one GeoTIFF a tile and a VRT
+# terrain, hydro and density stages read the DEM (and the user's layers) by windows and write one GeoTIFF a tile and a VRT
 # per raster, the same cells as the run on the whole grid, the same streams and figures; the sites
 # stage reads the density's tiles by bands and blocks, the roads stage searches each link on a
 # window of the DEM (on the given roads and the vegetation too; the corridors on a window around each road), the access stage its travel times by tiles; the settlements, the network, the
@@ -113,6 +113,16 @@ done
 same_summary given_whole given_tiles || fail "roads.existing: the run's figures differ on tiles"
 /usr/bin/python3 -c 'import json; r = json.load(open("given_tiles/run.json"))["summary"]["roads"]; assert r["on_existing_km"] > 1 and r["corridor"]["cut_m3"] > 0 and r["corridor"]["cleared_ha"] > 0, r' ||
   fail "roads.existing on tiles: the new roads do not run on the given ones, or no earthworks or clearing"
+
+# A planner's own layers on tiles of 50: the UTM heights (metres, so rescaled by their range over
+# the whole grid, read once by bands before the tiles) as a density layer, the forest as an
+# exclusion; the density and the settlements are the whole grid's.
+own=(--set 'density.layers=[{"file":"'"$WORK"'/utm.tif","weight":2}]' --set 'density.exclusions=["'"$WORK"'/forest.tif"]' --until sites)
+"$TP" -q run "${tiled[@]}" "${own[@]}" -o own_whole
+"$TP" -q run "${tiled[@]}" "${own[@]}" --set input.tile_size=50 -o own_tiles
+for r in buildable density; do same_cells "own_whole/$r.tif" "own_tiles/$r.vrt" || fail "density.layers: $r differs on tiles"; done
+cmp -s own_whole/cities.geojson own_tiles/cities.geojson || fail "density.layers: other settlements on tiles"
+cmp -s whole/density.tif own_whole/density.tif && fail "density.layers: the layer did not change the density"
 
 # The realism figures against the real places (sites.reference) on tiles of 40: the whole grid's.
 reference=(--set sites.reference="$SOURCE/tests/data/geonames_capcorse.geojson" --until sites)

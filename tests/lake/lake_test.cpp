@@ -4,11 +4,14 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <random>
 
 #include "core/error.hpp"
 #include "core/geodesy.hpp"
+#include "io/crs.hpp"
 #include "lake/lake.hpp"
 #include "support/georefs.hpp"
+#include "support/windows.hpp"
 
 using namespace terrapolis;
 using namespace terrapolis::lake;
@@ -109,4 +112,99 @@ TEST(Lake, GeographicAreaIsTheSumOfEllipsoidalCellAreas) {
   EXPECT_TRUE(lake.spills);  // reaches the edge
   // A degree of longitude at 60° is half the one at the equator: the rows' areas say so.
   EXPECT_NEAR(m.area_m2[20] / (0.01 * 111320 * 0.01 * 111320), 0.5, 0.01);
+}
+
+namespace {
+
+/// Random valleys: Gaussian hills and pits over a tilted plane, on a UTM 32N grid of 90 m cells or a
+/// WGS 84 grid of 3 seconds, with a few nodata holes.
+Dem random_valleys(std::mt19937& rng, bool geographic) {
+  Georef g = geographic ? test::geographic(46.5, 1.0 / 1200) : test::projected(90);
+  g.crs = crs_from_user(geographic ? "EPSG:4326" : "EPSG:32632");
+  const int cols = 700, rows = 600;
+  Dem d(cols, rows, g, 0.0f);
+  std::uniform_real_distribution<double> u(0, 1);
+  struct Bump { double x, y, a, s; };
+  std::vector<Bump> bumps(40);
+  for (Bump& b : bumps) b = {u(rng) * cols, u(rng) * rows, -300 + 900 * u(rng), 20 + 100 * u(rng)};
+  const double tilt_x = u(rng) - 0.5, tilt_y = u(rng) - 0.5;
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c) {
+      double z = 500 + tilt_x * c + tilt_y * r;
+      for (const Bump& b : bumps) z += b.a * std::exp(-((c - b.x) * (c - b.x) + (r - b.y) * (r - b.y)) / (2 * b.s * b.s));
+      d(c, r) = float(z);
+    }
+  for (int h = 0; h < 3; ++h) {  // holes of nodata
+    const int c0 = int(u(rng) * (cols - 20)), r0 = int(u(rng) * (rows - 20));
+    for (int r = r0; r < r0 + 15; ++r)
+      for (int c = c0; c < c0 + 15; ++c) d(c, r) = NAN;
+  }
+  return d;
+}
+
+}  // namespace
+
+TEST(Lake, ByWindowsTheWholeGridsLake) {
+  // flood_by_windows reads a window around the seed and grows it until the water stays inside: the
+  // same cells, depths, figures and spill as the flood of the whole grid, on random valleys, seeds,
+  // depths and dams; some lakes must outgrow the first window, some reach the grid's edge.
+  std::mt19937 rng(20261206);
+  std::uniform_real_distribution<double> u(0, 1);
+  SilentProgress p;
+  int grown = 0, spilled = 0, dammed = 0;
+  for (int trial = 0; trial < 16; ++trial) {
+    const Dem dem = random_valleys(rng, trial % 2 == 1);
+    const int cols = dem.cols(), rows = dem.rows();
+    const CellMetrics metrics = cell_metrics(dem.georef(), cols, rows);
+    const GridLocator locator(dem.georef());
+    int col = 0, row = 0;
+    do col = int(u(rng) * cols), row = int(u(rng) * rows);
+    while (std::isnan(dem(col, row)));
+    LakeSpec spec;
+    const auto at = locator.cell_lonlat(col, row);
+    spec.lon = at[0], spec.lat = at[1];
+    spec.depth_m = 5 + 120 * u(rng);
+    if (trial % 3 == 0) {  // a dam across the seed's column, 40 cells east
+      spec.dam_lonlat = {locator.cell_lonlat(std::min(cols - 1, col + 40), std::max(0, row - 60)),
+                         locator.cell_lonlat(std::min(cols - 1, col + 40), std::min(rows - 1, row + 60))};
+      spec.crest_m = double(dem(col, row)) + *spec.depth_m + 10;
+      ++dammed;
+    }
+    const Lake whole = flood(dem, metrics, spec, p);
+    int reads = 0;
+    const WindowLake w = flood_by_windows(
+        dem.georef(), cols, rows,
+        [&](int c0, int r0, int n, int m) {
+          ++reads;
+          return test::window_of(dem, c0, r0, n, m);
+        },
+        spec, dem.size(), p);
+    SCOPED_TRACE("trial " + std::to_string(trial));
+    EXPECT_EQ(w.lake.cells, whole.cells);
+    EXPECT_EQ(w.lake.area_km2, whole.area_km2);
+    EXPECT_EQ(w.lake.volume_m3, whole.volume_m3);
+    EXPECT_EQ(w.lake.max_depth_m, whole.max_depth_m);
+    EXPECT_EQ(w.lake.level_m, whole.level_m);
+    EXPECT_EQ(w.lake.spills, whole.spills);
+    EXPECT_EQ(w.lake.dam_cells, whole.dam_cells);
+    EXPECT_EQ(w.lake.seed_col, col);
+    std::size_t mismatches = 0;
+    for (int r = 0; r < rows; ++r)
+      for (int c = 0; c < cols; ++c) {
+        const int x = c - w.col0, y = r - w.row0;
+        const bool in = w.lake.mask.inside(x, y) && w.lake.mask(x, y) == 1;
+        if (in != (whole.mask(c, r) == 1) || (in && w.lake.depth(x, y) != whole.depth(c, r))) ++mismatches;
+      }
+    EXPECT_EQ(mismatches, 0u);
+    grown += reads > 1;
+    spilled += whole.spills;
+    // Too little memory for the lake's window is refused, naming the seed.
+    if (reads > 1) {
+      const auto read = [&](int c0, int r0, int n, int m) { return test::window_of(dem, c0, r0, n, m); };
+      EXPECT_THROW(flood_by_windows(dem.georef(), cols, rows, read, spec, 257 * 257, p), Error);
+    }
+  }
+  EXPECT_GE(grown, 3);
+  EXPECT_GE(spilled, 2);
+  EXPECT_GE(dammed, 5);
 }
