@@ -123,6 +123,7 @@ class HydroCommand final : public Command {
       q.basins = wanted[5];
       q.streams = wanted[4] && o.unit != AccumulationUnit::cells;
       q.streams_threshold_km2 = o.streams.threshold_km2;
+      q.river_types = types;
       q.filled_file = opts(pipeline::describe_output("filled.tif", terms));
       q.flowdir_file = opts(flowdir_description, flowdir_metadata);
       q.accumulation_file = opts(acc_description, {{"UNIT", acc_unit}});
@@ -218,7 +219,7 @@ class HydroCommand final : public Command {
       throw bad_input("--outputs: the accumulation hydrometry is not computed on tiles yet (Belhadj's is)");
     if (explicit_outputs && wanted[4] && o.unit == AccumulationUnit::cells)
       throw bad_input("--outputs: streams on tiles need --area-units m2 or km2");
-    if (classify) throw bad_input("--classify: river types are not computed on tiles yet");
+    if (classify && !wanted[0]) throw bad_input("--classify: on tiles the river types read the filled tiles (--outputs ... ,filled)");
   }
 
   DemInput dem_;

@@ -11,6 +11,7 @@
 
 #include "core/error.hpp"
 #include "core/memory.hpp"
+#include "io/text_io.hpp"
 #include "io/vector_io.hpp"
 
 namespace terrapolis::cli {
@@ -65,13 +66,11 @@ std::string tiles_of_this_process(const TiledHydroRequest& q, Context& context, 
     };
   if (q.basins)
     sinks.basins = [&](int t, const Raster<std::uint32_t>& b) { write_raster(tile_path(layers[3], t), b, q.basins_file); };
-  std::size_t reaches = 0;
+  std::optional<VectorLayer> streams;  // rank 0's, written once the filled tiles are (the river types read them)
   if (q.streams)
     sinks.streams = [&](hydro::StreamCells& cells) {
-      const VectorLayer layer = hydro::streams_of_cells(cells, h.georef, cell_metrics(h.georef, h.cols, h.rows), context.progress);
+      streams = hydro::streams_of_cells(cells, h.georef, cell_metrics(h.georef, h.cols, h.rows), context.progress);
       cells = {};
-      reaches = layer.features.size();
-      write_vector((out / "streams.geojson").string(), layer);
     };
   const hydro::tiled::TiledReport report = hydro::tiled::run_tiled_hydro(
       h.cols, h.rows, h.georef, [&](int c0, int r0, int c, int r) { return reader.read(c0, r0, c, r); }, o, sinks,
@@ -79,6 +78,15 @@ std::string tiles_of_this_process(const TiledHydroRequest& q, Context& context, 
   if (!leader) return {};
   for (const Layer& l : layers)
     if (l.wanted) MosaicFiles{out.string(), l.name}.finish(grid.count(), grid.across());
+  const std::size_t reaches = streams ? streams->features.size() : 0;
+  if (streams && q.river_types) {  // each reach's ends read from the filled tiles
+    const DemWindowReader z(MosaicFiles{out.string(), "filled"}.vrt());
+    CellSampler cells(z);
+    hydro::classify_streams(*streams, hydro::FilledCells{h.georef, h.cols, h.rows, [&](int c, int r) { return cells.at(c, r); }}, q.sea_level,
+                            *q.river_types);
+    write_text_file((out / "streams.qml").string(), hydro::river_types_qml(), false);
+  }
+  if (streams) write_vector((out / "streams.geojson").string(), *streams);
   char line[560];
   std::snprintf(line, sizeof line,
                 "tiles: %d of %d cells a side, %d at once; %llu spill labels, %llu edges; %llu cells of flats across tiles (%llu rounds); "

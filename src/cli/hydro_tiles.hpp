@@ -10,6 +10,7 @@
 #include "hydro/accumulation.hpp"
 #include "hydro/tiled/tiled_hydro.hpp"
 #include "hydro/flow_directions.hpp"
+#include "hydro/river_types.hpp"
 #include "io/raster_io.hpp"
 
 namespace terrapolis::cli {
@@ -28,6 +29,9 @@ struct TiledHydroRequest {
   bool basins = false;                ///< drainage basins, labels stitched across tiles
   bool streams = false;               ///< streams.geojson, reaches stitched across tiles (unit area_m2)
   double streams_threshold_km2 = 10;
+  /// The streams' river types (--classify), each reach's ends read from the filled tiles (which
+  /// must be written); rank 0's alone (it writes the streams).
+  std::optional<hydro::RiverTypeOptions> river_types;
   WriteOptions filled_file, flowdir_file, accumulation_file, basins_file;  ///< description, metadata, COG, overwrite
 };
 

@@ -57,12 +57,17 @@ void check(const RiverTypeOptions& o) {
 }
 
 void classify_streams(VectorLayer& streams, const Dem& filled, const std::optional<double>& sea_level, const RiverTypeOptions& o) {
+  classify_streams(streams, FilledCells{filled.georef(), filled.cols(), filled.rows(), [&](int c, int r) { return filled(c, r); }}, sea_level,
+                   o);
+}
+
+void classify_streams(VectorLayer& streams, const FilledCells& filled, const std::optional<double>& sea_level, const RiverTypeOptions& o) {
   check(o);
   const int f_id = streams.field_index("id"), f_area = streams.field_index("upstream_km2"), f_length = streams.field_index("length_m"),
             f_down = streams.field_index("downstream_id");
   if (f_id < 0 || f_area < 0 || f_length < 0 || f_down < 0) throw bad_input("streams: not a layer of extract_streams");
-  const Georef& g = filled.georef();
-  auto sea = [&](int c, int r) { return filled.inside(c, r) && is_sea(filled(c, r), sea_level); };
+  const Georef& g = filled.georef;
+  auto sea = [&](int c, int r) { return c >= 0 && r >= 0 && c < filled.cols && r < filled.rows && is_sea(filled.at(c, r), sea_level); };
   const std::size_t n = streams.features.size();
   std::vector<ReachMeasures> m(n);
   std::map<std::int64_t, std::size_t> by_id;
@@ -73,7 +78,7 @@ void classify_streams(VectorLayer& streams, const Dem& filled, const std::option
     const auto a = line.front(), b = line.back();
     const auto ca = cell_of(g, a[0], a[1]), cb = cell_of(g, b[0], b[1]);
     const double length = real(f, f_length);
-    const double drop = double(filled(ca[0], ca[1])) - double(filled(cb[0], cb[1]));
+    const double drop = double(filled.at(ca[0], ca[1])) - double(filled.at(cb[0], cb[1]));
     const double chord = crs_distance_m(g.crs, a[0], a[1], b[0], b[1]);
     m[i].discharge_m3s = paper_discharge_m3s(real(f, f_area));
     m[i].slope = length > 0 ? std::max(0.0, drop) / length : 0.0;

@@ -1,6 +1,7 @@
 // Discharge and river types of stream reaches (Génévaux et al. 2013, rivers paper §5.1-5.2).
 // SPDX-License-Identifier: MIT
 #pragma once
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -45,9 +46,19 @@ RiverType classify_reach(const ReachMeasures& m, const RiverTypeOptions& options
 /// Throws bad_input naming the command-line option of a threshold out of range.
 void check(const RiverTypeOptions& options);
 
+/// The conditioned DEM as the typing reads it: its grid and its value at a cell of the grid (NaN on
+/// nodata), so that a grid larger than memory is read cell by cell (a few cells a reach).
+struct FilledCells {
+  Georef georef;
+  int cols = 0, rows = 0;
+  std::function<float(int col, int row)> at;
+};
+
 /// Adds `discharge_m3s`, `slope`, `sinuosity`, `to_mouth_km` (null when the river reaches no
 /// sea) and `river_type` to every reach of `streams` (extract_streams's layer, on `filled`'s grid).
 /// The sea is the cells at or below `sea_level`; without one there is no coast (no D, no delta).
+void classify_streams(VectorLayer& streams, const FilledCells& filled, const std::optional<double>& sea_level, const RiverTypeOptions& options);
+/// The same on a conditioned DEM held whole.
 void classify_streams(VectorLayer& streams, const Dem& filled, const std::optional<double>& sea_level, const RiverTypeOptions& options);
 
 /// A QGIS 3 style (.qml) drawing a classified streams layer by `river_type`, width by discharge.

@@ -563,6 +563,21 @@ Dem DemWindowReader::read(int col0, int row0, int cols, int rows) const {
   return window;
 }
 
+CellSampler::CellSampler(const DemWindowReader& reader, int block, std::size_t max_blocks)
+    : reader_(reader), block_(std::max(1, block)), max_blocks_(std::max<std::size_t>(1, max_blocks)) {}
+
+float CellSampler::at(int col, int row) {
+  const std::pair<int, int> key{col / block_, row / block_};
+  auto it = blocks_.find(key);
+  if (it == blocks_.end()) {
+    if (blocks_.size() >= max_blocks_) blocks_.clear();
+    const RasterHeader& h = reader_.header();
+    const int c0 = key.first * block_, r0 = key.second * block_;
+    it = blocks_.emplace(key, reader_.read(c0, r0, std::min(block_, h.cols - c0), std::min(block_, h.rows - r0))).first;
+  }
+  return it->second(col - key.first * block_, row - key.second * block_);
+}
+
 void DemWindowReader::check_cells() const {
   const int strip = std::max(1, int(std::min<std::int64_t>(header_.rows, (1 << 22) / std::max(1, header_.cols))));  // ~16 MB a strip
   for (int r0 = 0; r0 < header_.rows; r0 += strip) {

@@ -1,6 +1,7 @@
 // Reading DEMs and rasters from any GDAL format, and writing GeoTIFF / Cloud Optimized GeoTIFF.
 // SPDX-License-Identifier: MIT
 #pragma once
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -148,6 +149,22 @@ class ScratchFolder {
 
 /// A raster written tile by tile: tile t of a mosaic `across` tiles wide as
 /// DIR/NAME/tile_RRRR_CCCC.tif, then DIR/NAME.vrt over them all.
+/// Single cells of a raster read by windows (a mosaic larger than memory), through a cache of
+/// square blocks: `max_blocks` blocks of `block` cells a side at most (4 bytes a cell), all dropped
+/// when it is full. Not thread-safe.
+class CellSampler {
+ public:
+  explicit CellSampler(const DemWindowReader& reader, int block = 256, std::size_t max_blocks = 64);
+  /// The value at (col, row), inside the raster; NaN on nodata.
+  float at(int col, int row);
+
+ private:
+  const DemWindowReader& reader_;
+  int block_;
+  std::size_t max_blocks_;
+  std::map<std::pair<int, int>, Dem> blocks_;
+};
+
 struct MosaicFiles {
   std::string dir, name;
   std::string tile(int t, int across) const;

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # `terrapolis hydro` tile by tile (--tile-size, --memory-limit, a folder of tiles, a VRT): the
-# mosaic of its tiles equals the whole-grid outputs cell for cell; refusals; nothing left behind.
+# mosaic of its tiles equals the whole-grid outputs cell for cell, the river types the whole grid's;
+# refusals; nothing left behind.
 # SPDX-License-Identifier: MIT
 source "$(dirname "$0")/lib.sh" "$@"
 bin=$TP samples=$SAMPLES work=$WORK
@@ -76,7 +77,22 @@ awk -v n="${BASH_REMATCH[2]}" -v t="${BASH_REMATCH[3]}" -v g="${BASH_REMATCH[4]}
 [[ -z $(ls -A "$work/nz_tiled" | grep scratch) ]] || fail "scratch folder left behind"
 no_leftovers "$work"
 
+# River types on tiles (--classify): each reach's ends read back from the filled tiles. Cap Corse
+# (GEBCO 15", sea below 0: mouths, so braided reaches too) on tiles of 40: the whole grid's streams
+# byte for byte, with their style.
+corsica=$samples/gebco2022_15s_north_corsica_capcorse.asc
+"$bin" -q hydro "$corsica" "$work/types_whole" --sea-level 0 --classify --outputs filled,streams
+"$bin" -q hydro "$corsica" "$work/types_tiled" --sea-level 0 --classify --outputs filled,streams --tile-size 40
+cmp -s "$work/types_whole/streams.geojson" "$work/types_tiled/streams.geojson" || fail "--classify: the tiled streams differ"
+[[ -s $work/types_tiled/streams.qml ]] || fail "--classify: no river types style on tiles"
+/usr/bin/python3 -c '
+import json, sys
+types = {f["properties"]["river_type"] for f in json.load(open(sys.argv[1]))["features"]}
+assert {"B", "E", "D"} <= types, types' "$work/types_tiled/streams.geojson" || fail "--classify: expected straight, sinuous and braided reaches"
+
 # Refusals: exit 2, nothing written.
+expect_refused "$work/r8" "--classify: on tiles the river types read the filled tiles" "$bin" hydro "$corsica" "$work/r8" --tile-size 40 \
+  --sea-level 0 --classify --outputs streams
 expect_refused "$work/r1" "only --fill priority-flood" "$bin" hydro "$zion" "$work/r1" --tile-size 64 --fill breach
 expect_refused "$work/r2" "accumulation hydrometry is not computed on tiles" "$bin" hydro "$zion" "$work/r2" --tile-size 64 --outputs filled,hydrometry \
   --hydrometry accumulation

@@ -24,13 +24,15 @@ streams = json.load(open(run + "/streams.geojson"))["features"]
 assert all(f["properties"]["river_type"] in ("B", "E", "D", "delta") for f in streams)
 PY
 # By tiles of 50 (input.tile_size): each reservoir flooded on a window around its seed, its water
-# added to the inland water's tiles; the whole grid's water, density, settlements and figures.
+# added to the inland water's tiles, the river types read from the filled tiles; the whole grid's
+# water, density, settlements, streams and figures.
 second='{"at": [9.4187, 42.5187], "depth_m": 40}'
-tiled=(--set outputs.preview=false --set "water.reservoirs=[$reservoir, $second]" --until sites)
+tiled=(--set outputs.preview=false --set "water.reservoirs=[$reservoir, $second]" --set hydro.classify=true --until sites)
 "$TP" --quiet run -o res_whole "${tiled[@]}" 2>/dev/null
 "$TP" --quiet run -o res_tiles "${tiled[@]}" --set input.tile_size=50 2>/dev/null
 for r in inland_water buildable density; do same_cells "res_whole/$r.tif" "res_tiles/$r.vrt" || fail "reservoirs: $r differs on tiles"; done
 cmp -s res_whole/cities.geojson res_tiles/cities.geojson || fail "reservoirs: other settlements on tiles"
+cmp -s res_whole/streams.geojson res_tiles/streams.geojson || fail "hydro.classify: other river types on tiles"
 /usr/bin/python3 - <<'PY' || fail "reservoirs: the figures differ on tiles"
 import json
 w, t = (json.load(open(f + "/run.json"))["summary"]["hydro"]["reservoirs"] for f in ("res_whole", "res_tiles"))

@@ -140,7 +140,6 @@ no_leftovers "$WORK"
 [[ -z $(find . -name '.scratch*') ]] || fail "a scratch folder was left behind"
 
 # Refused before any stage, exit 2, no folder: the later stages, and what the tiles do not compute yet.
-expect_refused r3 "/hydro/classify: not computed on tiles yet" "$TP" run "${tiled[@]}" --set input.tile_size=64 --set hydro.classify=true -o r3
 expect_refused r4 "/hydro/flow mfd: not computed on tiles yet" "$TP" run "${tiled[@]}" --set input.tile_size=64 --set hydro.flow=mfd -o r4
 expect_refused r8 "/roads/corridor/side_angles: not computed on tiles yet" "$TP" run "${tiled[@]}" --set input.tile_size=64 \
   --set roads.corridor.enabled=true --set roads.corridor.side_angles="$SAMPLES/spDataLarge_srtm_zion.tif" -o r8

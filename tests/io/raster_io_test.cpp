@@ -164,3 +164,20 @@ TEST(RasterIo, UtmCornersInLonLatMatchGdalinfo) {
   const auto xy = loc.lonlat_to_crs(lr[0], lr[1]);
   EXPECT_NEAR(xy[0], p[0], 1e-4);
 }
+
+TEST(RasterIo, CellSamplerReadsTheCellsThroughItsBlocks) {
+  // Random cells of a real DEM through blocks of 37 cells, two at most held:
+  // every value the whole raster's, across block edges, the last partial blocks and evictions.
+  const std::string path = sample("whiteboxR_DEM_vermont.tif");
+  const Dem whole = read_dem(path);
+  const DemWindowReader reader(path);
+  CellSampler cells(reader, 37, 2);
+  std::uint64_t state = 12345;
+  for (int k = 0; k < 5000; ++k) {
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    const int c = int((state >> 33) % std::uint64_t(whole.cols())), r = int((state >> 13) % std::uint64_t(whole.rows()));
+    const float v = cells.at(c, r), w = whole(c, r);
+    ASSERT_TRUE(std::isnan(w) ? std::isnan(v) : v == w) << c << "," << r;
+  }
+  EXPECT_EQ(cells.at(whole.cols() - 1, whole.rows() - 1), whole(whole.cols() - 1, whole.rows() - 1));
+}
