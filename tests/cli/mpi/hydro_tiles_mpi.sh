@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # `mpirun -np N terrapolis-mpi hydro --tile-size`: tiles dealt to 1, 2 and 4 ranks give the cells of
 # the whole grid and of the single-process tiled run, byte for byte (basins included); a depression and a flat that
-# span four tiles each; a bad input is one error line from rank 0, exit 2, nothing left behind.
+# span four tiles each; the exchanges in rounds when they exceed what one call carries; a bad input
+# is one error line from rank 0, exit 2, nothing left behind.
 # Usage: hydro_tiles_mpi.sh TERRAPOLIS SAMPLES SOURCE TERRAPOLIS_MPI MPIRUN (registered when MPI is found)
 # SPDX-License-Identifier: MIT
 source "$(dirname "$0")/../lib.sh" "$@"
@@ -68,6 +69,14 @@ for np in 1 2 4; do
     [[ $(ls "$work/np$np/$o"/tile_*.tif | wc -l) -eq 9 ]] || fail "np $np: expected 9 $o tiles"
   done
   [[ -z $(ls -A "$work/np$np" | grep scratch) ]] || fail "np $np: scratch folder left behind"
+done
+# An exchange larger than one MPI call carries (2 GB) goes in rounds: rounds of at most 1000 bytes
+# here (each rank sending its next 500 or 250), hundreds of them, the same bytes.
+for np in 2 4; do
+  TERRAPOLIS_MPI_EXCHANGE_BYTES=1000 mpi "$np" -v hydro "$dem" "$work/rounds$np" --tile-size 100 --streams-threshold 0.5 --outputs $all \
+    --threads 1 2>"$work/rounds$np.log" || fail "np $np in rounds: $(cat "$work/rounds$np.log")"
+  cmp -s "$work/whole/streams.geojson" "$work/rounds$np/streams.geojson" || fail "np $np in rounds: streams differ from the whole grid"
+  for o in "${outputs[@]}"; do same_cells "$work/whole/$o.tif" "$work/rounds$np/$o.vrt" || fail "np $np in rounds: $o differs"; done
 done
 no_leftovers "$work"
 
