@@ -73,7 +73,10 @@ class PathCommand final : public Command {
     auto t0 = std::chrono::steady_clock::now();  // the search (by windows: their reads too)
     if (tiles.given()) {
       check_windows_allowed(plugins);
-      corridor_options = pipeline::corridor_settings(options_.scenario()).options;
+      const pipeline::CorridorSettings settings = pipeline::corridor_settings(options_.scenario());
+      corridor_options = settings.options;
+      if (!settings.side_angles.empty() && !corridor.empty())  // the windows' margin counts the map's shallowest angle
+        corridor_options.least_side_angle_deg = pipeline::least_side_angle(settings.side_angles, DemWindowReader(dem_.path, dem_.options()).header());
       // The inland water's tiles, gone before the outputs are committed.
       const ScratchFolder scratch((std::filesystem::path(out).parent_path() / ".inland_water").string());
       t0 = std::chrono::steady_clock::now();
@@ -82,6 +85,9 @@ class PathCommand final : public Command {
         throw processing_error("path: no road found within the windows --memory-limit allows (raise it, or route on the whole DEM)");
       terrain = std::move(w.terrain);
       road = std::move(w.road);
+      if (!settings.side_angles.empty() && terrain)  // the map on the last window, which holds the corridor
+        corridor_options.side_angles_deg = read_resampled(settings.side_angles, terrain->georef().window(terrain->col0(), terrain->row0()),
+                                                          terrain->cols(), terrain->rows(), Resampling::nearest);
     } else {
       dem.emplace(dem_.read());
       terrain = std::make_unique<roads::TerrainField>(options_.terrain(*dem, plugins, context.progress, context.log));
@@ -167,7 +173,6 @@ class PathCommand final : public Command {
     if (options_.routing().router != roads::Router::galin) refuse("--router bezier");
     if (!options_.earthworks.empty()) refuse("--earthworks");
     if (!plugins.empty()) refuse("--plugin");
-    if (!options_.scenario().path("/roads/corridor/side_angles").empty()) refuse("--side-angles");
     if (!pipeline::inland_water_settings(options_.scenario()).reservoirs.empty()) refuse("water.reservoirs");
   }
 

@@ -178,6 +178,17 @@ std::vector<LayerOnGrid> layers_on_grid(const Scenario& scenario, const Georef& 
   return out;
 }
 
+double least_side_angle(const std::string& map, const RasterHeader& grid) {
+  const int band = std::clamp(int((1 << 21) / std::max(1, grid.cols)), 1, grid.rows);  // 8 MB a band
+  float least = 90;
+  for (int r = 0; r < grid.rows; r += band) {
+    const Raster<float> angles = read_resampled(map, grid.georef.window(0, r), grid.cols, std::min(band, grid.rows - r), Resampling::nearest);
+    for (const float a : angles.values())
+      if (a > 0 && a < 90) least = std::min(least, a);
+  }
+  return least < 90 ? least : 0.0;
+}
+
 std::vector<std::string> density_files(const Scenario& scenario) {
   const json& d = scenario.resolved["density"];
   std::vector<std::string> files = {scenario.path("/water/water_mask"), scenario.path("/density/model")};

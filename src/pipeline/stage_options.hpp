@@ -73,6 +73,10 @@ std::vector<LayerOnGrid> layers_on_grid(const Scenario& scenario, const Georef& 
 /// The same onto a window of the grid (density by tiles), `layers` being layers_on_grid's.
 void read_density_files(const Scenario& scenario, const Georef& window, int cols, int rows, const std::vector<LayerOnGrid>& layers,
                         const std::string& water_mask, density::DensityOptions& options);
+/// The shallowest angle within (0, 90) of a map of side angles (roads.corridor.side_angles) over the
+/// grid, 0 when it holds none: read by bands of rows as the corridors read it (nearest cell), for
+/// the reach of corridors read by windows (CorridorOptions::least_side_angle_deg).
+double least_side_angle(const std::string& map, const RasterHeader& grid);
 /// The files read_density_files reads (the water mask, the layers, the exclusions), as paths.
 std::vector<std::string> density_files(const Scenario& scenario);
 /// The sites section, with the scenario's seed.

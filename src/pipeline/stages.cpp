@@ -647,7 +647,7 @@ json corridor_hook(RunState& s, const roads::TerrainField& terrain, const std::v
                    const roads::CorridorWindows* windows) {
   CorridorSettings c = s.settings.corridor;
   if (!c.enabled) return nullptr;
-  if (!c.side_angles.empty())
+  if (!c.side_angles.empty() && !windows)  // by windows, each road's window of the map (CorridorWindows::side_angles)
     c.options.side_angles_deg = read_resampled(c.side_angles, s.dem.georef(), s.dem.cols(), s.dem.rows(), Resampling::nearest);
   const roads::Corridors corridors = roads::road_corridors(terrain, built, c.options, existing, windows);  // the new stretches only
   s.write("roads", "corridors.geojson", roads::corridors_layer(terrain, corridors), Style::corridors);
@@ -786,8 +786,13 @@ void roads_run(RunState& s, Progress& progress, const Log& log) {
     s.write("roads", "junctions.geojson", roads::junctions_layer(*terrain, r.layout), Style::junctions);
   s.write("roads", "road_sections.geojson", roads::sections_layer(*terrain, r.roads), Style::road_sections);
   std::optional<roads::CorridorWindows> corridor_windows;
-  if (by_windows)
-    corridor_windows = roads::CorridorWindows{by_windows->windows.read, by_windows->windows.window.margin_cells, !settings.vegetation.empty()};
+  if (by_windows) {
+    corridor_windows = roads::CorridorWindows{by_windows->windows.read, by_windows->windows.window.margin_cells, !settings.vegetation.empty(), {}};
+    if (const std::string& map = s.settings.corridor.side_angles; !map.empty())  // as corridor_hook reads it on the whole grid
+      corridor_windows->side_angles = [map, grid = s.grid.georef](int c0, int r0, int cols, int rows) {
+        return read_resampled(map, grid.window(c0, r0), cols, rows, Resampling::nearest);
+      };
+  }
   const json corridor = corridor_hook(s, *terrain, r.roads, r.existing, corridor_windows ? &*corridor_windows : nullptr);
   std::map<std::string, double> km;
   double bridge_m = 0, tunnel_m = 0, over_limit_m = 0, water_m = 0, network_km = 0;
@@ -822,12 +827,13 @@ void roads_load(RunState&) {}  // the access stage reads the saved layers
 void roads_prepare(const Scenario& scenario, const RasterHeader& grid, Settings& s) {
   s.roads = roads_settings(scenario);
   s.corridor = corridor_settings(scenario);
-  if (tile_settings(scenario).given()) {  // by windows (RunRoadWindows): what reads the whole grid is refused
-    const auto refuse = [](const std::string& what) { throw bad_input(what + ": not computed on tiles yet (input.tile_size, input.memory_limit_mb)"); };
-    if (!s.corridor.side_angles.empty()) refuse("/roads/corridor/side_angles");
-    if (s.roads.routing.router != roads::Router::galin) refuse("/roads/router");
-  }
   check_file("/roads/corridor/side_angles", s.corridor.side_angles);
+  if (tile_settings(scenario).given()) {  // by windows (RunRoadWindows): what reads the whole grid is refused
+    if (s.roads.routing.router != roads::Router::galin)
+      throw bad_input("/roads/router: not computed on tiles yet (input.tile_size, input.memory_limit_mb)");
+    if (!s.corridor.side_angles.empty() && s.corridor.enabled)  // the corridors' reach counts the map's shallowest angle
+      named("/roads/corridor/side_angles", [&] { s.corridor.options.least_side_angle_deg = least_side_angle(s.corridor.side_angles, grid); });
+  }
   check_file("/roads/vegetation", s.roads.vegetation);
   if (const std::string& lines = s.roads.existing; !lines.empty()) {
     check_file("/roads/existing", lines);

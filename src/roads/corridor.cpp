@@ -216,7 +216,8 @@ double corridor_reach_m(const CorridorOptions& options) {
   double half = options.half_width_m;
   for (const ClassWidths& w : options.widths) half = std::max(half, 0.5 * w.platform_m);
   // The side slope earthwork_options uses, unclamped (an angle out of (0, 90) is refused there).
-  const double angle = options.side_angle_deg;
+  const double least = options.least_side_angle_deg;
+  const double angle = least > 0 && least < options.side_angle_deg ? least : options.side_angle_deg;
   return half + (angle > 0 && angle < 90 ? options.max_height_m / std::tan(angle * kRad) : 0.0);
 }
 
@@ -242,14 +243,15 @@ EarthworkOptions earthwork_options(const CorridorOptions& c, Raster<float>& slop
 
 namespace {
 
-/// The window of the grid (`frame`'s) holding a road's points and `w.margin_cells` around them.
-TerrainField window_around(const CorridorWindows& w, const TerrainField& frame, const RoadGeometry& road) {
+/// The window of the grid (`frame`'s) holding a road's points and `w.margin_cells` around them:
+/// its first cell and size.
+std::array<int, 4> window_around(const CorridorWindows& w, const TerrainField& frame, const RoadGeometry& road) {
   double c0 = kInfinity, r0 = kInfinity, c1 = -kInfinity, r1 = -kInfinity;
   for (const GridPoint& p : road.points) c0 = std::min(c0, p.col), r0 = std::min(r0, p.row), c1 = std::max(c1, p.col), r1 = std::max(r1, p.row);
   const int a = std::max(0, int(std::floor(c0)) - w.margin_cells), b = std::max(0, int(std::floor(r0)) - w.margin_cells);
   const int c = std::min(frame.grid_cols() - 1, int(std::ceil(c1)) + w.margin_cells);
   const int d = std::min(frame.grid_rows() - 1, int(std::ceil(r1)) + w.margin_cells);
-  return w.read(a, b, c - a + 1, d - b + 1);
+  return {a, b, c - a + 1, d - b + 1};
 }
 
 }  // namespace
@@ -257,10 +259,12 @@ TerrainField window_around(const CorridorWindows& w, const TerrainField& frame, 
 Corridors corridors(const TerrainField& terrain, const std::vector<const RoadGeometry*>& roads, const CorridorOptions& options,
                     const std::vector<RoadClass>& classes, const CorridorWindows* windows) {
   if (!classes.empty() && classes.size() != roads.size()) throw processing_error("corridor: one class per road");
-  if (windows && options.side_angles_deg.size() > 0) throw bad_input("corridor: a map of side angles is not read by windows");
+  if (windows && options.side_angles_deg.size() > 0) throw processing_error("corridor: by windows, the map of side angles is read on each window");
   Raster<float> slopes;
   std::array<EarthworkOptions, 4> by_class;
   for (std::size_t c = 0; c < by_class.size(); ++c) by_class[c] = earthwork_options(options, slopes, RoadClass(c));
+  CorridorOptions with_map;  // by windows: the options with the road's window of the map
+  if (windows && windows->side_angles) with_map = options;
   const Crs& crs = terrain.georef().crs;
   Corridors out;
   out.vegetation = windows ? windows->vegetation : terrain.has_vegetation();
@@ -269,7 +273,14 @@ Corridors corridors(const TerrainField& terrain, const std::vector<const RoadGeo
   for (std::size_t ri = 0; ri < roads.size(); ++ri) {
     const RoadGeometry& road = *roads[ri];
     std::optional<TerrainField> window;
-    if (windows && !road.points.empty()) window.emplace(window_around(*windows, terrain, road));
+    if (windows && !road.points.empty()) {
+      const auto [c0, r0, w, h] = window_around(*windows, terrain, road);
+      window.emplace(windows->read(c0, r0, w, h));
+      if (windows->side_angles) {
+        with_map.side_angles_deg = windows->side_angles(c0, r0, w, h);
+        for (std::size_t c = 0; c < by_class.size(); ++c) by_class[c] = earthwork_options(with_map, slopes, RoadClass(c));
+      }
+    }
     const TerrainField& t = window ? *window : terrain;
     const std::size_t c = classes.empty() ? std::size_t(RoadClass::departmental) : std::min(std::size_t(classes[ri]), by_class.size() - 1);
     const EarthworkOptions& o = by_class[c];

@@ -3,6 +3,7 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 #include <array>
+#include <functional>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -41,6 +42,9 @@ struct CorridorOptions {
   double side_angle_deg = 25;  ///< angle of the cut and fill sides where no map says otherwise (deg, 0-90 exclusive)
   /// Optional map of side angles (deg) on the DEM's grid, e.g. from a geology map; NaN or <= 0: side_angle_deg.
   Raster<float> side_angles_deg;
+  /// Roads by windows with a map of side angles (CorridorWindows::side_angles): the map's
+  /// shallowest angle within (0, 90) over the grid, which corridor_reach_m counts; 0: no map.
+  double least_side_angle_deg = 0;
   double max_height_m = 50;   ///< deepest cut / highest fill (bounds the work area; beyond it a wall is needed), m
 };
 
@@ -81,7 +85,7 @@ struct Corridors {
 };
 
 /// How far (m) from a road's axis its corridor reads the terrain: the widest half-platform and a side
-/// rising max_height_m at side_angle_deg (a map of side angles is not counted).
+/// rising max_height_m at side_angle_deg, or at least_side_angle_deg when that is shallower.
 double corridor_reach_m(const CorridorOptions& options);
 
 /// The earthworks options these corridor options imply for a road of class `road_class` (r: the
@@ -105,12 +109,16 @@ EarthworkOptions earthwork_options(const CorridorOptions& options, Raster<float>
 /// road's points and `margin_cells` around them, one road at a time. A margin of
 /// window_margin_cells(0, corridor_reach_m(options), ...) holds every cell a cross-section reads, so
 /// the corridors are the whole grid's; the roads' own windows had that margin, so a road's window
-/// is no larger than the largest its search read. A map of side angles is not read by windows
-/// (refused: bad_input).
+/// is no larger than the largest its search read. A map of side angles is read on the same window
+/// (`side_angles`), the margin counting its shallowest angle (least_side_angle_deg).
 struct CorridorWindows {
   ReadTerrainWindow read;
   int margin_cells = 0;
   bool vegetation = false;  ///< the windows carry a vegetation layer (Corridors::vegetation)
+  /// The map of side angles (deg) on a window of the grid, as CorridorOptions::side_angles_deg holds
+  /// it on the whole grid; empty: no map.
+  using ReadAngles = std::function<Raster<float>(int col0, int row0, int cols, int rows)>;
+  ReadAngles side_angles;
 };
 Corridors corridors(const TerrainField& terrain, const std::vector<const RoadGeometry*>& roads, const CorridorOptions& options,
                     const std::vector<RoadClass>& classes = {}, const CorridorWindows* windows = nullptr);

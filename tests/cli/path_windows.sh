@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # `terrapolis path --memory-limit` (docs/roads.md, "One road on a region larger than memory"): the
 # road searched on windows of the DEM, grown until the bound proves it the whole grid's, is the
-# whole-grid road byte for byte (road, sections, corridor, with a vegetation layer too), on a file
+# whole-grid road byte for byte (road, sections, corridor, with a vegetation layer and a map of side
+# angles too), on a file
 # and on a 3 x 3 VRT of tiles;
 # what reads the whole DEM, and a limit too small for the road, refused before anything is written.
 # SPDX-License-Identifier: MIT
@@ -40,6 +41,13 @@ gdal_calc.py --quiet -A zutm.tif --outfile forest.tif --type Float32 --calc "cli
 cmp -s fwhole.geojson fwin.geojson || fail "--vegetation: the road on windows differs from the whole grid's"
 cmp -s fwhole_c.geojson fwin_c.geojson || fail "--vegetation: the corridor on windows differs from the whole grid's"
 cmp -s fwhole.geojson zwhole.geojson && fail "--vegetation changed nothing: the test compares nothing it prices"
+# A map of side angles (50 deg above 1700 m, loose ground at 10 deg below), read on the road's
+# last window, whose margin counts the map's shallowest angle: the whole grid's corridor.
+gdal_calc.py --quiet -A "$zion" --outfile angles.tif --type Float32 --calc "where(A > 1700, 50, 10)"
+"$TP" -q path "$zion" "${zends[@]}" awhole.geojson --corridor awhole_c.geojson --side-angles angles.tif
+"$TP" -q path "$zion" "${zends[@]}" awin.geojson --corridor awin_c.geojson --side-angles angles.tif --memory-limit $limit
+cmp -s awhole_c.geojson awin_c.geojson || fail "--side-angles: the corridor on windows differs from the whole grid's"
+cmp -s awhole_c.geojson zwhole_c.geojson && fail "--side-angles changed nothing: the test compares nothing it reads"
 no_leftovers .
 [[ ! -e .inland_water ]] || fail "the inland water's tiles were left behind"
 

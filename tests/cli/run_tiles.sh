@@ -94,8 +94,8 @@ for l in cities.geojson network.geojson roads.geojson; do cmp -s "places_whole/$
 
 # The roads as they are (roads.existing: every other road of the whole run) on tiles of 50: the
 # links reuse them by windows as on the whole grid, the corridors of the new stretches read a window
-# around each road, the forest cleared and priced on each window; the same layers, the given roads
-# as read, figures.
+# around each road (the DEM, the forest cleared and priced, the side angles); the same layers, the
+# given roads as read, figures.
 /usr/bin/python3 -c '
 import json
 g = json.load(open("whole/roads.geojson"))
@@ -104,7 +104,12 @@ json.dump({"type": "FeatureCollection", "features": g["features"][::2]}, open("g
 # each window with the whole grid's kernel.
 gdalwarp -q -t_srs EPSG:32632 -tr 250 250 -r bilinear "$SAMPLES/gebco2022_15s_north_corsica_capcorse.asc" utm.tif
 gdal_calc.py --quiet -A utm.tif --outfile forest.tif --type Float32 --calc "clip((A - 40) / 400.0, 0, 1)"
-given=(--set roads.existing="$WORK/given.geojson" --set roads.corridor.enabled=true --set roads.vegetation="$WORK/forest.tif" --until roads)
+# A map of side angles (rock above 300 m, 60 deg; loose ground at 12 deg below; nodata at sea: the
+# default angle), read on each corridor's window, the margin counting its shallowest angle.
+gdal_calc.py --quiet -A "$SAMPLES/gebco2022_15s_north_corsica_capcorse.asc" --outfile angles.tif --type Float32 --NoDataValue -1 \
+  --calc "where(A <= 0, -1, where(A > 300, 60, 12))"
+given=(--set roads.existing="$WORK/given.geojson" --set roads.corridor.enabled=true --set roads.vegetation="$WORK/forest.tif"
+  --set roads.corridor.side_angles="$WORK/angles.tif" --until roads)
 "$TP" -q run "${tiled[@]}" "${given[@]}" -o given_whole
 "$TP" -q run "${tiled[@]}" "${given[@]}" --set input.tile_size=50 -o given_tiles
 for l in existing_roads.geojson roads.geojson sections.geojson junctions.geojson road_sections.geojson corridors.geojson; do
@@ -141,8 +146,7 @@ no_leftovers "$WORK"
 
 # Refused before any stage, exit 2, no folder: the later stages, and what the tiles do not compute yet.
 expect_refused r4 "/hydro/flow mfd: not computed on tiles yet" "$TP" run "${tiled[@]}" --set input.tile_size=64 --set hydro.flow=mfd -o r4
-expect_refused r8 "/roads/corridor/side_angles: not computed on tiles yet" "$TP" run "${tiled[@]}" --set input.tile_size=64 \
-  --set roads.corridor.enabled=true --set roads.corridor.side_angles="$SAMPLES/spDataLarge_srtm_zion.tif" -o r8
+expect_refused r8 "/roads/router: not computed on tiles yet" "$TP" run "${tiled[@]}" --set input.tile_size=64 --set roads.router=bezier -o r8
 gdal_calc.py --quiet -A "$SAMPLES/spDataLarge_srtm_zion.tif" --outfile nodata.tif --calc "A*0+65535" --NoDataValue 65535 --type UInt16
 expect_refused r5 "nodata.tif: holds no data" "$TP" run --set dem="$WORK/nodata.tif" "${tiled[@]}" --set input.tile_size=64 -o r5
 echo "run by tiles: ok"

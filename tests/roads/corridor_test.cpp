@@ -342,14 +342,18 @@ TEST(Corridor, ByWindowsAroundEachRoadTheWholeGridsCorridors) {
   // (CorridorWindows): the sections, volumes and land take are the whole grid's, on projected and
   // geographic grids, roads cutting and filling through rough hills up to the grid's edge. With no
   // margin the cross-sections stop at the window's edge: the figures differ (the test can fail).
+  // With a map of side angles (trials 4 to 7: random angles, some shallow, some NaN or out of range)
+  // read on each road's window, the margin counts the map's shallowest angle; counting the default
+  // angle alone, the figures differ.
   std::mt19937_64 rng(31);
   std::uniform_real_distribution<double> u(0, 1);
-  int differs_without_margin = 0;
-  for (int trial = 0; trial < 4; ++trial) {
+  int differs_without_margin = 0, differs_without_least = 0;
+  for (int trial = 0; trial < 8; ++trial) {
     const int cols = 120, rows = 90;
     struct Bump { double c, r, h, s; };
     std::vector<Bump> bumps;
-    for (int i = 0; i < 12; ++i) bumps.push_back({u(rng) * cols, u(rng) * rows, (u(rng) - 0.4) * 40, 3 + 8 * u(rng)});
+    const double relief = trial >= 4 ? 120 : 40;  // with the map: cuts and fills to max_height_m
+    for (int i = 0; i < 12; ++i) bumps.push_back({u(rng) * cols, u(rng) * rows, (u(rng) - 0.4) * relief, 3 + 8 * u(rng)});
     Dem dem(cols, rows, trial % 2 ? terrapolis::test::geographic(46.0, 1.0 / 3600) : terrapolis::test::projected(25.0));
     for (int r = 0; r < rows; ++r)
       for (int c = 0; c < cols; ++c) {
@@ -361,7 +365,8 @@ TEST(Corridor, ByWindowsAroundEachRoadTheWholeGridsCorridors) {
     std::vector<RoadGeometry> roads;
     for (int k = 0; k < 4; ++k) {  // polylines at a level deck, the last one reaching the grid's edge
       const double c0 = 2 + u(rng) * (cols - 4), r0 = 2 + u(rng) * (rows - 4);
-      const double c1 = k == 3 ? cols - 1 : 2 + u(rng) * (cols - 4), r1 = 2 + u(rng) * (rows - 4);
+      const double c1 = k == 3 ? cols - 1 : 2 + u(rng) * (cols - 4);
+      const double r1 = trial >= 4 ? r0 : 2 + u(rng) * (rows - 4);  // with the map, east-west: every side meets the window's edge
       const double deck = 50 + 10 * u(rng);
       RoadGeometry g;
       const int n = int(2 * std::hypot(c1 - c0, r1 - r0)) + 2;
@@ -376,6 +381,15 @@ TEST(Corridor, ByWindowsAroundEachRoadTheWholeGridsCorridors) {
     for (const RoadGeometry& g : roads) pointers.push_back(&g);
     CorridorOptions o = options(30);
     o.max_height_m = 6;
+    Raster<float> map(cols, rows, dem.georef());
+    if (trial >= 4) {
+      for (float& a : map.values()) {
+        const double v = u(rng);
+        a = v < 0.1 ? NAN : v < 0.2 ? 95.0f : float(8 + 12 * u(rng));  // shallow sides: wide corridors
+      }
+      o.side_angles_deg = map;
+      o.max_height_m = 40;
+    }
     const std::string expected = corridors_text(corridors(whole, pointers, o));
     const TerrainGrid grid{dem.georef(), cols, rows, whole.has_bathymetry()};
     const TerrainField frame = TerrainField::frame(grid);
@@ -384,11 +398,23 @@ TEST(Corridor, ByWindowsAroundEachRoadTheWholeGridsCorridors) {
       ++reads;
       return TerrainField(terrapolis::test::window_of(dem, c0, r0, w, h), c0, r0, grid, 0.0, 10.0, 0.0);
     };
-    const CorridorWindows windows{read, window_margin_cells(0, corridor_reach_m(o), whole.min_cell_m())};
-    EXPECT_EQ(expected, corridors_text(corridors(frame, pointers, o, {}, &windows))) << trial;
+    CorridorWindows::ReadAngles angles;
+    if (trial >= 4) angles = [&](int c0, int r0, int w, int h) { return terrapolis::test::window_of(map, c0, r0, w, h); };
+    CorridorOptions by_windows = o;  // the map is read on the windows, its shallowest angle counted in the margin
+    by_windows.side_angles_deg = {};
+    if (trial >= 4) by_windows.least_side_angle_deg = 8;
+    for (float a : map.values())
+      if (trial >= 4 && a > 0 && a < 90) by_windows.least_side_angle_deg = std::min(by_windows.least_side_angle_deg, double(a));
+    const CorridorWindows windows{read, window_margin_cells(0, corridor_reach_m(by_windows), whole.min_cell_m()), false, angles};
+    EXPECT_EQ(expected, corridors_text(corridors(frame, pointers, by_windows, {}, &windows))) << trial;
     EXPECT_EQ(reads, roads.size()) << trial;  // a window a road
-    const CorridorWindows no_margin{read, 0};
-    differs_without_margin += expected != corridors_text(corridors(frame, pointers, o, {}, &no_margin));
+    const CorridorWindows no_margin{read, 0, false, angles};
+    differs_without_margin += expected != corridors_text(corridors(frame, pointers, by_windows, {}, &no_margin));
+    if (trial >= 4) {
+      const CorridorWindows default_margin{read, window_margin_cells(0, corridor_reach_m(o), whole.min_cell_m()), false, angles};
+      differs_without_least += expected != corridors_text(corridors(frame, pointers, by_windows, {}, &default_margin));
+    }
   }
-  EXPECT_GE(differs_without_margin, 2);
+  EXPECT_GE(differs_without_margin, 4);
+  EXPECT_GE(differs_without_least, 1);
 }
