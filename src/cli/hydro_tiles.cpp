@@ -80,10 +80,7 @@ std::string tiles_of_this_process(const TiledHydroRequest& q, Context& context, 
     if (l.wanted) MosaicFiles{out.string(), l.name}.finish(grid.count(), grid.across());
   const std::size_t reaches = streams ? streams->features.size() : 0;
   if (streams && q.river_types) {  // each reach's ends read from the filled tiles
-    const DemWindowReader z(MosaicFiles{out.string(), "filled"}.vrt());
-    CellSampler cells(z);
-    hydro::classify_streams(*streams, hydro::FilledCells{h.georef, h.cols, h.rows, [&](int c, int r) { return cells.at(c, r); }}, q.sea_level,
-                            *q.river_types);
+    hydro::classify_streams(*streams, DemWindowReader(MosaicFiles{out.string(), "filled"}.vrt()), h.georef, q.sea_level, *q.river_types);
     write_text_file((out / "streams.qml").string(), hydro::river_types_qml(), false);
   }
   if (streams) write_vector((out / "streams.geojson").string(), *streams);

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <map>
 #include <vector>
 
@@ -56,12 +57,16 @@ void check(const RiverTypeOptions& o) {
   if (!(o.coast_distance_km >= 0) || !std::isfinite(o.coast_distance_km)) throw bad_input("/hydro/coast_distance_km: must be >= 0 km");
 }
 
-void classify_streams(VectorLayer& streams, const Dem& filled, const std::optional<double>& sea_level, const RiverTypeOptions& o) {
-  classify_streams(streams, FilledCells{filled.georef(), filled.cols(), filled.rows(), [&](int c, int r) { return filled(c, r); }}, sea_level,
-                   o);
-}
+namespace {
 
-void classify_streams(VectorLayer& streams, const FilledCells& filled, const std::optional<double>& sea_level, const RiverTypeOptions& o) {
+/// The conditioned DEM as the typing reads it: its grid and its value at a cell (NaN on nodata).
+struct FilledCells {
+  const Georef& georef;
+  int cols = 0, rows = 0;
+  std::function<float(int col, int row)> at;
+};
+
+void classify(VectorLayer& streams, const FilledCells& filled, const std::optional<double>& sea_level, const RiverTypeOptions& o) {
   check(o);
   const int f_id = streams.field_index("id"), f_area = streams.field_index("upstream_km2"), f_length = streams.field_index("length_m"),
             f_down = streams.field_index("downstream_id");
@@ -136,6 +141,18 @@ void classify_streams(VectorLayer& streams, const FilledCells& filled, const std
     else v.emplace_back(m[i].to_mouth_km);
     v.emplace_back(std::string(river_type_name(classify_reach(m[i], o))));
   }
+}
+
+}  // namespace
+
+void classify_streams(VectorLayer& streams, const Dem& filled, const std::optional<double>& sea_level, const RiverTypeOptions& o) {
+  classify(streams, {filled.georef(), filled.cols(), filled.rows(), [&](int c, int r) { return filled(c, r); }}, sea_level, o);
+}
+
+void classify_streams(VectorLayer& streams, const DemWindowReader& filled, const Georef& grid, const std::optional<double>& sea_level,
+                      const RiverTypeOptions& o) {
+  CellSampler cells(filled);
+  classify(streams, {grid, filled.header().cols, filled.header().rows, [&](int c, int r) { return cells.at(c, r); }}, sea_level, o);
 }
 
 std::string river_types_qml() {

@@ -1,11 +1,11 @@
 // Discharge and river types of stream reaches (Génévaux et al. 2013, rivers paper §5.1-5.2).
 // SPDX-License-Identifier: MIT
 #pragma once
-#include <functional>
 #include <optional>
 #include <string>
 
 #include "core/raster.hpp"
+#include "io/raster_io.hpp"
 #include "io/vector_io.hpp"
 
 namespace terrapolis::hydro {
@@ -46,20 +46,14 @@ RiverType classify_reach(const ReachMeasures& m, const RiverTypeOptions& options
 /// Throws bad_input naming the command-line option of a threshold out of range.
 void check(const RiverTypeOptions& options);
 
-/// The conditioned DEM as the typing reads it: its grid and its value at a cell of the grid (NaN on
-/// nodata), so that a grid larger than memory is read cell by cell (a few cells a reach).
-struct FilledCells {
-  Georef georef;
-  int cols = 0, rows = 0;
-  std::function<float(int col, int row)> at;
-};
-
 /// Adds `discharge_m3s`, `slope`, `sinuosity`, `to_mouth_km` (null when the river reaches no
 /// sea) and `river_type` to every reach of `streams` (extract_streams's layer, on `filled`'s grid).
 /// The sea is the cells at or below `sea_level`; without one there is no coast (no D, no delta).
-void classify_streams(VectorLayer& streams, const FilledCells& filled, const std::optional<double>& sea_level, const RiverTypeOptions& options);
-/// The same on a conditioned DEM held whole.
 void classify_streams(VectorLayer& streams, const Dem& filled, const std::optional<double>& sea_level, const RiverTypeOptions& options);
+/// The same on a grid larger than memory (`grid`'s georeferencing, the filled tiles' mosaic read by
+/// `filled`): each reach's ends, and a mouth's neighbours, read cell by cell through a CellSampler.
+void classify_streams(VectorLayer& streams, const DemWindowReader& filled, const Georef& grid, const std::optional<double>& sea_level,
+                      const RiverTypeOptions& options);
 
 /// A QGIS 3 style (.qml) drawing a classified streams layer by `river_type`, width by discharge.
 std::string river_types_qml();

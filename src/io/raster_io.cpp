@@ -563,6 +563,12 @@ Dem DemWindowReader::read(int col0, int row0, int cols, int rows) const {
   return window;
 }
 
+void read_resampled_by_bands(const std::string& path, const Georef& like, int cols, int rows, Resampling resampling, const WarpScale* scale,
+                             const std::function<void(const Raster<float>& band, int row0)>& band, std::size_t band_cells) {
+  const int n = int(std::clamp(double(band_cells) / std::max(1, cols), 1.0, double(std::max(1, rows))));
+  for (int r = 0; r < rows; r += n) band(read_resampled(path, like.window(0, r), cols, std::min(n, rows - r), resampling, 1, scale), r);
+}
+
 CellSampler::CellSampler(const DemWindowReader& reader, int block, std::size_t max_blocks)
     : reader_(reader), block_(std::max(1, block)), max_blocks_(std::max<std::size_t>(1, max_blocks)) {}
 

@@ -1,6 +1,7 @@
 // Reading DEMs and rasters from any GDAL format, and writing GeoTIFF / Cloud Optimized GeoTIFF.
 // SPDX-License-Identifier: MIT
 #pragma once
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -79,6 +80,12 @@ Raster<float> read_resampled(const std::string& path, const Georef& like, int co
 /// for a grid and all its windows makes each window's warp the grid's.
 WarpScale warp_scale(const std::string& path, const Georef& like, int cols, int rows);
 
+/// read_resampled of `path` onto the grid of `like` (`cols` x `rows`) band by band, for a grid
+/// larger than memory: bands of whole rows of at most `band_cells` cells (8 bytes a cell while
+/// read, 16 MB by default), each handed to `band` with its first row.
+void read_resampled_by_bands(const std::string& path, const Georef& like, int cols, int rows, Resampling resampling, const WarpScale* scale,
+                             const std::function<void(const Raster<float>& band, int row0)>& band, std::size_t band_cells = std::size_t(1) << 21);
+
 struct WriteOptions {
   bool cog = false;        ///< Cloud Optimized GeoTIFF layout (GDAL's COG driver)
   bool overwrite = false;  ///< replace an existing file
@@ -147,8 +154,6 @@ class ScratchFolder {
   std::string path_;
 };
 
-/// A raster written tile by tile: tile t of a mosaic `across` tiles wide as
-/// DIR/NAME/tile_RRRR_CCCC.tif, then DIR/NAME.vrt over them all.
 /// Single cells of a raster read by windows (a mosaic larger than memory), through a cache of
 /// square blocks: `max_blocks` blocks of `block` cells a side at most (4 bytes a cell), all dropped
 /// when it is full. Not thread-safe.
@@ -165,6 +170,8 @@ class CellSampler {
   std::map<std::pair<int, int>, Dem> blocks_;
 };
 
+/// A raster written tile by tile: tile t of a mosaic `across` tiles wide as
+/// DIR/NAME/tile_RRRR_CCCC.tif, then DIR/NAME.vrt over them all.
 struct MosaicFiles {
   std::string dir, name;
   std::string tile(int t, int across) const;

@@ -115,7 +115,7 @@ bool spread(const Dem& dem, const CellMetrics& metrics, std::size_t seed, double
 }
 
 /// A spec placed on a grid: its seed cell, its dam in the grid's CRS (empty: none) and its level
-/// (NaN when it is a depth above the seed's ground, which the caller reads).
+/// (level_of reads a depth above the seed's ground).
 struct Placed {
   int col = 0, row = 0;
   Dam dam;
@@ -141,7 +141,6 @@ Placed place(const Georef& georef, int cols, int rows, const LakeSpec& spec) {
     out.level_m = out.dam.crest_m;
   }
   if (spec.level_m) out.level_m = *spec.level_m;
-  else if (spec.depth_m) out.level_m = NAN;
   return out;
 }
 
@@ -208,6 +207,7 @@ WindowLake flood_by_windows(const Georef& grid, int cols, int rows, const ReadWi
   }
   const CellMetrics metrics = cell_metrics(grid, cols, rows);
   double level = NAN;
+  int windows = 0;
   // A square around the seed, grown twice as wide each time the water reaches its side, until the
   // lake and the cells around it lie inside (the propagation then visits the whole grid's cells in
   // the whole grid's order: the same figures, bit for bit).
@@ -221,17 +221,14 @@ WindowLake flood_by_windows(const Georef& grid, int cols, int rows, const ReadWi
     if (std::size_t(c1 - c0) * std::size_t(r1 - r0) > max_cells) throw too_large();
     const Dem dem = read(c0, r0, c1 - c0, r1 - r0);
     const std::size_t seed = dem.index(p.col - c0, p.row - r0);
-    if (std::isnan(level)) {
-      level = level_of(spec, p, dem.is_nodata(seed) ? NAN : double(dem[seed]));
-      if (!std::isfinite(level)) throw bad_input("/level_m: must be a finite elevation in metres");
-    }
+    if (std::isnan(level)) level = level_of(spec, p, dem.is_nodata(seed) ? NAN : double(dem[seed]));  // finite: check_spec
     std::vector<std::uint8_t> is_dam;
     if (!dam_cells.empty()) {
       is_dam.assign(dem.size(), 0);
       for (std::size_t i : dam_cells)
         if (const int c = int(i % std::size_t(cols)) - c0, r = int(i / std::size_t(cols)) - r0; dem.inside(c, r)) is_dam[dem.index(c, r)] = 1;
     }
-    WindowLake out{Lake{}, c0, r0};
+    WindowLake out{Lake{}, c0, r0, ++windows};
     Lake& lake = out.lake;
     lake.level_m = level, lake.seed_col = p.col, lake.seed_row = p.row, lake.dam_cells = dam_cells.size();
     const GridSides sides = {c0 == 0, r0 == 0, c1 == cols, r1 == rows};

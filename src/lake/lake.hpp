@@ -67,6 +67,7 @@ Lake flood(const Dem& dem, const CellMetrics& metrics, const LakeSpec& spec, Pro
 struct WindowLake {
   Lake lake;
   int col0 = 0, row0 = 0;
+  int windows = 0;  ///< windows flooded, the last one holding the lake
 };
 /// A window [col0, col0 + cols) x [row0, row0 + rows) of the grid's DEM, on the grid's cells.
 using ReadWindow = std::function<Dem(int col0, int row0, int cols, int rows)>;

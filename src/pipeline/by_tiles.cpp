@@ -31,6 +31,8 @@ WindowReservoirs::WindowReservoirs(const DemWindowReader& dem, const InlandWater
       throw bad_input(pointer + e.what());
     }
     figures_.push_back(reservoir_figures(w.lake, pointer, log));
+    log.detail(pointer + ": flooded on " + std::to_string(w.windows) + " window" + (w.windows > 1 ? "s" : "") + ", the last " +
+               std::to_string(w.lake.mask.cols()) + " x " + std::to_string(w.lake.mask.rows()) + " cells");
     const Raster<std::uint8_t>& m = w.lake.mask;
     int x0 = m.cols(), y0 = m.rows(), x1 = -1, y1 = -1;  // the flooded cells' bounding box
     for (int y = 0; y < m.rows(); ++y)
@@ -128,7 +130,7 @@ density::ReadWindowInputs density_windows(const DemWindowReader& dem, const Scen
   std::shared_ptr<const DemWindowReader> accumulation;
   if (!accumulation_km2.empty() && density::needs_terrain_terms(options)) accumulation = std::make_shared<const DemWindowReader>(accumulation_km2);
   const RasterHeader& h = dem.header();
-  std::vector<LayerOnGrid> layers = layers_on_grid(scenario, h.georef, h.cols, h.rows, kLayerBandCells);
+  std::vector<LayerOnGrid> layers = layers_on_grid(scenario, h.georef, h.cols, h.rows);
   return [&dem, &scenario, &options, inland_water, hydrometry, accumulation, layers = std::move(layers)](int c0, int r0, int cols, int rows,
                                                                                                          bool dem_only) {
     density::WindowInputs in;

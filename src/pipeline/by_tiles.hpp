@@ -78,8 +78,6 @@ using ReadHydrometry = std::function<Raster<float>(const Dem& window, int c0, in
 /// and, when the terrain terms are computed, the rivers of `accumulation_km2` (empty: none). The
 /// user layers are read once over the grid first (layers_on_grid), so a window's are the grid's.
 /// Holds references to `dem`, `scenario` and `options`.
-/// The user layers' range over the grid is read by bands of rows of this many cells (16 MB while read).
-inline constexpr std::size_t kLayerBandCells = std::size_t(1) << 21;
 /// Bytes a cell of a density window more for the scenario's user layers (a float held, GDAL's
 /// warped copy) and exclusions (a byte, its copy), for run_tiled_density's tile size.
 double density_file_bytes_per_cell(const Scenario& scenario);

@@ -163,29 +163,23 @@ void read_density_files(const Scenario& scenario, const Georef& window, int cols
   read_density_files(scenario, window, cols, rows, &layers, water_mask, o);
 }
 
-std::vector<LayerOnGrid> layers_on_grid(const Scenario& scenario, const Georef& grid, int cols, int rows, std::size_t band_cells) {
+std::vector<LayerOnGrid> layers_on_grid(const Scenario& scenario, const Georef& grid, int cols, int rows) {
   std::vector<LayerOnGrid> out;
-  const int band = int(std::clamp(double(band_cells) / cols, 1.0, double(rows)));
   for (const auto& layer : scenario.resolved["density"]["layers"]) {
     const std::string file = scenario.file(layer["file"].get<std::string>());
     LayerOnGrid& l = out.emplace_back();
     l.scale = warp_scale(file, grid, cols, rows);
-    for (int r = 0; r < rows; r += band) {
-      const int n = std::min(band, rows - r);
-      l.range.add(read_resampled(file, grid.window(0, r), cols, n, Resampling::bilinear, 1, &l.scale));
-    }
+    read_resampled_by_bands(file, grid, cols, rows, Resampling::bilinear, &l.scale, [&](const Raster<float>& band, int) { l.range.add(band); });
   }
   return out;
 }
 
 double least_side_angle(const std::string& map, const RasterHeader& grid) {
-  const int band = std::clamp(int((1 << 21) / std::max(1, grid.cols)), 1, grid.rows);  // 8 MB a band
   float least = 90;
-  for (int r = 0; r < grid.rows; r += band) {
-    const Raster<float> angles = read_resampled(map, grid.georef.window(0, r), grid.cols, std::min(band, grid.rows - r), Resampling::nearest);
+  read_resampled_by_bands(map, grid.georef, grid.cols, grid.rows, Resampling::nearest, nullptr, [&](const Raster<float>& angles, int) {
     for (const float a : angles.values())
       if (a > 0 && a < 90) least = std::min(least, a);
-  }
+  });
   return least < 90 ? least : 0.0;
 }
 

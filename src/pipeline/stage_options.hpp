@@ -68,8 +68,8 @@ struct LayerOnGrid {
   density::ValueRange range;
 };
 /// density.layers over the grid `cols` x `rows` of `grid`, in their order, each read by bands of
-/// rows of at most `band_cells` cells (8 bytes a cell while read).
-std::vector<LayerOnGrid> layers_on_grid(const Scenario& scenario, const Georef& grid, int cols, int rows, std::size_t band_cells);
+/// rows (read_resampled_by_bands).
+std::vector<LayerOnGrid> layers_on_grid(const Scenario& scenario, const Georef& grid, int cols, int rows);
 /// The same onto a window of the grid (density by tiles), `layers` being layers_on_grid's.
 void read_density_files(const Scenario& scenario, const Georef& window, int cols, int rows, const std::vector<LayerOnGrid>& layers,
                         const std::string& water_mask, density::DensityOptions& options);

@@ -218,12 +218,7 @@ void hydro_run_tiles(RunState& s, Progress& progress, const Log& log) {
   s.write_mosaic("hydro", filled, report.tiles, across, Style::elevation);
   s.write_mosaic("hydro", flowdir, report.tiles, across, Style::flow_direction);
   s.write_mosaic("hydro", accumulation, report.tiles, across, Style::accumulation);
-  if (const auto& types = s.settings.river_types) {  // each reach's ends read from the filled tiles
-    const DemWindowReader z(filled.vrt());
-    CellSampler cells(z);
-    hydro::classify_streams(streams, hydro::FilledCells{g.georef, g.cols, g.rows, [&](int c, int r) { return cells.at(c, r); }},
-                            options.sea_level, *types);
-  }
+  if (const auto& types = s.settings.river_types) hydro::classify_streams(streams, DemWindowReader(filled.vrt()), g.georef, options.sea_level, *types);
   s.write("hydro", "streams.geojson", streams, Style::streams);
   json figures = hydro_figures(streams, largest_km2, 0);
   streams = {};

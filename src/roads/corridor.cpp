@@ -272,17 +272,17 @@ Corridors corridors(const TerrainField& terrain, const std::vector<const RoadGeo
   std::vector<Polygon> road_zones;  // every road's zone, united road by road
   for (std::size_t ri = 0; ri < roads.size(); ++ri) {
     const RoadGeometry& road = *roads[ri];
+    const std::size_t c = classes.empty() ? std::size_t(RoadClass::departmental) : std::min(std::size_t(classes[ri]), by_class.size() - 1);
     std::optional<TerrainField> window;
     if (windows && !road.points.empty()) {
       const auto [c0, r0, w, h] = window_around(*windows, terrain, road);
       window.emplace(windows->read(c0, r0, w, h));
-      if (windows->side_angles) {
+      if (windows->side_angles) {  // the road's class's options on its window of the map
         with_map.side_angles_deg = windows->side_angles(c0, r0, w, h);
-        for (std::size_t c = 0; c < by_class.size(); ++c) by_class[c] = earthwork_options(with_map, slopes, RoadClass(c));
+        by_class[c] = earthwork_options(with_map, slopes, RoadClass(c));
       }
     }
     const TerrainField& t = window ? *window : terrain;
-    const std::size_t c = classes.empty() ? std::size_t(RoadClass::departmental) : std::min(std::size_t(classes[ri]), by_class.size() - 1);
     const EarthworkOptions& o = by_class[c];
     const auto sections = road_sections(t, road);
     std::vector<Polygon> zones;
