@@ -193,7 +193,7 @@ class PathCommand final : public Command {
         pipeline::inland_water_mosaic(reader, pipeline::inland_water_settings(scenario), tiles, scratch, context.progress, context.log),
         ReadOptions{});
     const double budget_mb = tiles.limit_mb() - reserve_reader_memory(tiles.limit_mb());
-    const pipeline::RoadWindows w = pipeline::road_windows(reader, lakes, h.georef, scenario, model, roads::corridor_reach_m(corridor), budget_mb, 1,
+    const pipeline::RoadWindows w = pipeline::road_windows(reader, lakes, h.georef, scenario, model, roads::corridor_reach_m(corridor), budget_mb,
                                                            options_.settings().vegetation);
     roads::RoutingOptions bounded = routing;
     bounded.max_nodes = std::min(routing.max_nodes, w.max_nodes);

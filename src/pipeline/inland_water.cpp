@@ -61,12 +61,11 @@ roads::TerrainField road_terrain(const Dem& dem, const Scenario& scenario, const
 }
 
 RoadWindows road_windows(const DemWindowReader& dem, const DemWindowReader& lakes, const Georef& georef, const Scenario& scenario,
-                         const roads::CostModel& model, double reach_m, double budget_mb, std::size_t parallel,
-                         const std::string& vegetation) {
+                         const roads::CostModel& model, double reach_m, double budget_mb, const std::string& vegetation) {
   const RasterHeader& h = dem.header();
   if (!(budget_mb > 0)) throw bad_input("the memory limit leaves nothing for the roads' windows once the process is counted");
   const double sea_level = scenario.resolved["water"]["sea_level_m"].get<double>();
-  const double budget = std::max(0.0, budget_mb) * 1e6 / double(std::max<std::size_t>(1, parallel));
+  const double budget = std::max(0.0, budget_mb) * 1e6;
   RoadWindows out;
   out.grid = {georef, h.cols, h.rows, false};
   roads::WaterCount count;  // by bands of an eighth of the budget, at 4 bytes a cell

@@ -50,13 +50,13 @@ struct RoadWindows {
   std::size_t max_nodes = 0;        ///< the search's nodes within the limit
 };
 /// `budget_mb`: what the windows and searches may take together (half each: windows at
-/// roads::kWindowBytesPerCell, nodes at 48 bytes with their long-arc cache), shared by `parallel` searches at once.
+/// roads::kWindowBytesPerCell, nodes at 48 bytes with their long-arc cache); the links searched
+/// at once share it (roads::NetworkWindows).
 /// `reach_m`: how far from the road its corridor reads (0 without corridors). `vegetation`: the
 /// roads.vegetation raster, warped onto each window with the whole grid's kernel (warp_scale, as
 /// add_road_layers), or "".
 RoadWindows road_windows(const DemWindowReader& dem, const DemWindowReader& lakes, const Georef& georef, const Scenario& scenario,
-                         const roads::CostModel& model, double reach_m, double budget_mb, std::size_t parallel,
-                         const std::string& vegetation = {});
+                         const roads::CostModel& model, double reach_m, double budget_mb, const std::string& vegetation = {});
 
 /// Adds the road layers to the roads' terrain: roads.vegetation read onto the DEM's grid (when
 /// given) and the plugins' road cost terms.

@@ -705,7 +705,8 @@ json existing_figures(const roads::ExistingRoads& e, const roads::NetworkResult&
 }
 
 /// The roads stage's windows in a run by tiles: the DEM's mosaic and inland_water.vrt read by
-/// windows (pipeline::road_windows) within the memory limit, shared by the links routed at once;
+/// windows (pipeline::road_windows) within the memory limit, shared by the links routed at once
+/// (a link they leave limited is routed again alone: roads::NetworkWindows);
 /// their margin holds the corridors' reach when they are drawn. Built in place: `windows` refers
 /// to the readers.
 struct RunRoadWindows {
@@ -720,7 +721,7 @@ struct RunRoadWindows {
         parallel(roads::links_at_once(s.settings.roads.routing)),
         windows(road_windows(dem, lakes, s.grid.georef, s.scenario, s.settings.roads.model,
                              s.settings.corridor.enabled ? roads::corridor_reach_m(s.settings.corridor.options) : 0.0,
-                             in.tiles.limit_mb() - in.reserved_mb - held_mb, parallel, s.settings.roads.vegetation)),
+                             in.tiles.limit_mb() - in.reserved_mb - held_mb, s.settings.roads.vegetation)),
         frame(roads::TerrainField::frame(windows.grid)) {}
   RunRoadWindows(const RunRoadWindows&) = delete;  // `windows` refers to the readers
   RunRoadWindows& operator=(const RunRoadWindows&) = delete;
@@ -729,9 +730,8 @@ struct RunRoadWindows {
   roads::NetworkResult route(const RoadsSettings& settings, const std::vector<roads::Link>& links, const roads::ExistingRoads* existing,
                              Progress& progress) const {
     const roads::RoadGraph graph(frame, settings.model, settings.routing.graph);
-    roads::RoutingOptions routing = settings.routing;
-    routing.max_nodes = std::min(routing.max_nodes, windows.max_nodes);
-    return roads::route_network_by_windows(frame, graph, links, routing, progress, {windows.grid, windows.read, windows.window}, existing);
+    return roads::route_network_by_windows(frame, graph, links, settings.routing, progress,
+                                           {windows.grid, windows.read, windows.window, windows.max_nodes}, existing);
   }
 };
 
@@ -752,7 +752,8 @@ void roads_run(RunState& s, Progress& progress, const Log& log) {
       for (const roads::CellChain& chain : existing->chains) given_cells += chain.cells.size();
     by_windows.emplace(s, *s.by_tiles, double(given_cells) * roads::kRoadCellBytes / 1e6);
     log.detail("roads by windows: windows of at most " + std::to_string(by_windows->windows.window.max_cells) + " cells and " +
-               std::to_string(by_windows->windows.max_nodes) + " search nodes a road, " + std::to_string(by_windows->parallel) + " roads at once" +
+               std::to_string(by_windows->windows.max_nodes) + " search nodes, shared by " + std::to_string(by_windows->parallel) +
+               " roads at once (one left limited is routed again alone)" +
                (existing ? ", " + std::to_string(given_cells) + " cells of given roads" : ""));
     r = by_windows->route(settings, links, existing ? &*existing : nullptr, progress);
   } else {
@@ -944,7 +945,7 @@ void access_run_tiles(RunState& s, Progress& progress, const Log& log) {
   }
   // A band of rows: times, ids (read as floats and as ids), people, density, buildable: 24 bytes a cell.
   const int band = std::clamp(int(0.25 * budget_mb * 1e6 / 24 / cols), 1, rows);
-  const RoadWindows terrain = road_windows(dem, lakes, s.grid.georef, s.scenario, s.settings.roads.model, 0, budget_mb, 1);
+  const RoadWindows terrain = road_windows(dem, lakes, s.grid.georef, s.scenario, s.settings.roads.model, 0, budget_mb);
   const VectorLayer sections = classed_sections(s);
   const access::ReadAccessWindow read = [&](int c0, int r0, int w, int h) {
     access::AccessWindow out;

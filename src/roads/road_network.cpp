@@ -298,6 +298,7 @@ struct Attempt {
   std::vector<float> factor;  ///< by windows: the roads' factors over the last window searched
   ArcDiscount seen;           ///< by windows: the discount that window's search read
   bool limited = false;       ///< by windows: decided on the largest window the limit allows
+  bool alone = false;         ///< by windows: searched within the whole limit, not its share
 
   /// Makes `tiles` cover tiles [c0, c1] x [r0, r1] too, keeping its marks.
   void cover(int c0, int r0, int c1, int r1) {
@@ -368,7 +369,14 @@ class NetworkRouter {
       const std::vector<std::size_t> todo = next_batch(head, lookahead);
       result.searches += todo.size();
       tbb::parallel_for(std::size_t(0), todo.size(), [&](std::size_t j) { route(todo[j]); });
-      while (head < order_.size() && attempts_[head].routed && still_valid(attempts_[head])) commit(head++);
+      while (head < order_.size() && attempts_[head].routed && still_valid(attempts_[head])) {
+        // Limited (or refused) on its share of the limit: again alone, on the same roads.
+        if (windows_ && !attempts_[head].alone && (attempts_[head].limited || attempts_[head].error)) {
+          route(head, true);
+          ++result.searches;
+        }
+        commit(head++);
+      }
     }
     step_->update(1.0);
     for (std::size_t i = 0; i < edges_.size(); ++i) {
@@ -439,10 +447,13 @@ class NetworkRouter {
     return true;
   }
 
-  void route(std::size_t k) {
+  /// Routes the k-th link in importance order on the roads built so far; by windows within the
+  /// share of the limit of the links routed at once, or `alone` within all of it.
+  void route(std::size_t k, bool alone = false) {
     Attempt& at = attempts_[k];
     at = Attempt{};
     at.routed = true;
+    at.alone = alone || links_at_once(options_) == 1;
     at.version = built_.changes().size();
     at.floor = built_.floor();
     const std::size_t i = order_[k];
@@ -467,7 +478,11 @@ class NetworkRouter {
 
   /// Link i by windows (roads::route_by_windows): the roads built so far over each window, the
   /// tiles its last search read; the road's cells turned into the grid's indices.
-  void route_by_windows(Attempt& at, std::size_t i, const RoutingOptions& o) {
+  void route_by_windows(Attempt& at, std::size_t i, RoutingOptions o) {
+    const std::size_t share = at.alone ? 1 : links_at_once(options_);
+    WindowOptions window = windows_->window;
+    window.max_cells /= share;  // 0 (no limit) stays 0
+    if (windows_->max_nodes > 0) o.max_nodes = std::min(o.max_nodes, std::max<std::size_t>(1, windows_->max_nodes / share));
     WindowReuse reuse;
     reuse.over_window = [&](const TerrainField& w) -> const ArcDiscount* {
       const ArcDiscount* d = built_.discount();
@@ -490,7 +505,7 @@ class NetworkRouter {
     };
     const RoadGraph& g = graph_of(links_[i].road_class);
     WindowedRoad w = roads::route_by_windows(windows_->grid, windows_->read, g.model(), g.options(), edges_[i].a, edges_[i].b, o,
-                                             windows_->window, nullptr, &reuse);
+                                             window, nullptr, &reuse);
     std::vector<float>().swap(at.factor);  // held by the links routed ahead until they are committed
     at.seen = ArcDiscount{};                // it pointed at the factors and at tiles since re-laid
     if (w.road)

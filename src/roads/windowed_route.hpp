@@ -103,11 +103,16 @@ WindowedRoad route_by_windows(const TerrainGrid& grid, const ReadTerrainWindow& 
                               const WindowReuse* reuse = nullptr);
 
 /// The network by windows: route_network with each link routed by route_by_windows on `read`'s
-/// windows (the grid and the windows' limit in `window`), on the roads built before it.
+/// windows (the grid, the windows' limit and margin in `window`), on the roads built before it.
+/// The links searched at once (links_at_once) share the limits, each taking its part of
+/// window.max_cells and max_nodes; a link then left limited (or refused) is searched again alone
+/// with all of them, so a road is the same whatever the threads: the grid's, or the whole
+/// limit's largest window's answer.
 struct NetworkWindows {
   TerrainGrid grid;
   ReadTerrainWindow read;
   WindowOptions window;
+  std::size_t max_nodes = 0;  ///< the search nodes the limit allows one link alone (0: RoutingOptions::max_nodes only)
 };
 /// route_network by windows: `frame` is TerrainField::frame(windows.grid) (the roads' cells are its
 /// indices, the layers are drawn on it), `base` a graph on it (its model and options; the searches

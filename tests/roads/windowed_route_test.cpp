@@ -267,7 +267,7 @@ TEST(RoadByWindows, ANetworkByWindowsIsTheWholeGridsNetwork) {
   // (the roads built so far kept per road cell, each window's factors copied from them) the layers
   // are the whole grid's, byte for byte; under a limit no window read exceeds it (a counter).
   std::mt19937_64 rng(11);
-  int limited_runs = 0;
+  int limited_runs = 0, limited_links = 0;
   for (int trial = 0; trial < 6; ++trial) {
     const int cols = 220, rows = 170;
     const Dem dem = landscape(rng, cols, rows, trial % 2 ? test::geographic(45.0, 1.0 / 1200) : test::projected(10.0), trial % 3 == 0);
@@ -278,7 +278,9 @@ TEST(RoadByWindows, ANetworkByWindowsIsTheWholeGridsNetwork) {
     const RoadGraph whole_graph(whole, model, GraphOptions{});
     std::vector<Link> links;
     for (int k = 0; k < 7; ++k) {
-      const Cell a{int(rng() % cols), int(rng() % rows)}, b{int(rng() % cols), int(rng() % rows)};
+      // Ends up to 60 cells apart: most first windows fit the limit below.
+      const Cell a{int(rng() % cols), int(rng() % rows)};
+      const Cell b{std::clamp(a.col + int(rng() % 121) - 60, 0, cols - 1), std::clamp(a.row + int(rng() % 121) - 60, 0, rows - 1)};
       links.push_back({k, k + 1, dem.georef().cell_centre(a.col, a.row), dem.georef().cell_centre(b.col, b.row),
                        k < 2 ? RoadClass::national : RoadClass::departmental});
     }
@@ -300,27 +302,42 @@ TEST(RoadByWindows, ANetworkByWindowsIsTheWholeGridsNetwork) {
     };
     WindowOptions window;
     window.margin_cells = window_margin_cells(model.road_radius_m, 0, whole.min_cell_m());
+    window.pad_cells = 8;
     const NetworkResult got = route_network_by_windows(frame, frame_graph, links, options, silent, {grid, read, window});
     EXPECT_TRUE(got.limited.empty()) << trial;
     EXPECT_EQ(layers_text(whole, expected), layers_text(frame, got)) << trial;
-    // Under a limit of a fifth of the grid: no window past it; what was not proved is listed, a
-    // link whose first window is past the limit refused.
+    // Under a limit of a quarter of the grid: no window past it; what was not proved is listed, a
+    // link whose first window is past the limit refused. The two links routed at once take an
+    // eighth each and a link so limited is routed again alone: the same roads with one, two or
+    // three at once.
     largest = 0;
-    window.max_cells = std::size_t(cols) * std::size_t(rows) / 5;
-    try {
-      const NetworkResult bounded = route_network_by_windows(frame, frame_graph, links, options, silent, {grid, read, window});
-      limited_runs += !bounded.limited.empty();
-      if (bounded.limited.empty()) {
-        EXPECT_EQ(layers_text(whole, expected), layers_text(frame, bounded)) << trial;
+    window.max_cells = std::size_t(cols) * std::size_t(rows) / 4;
+    std::string first;
+    for (const std::size_t at_once : {2, 1, 3}) {
+      options.lookahead = at_once;
+      std::string text;
+      try {
+        const NetworkResult bounded = route_network_by_windows(frame, frame_graph, links, options, silent, {grid, read, window});
+        if (at_once == 2) limited_runs += !bounded.limited.empty(), limited_links += int(bounded.limited.size());
+        if (bounded.limited.empty()) {
+          EXPECT_EQ(layers_text(whole, expected), layers_text(frame, bounded)) << trial;
+        }
+        text = layers_text(frame, bounded);
+        for (const std::string& l : bounded.limited) text += " limited " + l;
+      } catch (const Error& e) {
+        EXPECT_EQ(e.kind(), ErrorKind::bad_input) << e.what();
+        EXPECT_NE(std::string(e.what()).find("the memory limit allows windows of"), std::string::npos) << e.what();
+        limited_runs += at_once == 2;
+        text = e.what();
       }
-    } catch (const Error& e) {
-      EXPECT_EQ(e.kind(), ErrorKind::bad_input) << e.what();
-      EXPECT_NE(std::string(e.what()).find("the memory limit allows windows of"), std::string::npos) << e.what();
-      ++limited_runs;
+      if (at_once == 2) first = text;
+      EXPECT_EQ(first, text) << trial << ": " << at_once << " at once";
     }
+    options.lookahead = 2;
     EXPECT_LE(largest, window.max_cells) << trial;
   }
   EXPECT_GE(limited_runs, 1);  // the limit bit somewhere: the counter was tested at its bound
+  EXPECT_GE(limited_links, 2);  // left limited even alone: the whole limit's answer, at any number at once
 }
 
 TEST(RoadByWindows, GivenRoadsByWindowsGiveTheWholeGridsNetwork) {
