@@ -482,6 +482,7 @@ class NetworkRouter {
     const std::size_t share = at.alone ? 1 : links_at_once(options_);
     WindowOptions window = windows_->window;
     window.max_cells /= share;  // 0 (no limit) stays 0
+    window.give_up_at_limit = !at.alone;  // routed again alone: the share's largest window would be wasted
     if (windows_->max_nodes > 0) o.max_nodes = std::min(o.max_nodes, std::max<std::size_t>(1, windows_->max_nodes / share));
     WindowReuse reuse;
     reuse.over_window = [&](const TerrainField& w) -> const ArcDiscount* {

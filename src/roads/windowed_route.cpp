@@ -279,6 +279,11 @@ WindowedRoad route_by_windows(const TerrainGrid& grid, const ReadTerrainWindow& 
     Box next = reached ? area.united(*reached) : area.grown(std::max(area.c1 - area.c0, area.r1 - area.r0) / 2 + 1, grid);
     if (needed && !reached) next = next.united(*needed);
     if (too_large(next)) {
+      if (window.give_up_at_limit) {
+        out.limited = true;
+        out.road.reset();
+        return out;
+      }
       int fits = 0, over = std::max(area.c1 - area.c0, area.r1 - area.r0) + 1;  // the largest growth that fits
       if (!too_large(area.grown(over, grid))) fits = over;
       while (over - fits > 1) (too_large(area.grown((fits + over) / 2, grid)) ? over : fits) = (fits + over) / 2;

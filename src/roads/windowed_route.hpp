@@ -26,6 +26,9 @@ struct WindowOptions {
   /// metre (a road of 53 km between ends 35 km apart in the Alps costs 1.6 times it).
   int pad_cells = 32;
   double first_ratio = 1.6;
+  /// Past max_cells, give up at once (WindowedRoad::limited, no road) instead of searching the
+  /// largest window the limit allows: for a caller that routes such a link again with a larger limit.
+  bool give_up_at_limit = false;
 };
 
 /// Bytes a window takes per cell while its road is searched: the terrain (surface, ground, depth,
