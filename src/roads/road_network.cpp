@@ -326,7 +326,8 @@ class NetworkRouter {
   NetworkRouter(const TerrainField& t, const RoadGraph& base, const std::vector<Link>& links, const RoutingOptions& options,
                 Progress& progress, const ExistingRoads* existing, const NetworkWindows* windows)
       : t_(t), base_(base), links_(links), options_(options), windows_(windows), built_(t, options.reuse_discount),
-        tile_cols_((std::size_t(t.cols()) >> kShift) + 1), tile_rows_((std::size_t(t.rows()) >> kShift) + 1) {
+        tile_cols_((std::size_t(t.cols()) >> kShift) + 1), tile_rows_((std::size_t(t.rows()) >> kShift) + 1),
+        at_once_(links_at_once(options)) {
     // One graph per road class, under the class's design standards, built before routing (the
     // searches share them read-only).
     for (const Link& l : links) {
@@ -363,10 +364,9 @@ class NetworkRouter {
   }
 
   NetworkResult run() {
-    const std::size_t lookahead = links_at_once(options_);
     NetworkResult result;
     for (std::size_t head = 0; head < order_.size();) {
-      const std::vector<std::size_t> todo = next_batch(head, lookahead);
+      const std::vector<std::size_t> todo = next_batch(head, at_once_);
       result.searches += todo.size();
       tbb::parallel_for(std::size_t(0), todo.size(), [&](std::size_t j) { route(todo[j]); });
       while (head < order_.size() && attempts_[head].routed && still_valid(attempts_[head])) {
@@ -453,7 +453,7 @@ class NetworkRouter {
     Attempt& at = attempts_[k];
     at = Attempt{};
     at.routed = true;
-    at.alone = alone || links_at_once(options_) == 1;
+    at.alone = alone || at_once_ == 1;
     at.version = built_.changes().size();
     at.floor = built_.floor();
     const std::size_t i = order_[k];
@@ -479,7 +479,7 @@ class NetworkRouter {
   /// Link i by windows (roads::route_by_windows): the roads built so far over each window, the
   /// tiles its last search read; the road's cells turned into the grid's indices.
   void route_by_windows(Attempt& at, std::size_t i, RoutingOptions o) {
-    const std::size_t share = at.alone ? 1 : links_at_once(options_);
+    const std::size_t share = at.alone ? 1 : at_once_;
     WindowOptions window = windows_->window;
     window.max_cells /= share;  // 0 (no limit) stays 0
     window.give_up_at_limit = !at.alone;  // routed again alone: the share's largest window would be wasted
@@ -550,6 +550,7 @@ class NetworkRouter {
   std::optional<ProgressStep> step_;  // begun once the links are checked
   const std::size_t tile_cols_, tile_rows_;
   int reach_ = 0;  // cells a surface arc's factors lie from the cell the search marks
+  const std::size_t at_once_;  // links routed at once (links_at_once): by windows, each has this share of the limit
   std::vector<Attempt> attempts_;
 };
 

@@ -67,7 +67,8 @@ struct WindowedRoad {
   bool proved = false;                  ///< the bound proved the road the grid's (false: the window was the grid, or limited)
   bool proved_by_reach = false;         ///< proved by the reach bound (road reuse), the straight line could not
   /// No window the limit allows proved the road (or found one): `road` is the largest window's
-  /// answer, the best road within it, a ferry between its land masses, or none.
+  /// answer, the best road within it, a ferry between its land masses, or none (none when the
+  /// windows outgrew max_cells under WindowOptions::give_up_at_limit).
   bool limited = false;
 };
 
